@@ -1,0 +1,108 @@
+"""LIDAR geometry and timing presets (pure data).
+
+A ``LidarSpec`` says where the beams point and how far they see; the
+simulator casts one ray per beam and the fault stage turns the truth into
+what a given driver would publish.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+
+from harness.errors import ConfigError
+
+
+@dataclass(frozen=True)
+class LidarSpec:
+    """Beam layout of one revolution, in the LIDAR frame (REP-103: CCW, x forward)."""
+
+    name: str
+    samples: int
+    angle_min: float
+    angle_increment: float
+    range_min: float
+    range_max: float
+    rate_hz: float
+
+    @property
+    def angle_max(self) -> float:
+        return self.angle_min + (self.samples - 1) * self.angle_increment
+
+    @property
+    def scan_time(self) -> float:
+        return 1.0 / self.rate_hz
+
+    @property
+    def time_increment(self) -> float:
+        return self.scan_time / self.samples
+
+    def with_overrides(self, **changes: float | int | None) -> LidarSpec:
+        """A copy with the given fields replaced (None means keep)."""
+        kept = {k: v for k, v in changes.items() if v is not None}
+        spec = replace(self, **kept)
+        spec.check()
+        return spec
+
+    def check(self) -> None:
+        """Refuse layouts no real sensor has."""
+        if not 1 <= self.samples <= 16383:
+            raise ConfigError(f"lidar samples must be 1..16383, got {self.samples}")
+        if not (0 < self.range_min < self.range_max):
+            raise ConfigError(
+                f"lidar needs 0 < range_min < range_max, got {self.range_min}..{self.range_max}"
+            )
+        if not self.rate_hz > 0:
+            raise ConfigError(f"lidar rate_hz must be positive, got {self.rate_hz}")
+        if not self.angle_increment > 0:
+            raise ConfigError(f"lidar angle_increment must be positive, got {self.angle_increment}")
+
+
+def _full_circle(samples: int, *, closed: bool) -> float:
+    """Increment for `samples` beams over a full turn; `closed` repeats the first angle."""
+    return 2 * math.pi / (samples - 1 if closed else samples)
+
+
+PRESETS: dict[str, LidarSpec] = {
+    # The lab's simulator (public FOSSBot Gazebo model): 360 samples from -pi
+    # to pi inclusive, as Gazebo spaces them ((max - min) / (samples - 1)).
+    "gazebo": LidarSpec(
+        name="gazebo",
+        samples=360,
+        angle_min=-math.pi,
+        angle_increment=_full_circle(360, closed=True),
+        range_min=0.12,
+        range_max=12.0,
+        rate_hz=10.0,
+    ),
+    # Slamtec RPLIDAR A1M8 as the FOSSBot v2 bridge publishes it: 360 one-degree
+    # bins, 0 .. 2*pi - step.
+    "rplidar_a1": LidarSpec(
+        name="rplidar_a1",
+        samples=360,
+        angle_min=0.0,
+        angle_increment=_full_circle(360, closed=False),
+        range_min=0.15,
+        range_max=12.0,
+        rate_hz=5.5,
+    ),
+    # LDROBOT LD19/LD06: 4500 samples/s at 10 Hz = 450 points per turn.
+    "ld19": LidarSpec(
+        name="ld19",
+        samples=450,
+        angle_min=0.0,
+        angle_increment=_full_circle(450, closed=False),
+        range_min=0.02,
+        range_max=12.0,
+        rate_hz=10.0,
+    ),
+}
+
+
+def preset(name: str) -> LidarSpec:
+    """The named preset, or a ConfigError listing the known ones."""
+    try:
+        return PRESETS[name]
+    except KeyError:
+        known = ", ".join(sorted(PRESETS))
+        raise ConfigError(f"unknown lidar preset {name!r} (known: {known})") from None

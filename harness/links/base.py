@@ -1,0 +1,109 @@
+"""The small interface every link shares, and the registry that names them."""
+
+from __future__ import annotations
+
+import importlib
+import pkgutil
+from abc import ABC, abstractmethod
+from dataclasses import dataclass
+from typing import Callable, ClassVar, TypeVar
+
+from harness.answers import Answers
+from harness.errors import ConfigError
+from harness.scan import Scan
+
+
+@dataclass(frozen=True)
+class LinkOptions:
+    """Settings a link may use; each link reads the ones that concern it."""
+
+    threshold: float = 0.5
+    scan_timeout: float = 1.0  # seconds to wait for the answers to one scan
+    ready_timeout: float = 20.0  # seconds to wait for the node to come up
+    processor: str | None = None  # inprocess: "module:function" instead of the reference
+    node: str | None = None  # shell command starting the node under test
+    package: str | None = None
+    executable: str | None = None
+    workspace: str | None = None
+    params: tuple[str, ...] = ()  # NAME:=VALUE items passed to the node verbatim
+    scan_topic: str = "/scan"
+    status_topic: str = "/lidar_status"
+    warning_topic: str = "/obstacle_warning"
+    realtime: bool = False
+
+
+class Link(ABC):
+    """Deliver one scan at a time and gather what the software under test says."""
+
+    name: ClassVar[str]
+
+    def __init__(self, options: LinkOptions) -> None:
+        self.options = options
+
+    def open(self) -> None:
+        """Bring the software under test up and wait (bounded) until it is ready."""
+
+    @abstractmethod
+    def send(self, scan: Scan, tick: int) -> None:
+        """Deliver one scan."""
+
+    @abstractmethod
+    def collect(self, scan: Scan, tick: int) -> Answers:
+        """Wait (bounded by options.scan_timeout) for the answers to the last scan."""
+
+    def exchange(self, scan: Scan, tick: int) -> Answers:
+        """Lockstep: send a scan, then collect its answers."""
+        self.send(scan, tick)
+        return self.collect(scan, tick)
+
+    def diagnostics(self) -> str:
+        """Extra text for failure reports (e.g. the node's last stderr lines)."""
+        return ""
+
+    def close(self) -> None:
+        """Stop everything this link started; safe to call twice."""
+
+    def __enter__(self) -> Link:
+        self.open()
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+
+_REGISTRY: dict[str, type[Link]] = {}
+L = TypeVar("L", bound=type[Link])
+
+
+def register(name: str) -> Callable[[L], L]:
+    """Class decorator: make a link available under `name` (once)."""
+
+    def decorate(cls: L) -> L:
+        if name in _REGISTRY and _REGISTRY[name] is not cls:
+            raise RuntimeError(f"link {name!r} is registered twice")
+        cls.name = name
+        _REGISTRY[name] = cls
+        return cls
+
+    return decorate
+
+
+def known_links() -> list[str]:
+    """Names of the link modules shipped in this package."""
+    import harness.links as package
+
+    return sorted(
+        m.name for m in pkgutil.iter_modules(package.__path__) if m.name not in ("base",)
+    )
+
+
+def create_link(name: str, options: LinkOptions) -> Link:
+    """The link registered as `name`, importing its module on first use."""
+    if name not in _REGISTRY:
+        if name not in known_links():
+            raise ConfigError(f"unknown link {name!r} (known: {', '.join(known_links())})")
+        try:
+            importlib.import_module(f"harness.links.{name}")
+        except ImportError as err:
+            raise ConfigError(f"link {name!r} cannot start: {err}") from None
+    return _REGISTRY[name](options)

@@ -1,0 +1,60 @@
+"""The emitted LIDAR scan: exactly the fields of sensor_msgs/LaserScan.
+
+Everything downstream of the simulator (faults, links, oracle, recordings)
+speaks this one type, so a scan judged by the oracle is byte for byte the
+scan the node under test received.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class Scan:
+    """One revolution, with REP-117 semantics for the values in ``ranges``."""
+
+    angle_min: float
+    angle_max: float
+    angle_increment: float
+    time_increment: float
+    scan_time: float
+    range_min: float
+    range_max: float
+    ranges: np.ndarray  # float32, one per beam
+    intensities: np.ndarray = field(default_factory=lambda: np.zeros(0, np.float32))
+    stamp: float = 0.0  # simulation time of the first beam, seconds
+    frame_id: str = "lidar_scan_frame"
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "ranges", np.asarray(self.ranges, dtype=np.float32))
+        object.__setattr__(self, "intensities", np.asarray(self.intensities, dtype=np.float32))
+
+    def angles(self) -> np.ndarray:
+        """Beam angles as the lab computes them: angle_min + i * angle_increment."""
+        return self.angle_min + np.arange(self.ranges.size) * self.angle_increment
+
+    def valid_mask(self) -> np.ndarray:
+        """REP-117 validity: finite and within [range_min, range_max]."""
+        r = self.ranges
+        with np.errstate(invalid="ignore"):
+            return np.isfinite(r) & (r >= self.range_min) & (r <= self.range_max)
+
+    def to_bytes(self) -> bytes:
+        """A canonical byte form, for determinism checks and digests."""
+        head = np.array(
+            [
+                self.angle_min,
+                self.angle_max,
+                self.angle_increment,
+                self.time_increment,
+                self.scan_time,
+                self.range_min,
+                self.range_max,
+                self.stamp,
+            ],
+            dtype=np.float64,
+        )
+        return head.tobytes() + self.ranges.tobytes() + self.intensities.tobytes()

@@ -1,0 +1,1 @@
+"""FOSSBot Lab 07 reference solution: LIDAR obstacle status and warning."""

@@ -1,0 +1,1 @@
+"""Robot and world models (URDF/SDF), installed as package data of `harness`."""

@@ -1,0 +1,1 @@
+"""Shipped scenario files, installed as package data of `harness`."""
