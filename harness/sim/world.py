@@ -1,0 +1,403 @@
+"""The PyBullet world of one scenario: floor, obstacles and the robot.
+
+Each ``World`` owns its own physics client (every call passes
+``physicsClientId``), so several worlds can live in one process, e.g. two
+runs compared for determinism. The world is stepped only at a fixed 240 Hz
+and built in a fixed order, which makes it deterministic.
+
+Collision groups keep the LIDAR honest: the robot and the floor sit in
+groups that the LIDAR's ray mask leaves out, so the sensor never sees its
+own robot (whatever the URDF's collision geometry) nor the floor when the
+robot pitches in wheels mode. Obstacles keep PyBullet's default groups.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import sys
+from importlib import resources
+from pathlib import Path
+from types import TracebackType
+
+import numpy as np
+import pybullet as pb
+
+from harness.errors import ConfigError
+from harness.scenario import Box, Cylinder, Model, Scenario, Wall
+from harness.sim.motion import WheelGeometry
+
+TIME_STEP = 1.0 / 240.0  # s; the only physics step the harness uses
+GRAVITY = 9.81  # m/s^2
+FLOOR_FRICTION = 1.0
+
+ROBOT_GROUP = 1 << 6  # collision filter group of every robot link
+FLOOR_GROUP = 1 << 7  # collision filter group of the floor
+_STATIC_GROUP = 2  # Bullet's StaticFilter
+RAY_MASK = -1 & ~(ROBOT_GROUP | FLOOR_GROUP)  # what the LIDAR may hit
+
+# Scenario cylinders become triangle-mesh prisms: Bullet's ray test against
+# an implicit cylinder is off by up to ~1 mm, a fine prism by far less.
+CYLINDER_SAGITTA = 2e-5  # m, largest gap between the prism and the true circle
+_CYLINDER_SEGMENTS = (64, 2048)
+
+_OBSTACLE_RGBA = (0.8, 0.55, 0.3, 1.0)
+_FLOOR_RGBA = (0.85, 0.85, 0.85, 1.0)
+
+
+def robot_models_dir() -> Path:
+    """Folder of the shipped robot and world models (``robot_models/``)."""
+    return Path(str(resources.files("harness.robot_models")))
+
+
+def yaw_quaternion(yaw: float) -> tuple[float, float, float, float]:
+    """Quaternion (x, y, z, w) of a rotation by `yaw` about +z."""
+    return (0.0, 0.0, math.sin(yaw / 2.0), math.cos(yaw / 2.0))
+
+
+def quaternion_yaw(q: tuple[float, float, float, float] | list[float]) -> float:
+    """Heading (rotation about +z) of a quaternion (x, y, z, w)."""
+    x, y, z, w = q
+    return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+
+
+class World:
+    """A PyBullet world built from a scenario; close it (or use ``with``)."""
+
+    def __init__(self, scenario: Scenario, *, gui: bool = False) -> None:
+        self.scenario = scenario
+        self.where = scenario.source or "<scenario>"
+        if gui and sys.platform.startswith("linux") and not os.environ.get("DISPLAY"):
+            raise ConfigError("--gui needs a display")
+        self.client: int = pb.connect(pb.GUI if gui else pb.DIRECT)
+        if self.client < 0:
+            raise ConfigError("cannot start PyBullet" + (" with a GUI" if gui else ""))
+        try:
+            self._build()
+        except BaseException:
+            self.close()
+            raise
+
+    # -- building ---------------------------------------------------------
+
+    def _build(self) -> None:
+        c = self.client
+        pb.setPhysicsEngineParameter(
+            fixedTimeStep=TIME_STEP,
+            numSubSteps=0,
+            deterministicOverlappingPairs=1,
+            physicsClientId=c,
+        )
+        pb.setGravity(0.0, 0.0, -GRAVITY, physicsClientId=c)
+        self.floor = self._add_floor()
+        self.obstacle_bodies: list[tuple[int, ...]] = [
+            self._add_obstacle(i, obstacle) for i, obstacle in enumerate(self.scenario.obstacles)
+        ]
+        self.robot_path = self.resolve(self.scenario.robot.urdf, "robot.urdf")
+        self.robot = self._load_robot()
+        self.lidar_link = self.link_index(self.scenario.robot.lidar_link, "robot.lidar_link")
+
+    def _add_floor(self) -> int:
+        c = self.client
+        shape = pb.createCollisionShape(pb.GEOM_PLANE, physicsClientId=c)
+        visual = pb.createVisualShape(
+            pb.GEOM_BOX,
+            halfExtents=(20.0, 20.0, 0.001),
+            visualFramePosition=(0.0, 0.0, -0.001),
+            rgbaColor=_FLOOR_RGBA,
+            physicsClientId=c,
+        )
+        floor = pb.createMultiBody(0.0, shape, visual, physicsClientId=c)
+        pb.changeDynamics(floor, -1, lateralFriction=FLOOR_FRICTION, physicsClientId=c)
+        pb.setCollisionFilterGroupMask(
+            floor, -1, FLOOR_GROUP, -1 & ~_STATIC_GROUP, physicsClientId=c
+        )
+        return floor
+
+    def _add_obstacle(self, index: int, obstacle: Wall | Box | Cylinder | Model) -> tuple[int, ...]:
+        if isinstance(obstacle, Wall):
+            (x0, y0), (x1, y1) = obstacle.start, obstacle.end
+            half = (math.dist(obstacle.start, obstacle.end) / 2.0, obstacle.thickness / 2.0)
+            return (
+                self._add_box(
+                    ((x0 + x1) / 2.0, (y0 + y1) / 2.0),
+                    (*half, obstacle.height / 2.0),
+                    math.atan2(y1 - y0, x1 - x0),
+                ),
+            )
+        if isinstance(obstacle, Box):
+            half = tuple(s / 2.0 for s in obstacle.size)
+            return (self._add_box(obstacle.position, half, obstacle.yaw),)
+        if isinstance(obstacle, Cylinder):
+            return (self._add_cylinder(obstacle),)
+        return self._add_model(index, obstacle)
+
+    def _add_box(self, xy: tuple[float, float], half: tuple[float, ...], yaw: float) -> int:
+        c = self.client
+        shape = pb.createCollisionShape(pb.GEOM_BOX, halfExtents=half, physicsClientId=c)
+        visual = pb.createVisualShape(
+            pb.GEOM_BOX, halfExtents=half, rgbaColor=_OBSTACLE_RGBA, physicsClientId=c
+        )
+        return pb.createMultiBody(
+            0.0,
+            shape,
+            visual,
+            basePosition=(xy[0], xy[1], half[2]),
+            baseOrientation=yaw_quaternion(yaw),
+            physicsClientId=c,
+        )
+
+    def _add_cylinder(self, cyl: Cylinder) -> int:
+        c = self.client
+        vertices, indices = cylinder_prism(cyl.radius, cyl.height)
+        shape = pb.createCollisionShape(
+            pb.GEOM_MESH,
+            vertices=vertices,
+            indices=indices,
+            flags=pb.GEOM_FORCE_CONCAVE_TRIMESH,
+            physicsClientId=c,
+        )
+        visual = pb.createVisualShape(
+            pb.GEOM_CYLINDER,
+            radius=cyl.radius,
+            length=cyl.height,
+            rgbaColor=_OBSTACLE_RGBA,
+            physicsClientId=c,
+        )
+        return pb.createMultiBody(
+            0.0,
+            shape,
+            visual,
+            basePosition=(cyl.position[0], cyl.position[1], cyl.height / 2.0),
+            physicsClientId=c,
+        )
+
+    def _add_model(self, index: int, model: Model) -> tuple[int, ...]:
+        c = self.client
+        field = f"obstacles[{index}].path"
+        path = self.resolve(model.path, field)
+        position, orientation = model.position, yaw_quaternion(model.yaw)
+        try:
+            if path.suffix == ".urdf":
+                body = pb.loadURDF(
+                    str(path),
+                    basePosition=position,
+                    baseOrientation=orientation,
+                    useFixedBase=True,
+                    flags=pb.URDF_USE_IMPLICIT_CYLINDER,
+                    physicsClientId=c,
+                )
+                return (body,)
+            bodies = tuple(pb.loadSDF(str(path), physicsClientId=c))
+        except pb.error as err:
+            raise ConfigError(
+                f"{self.where}: {field}: cannot load {model.path!r}: PyBullet: {err}"
+            ) from None
+        for body in bodies:  # place the SDF's world at (position, yaw); obstacles stay put
+            pos, orn = pb.getBasePositionAndOrientation(body, physicsClientId=c)
+            pos, orn = pb.multiplyTransforms(position, orientation, pos, orn)
+            pb.resetBasePositionAndOrientation(body, pos, orn, physicsClientId=c)
+            pb.changeDynamics(body, -1, mass=0.0, physicsClientId=c)
+        return bodies
+
+    def _load_robot(self) -> int:
+        c = self.client
+        start = self.scenario.robot.start
+        try:
+            robot = pb.loadURDF(
+                str(self.robot_path),
+                basePosition=(start.x, start.y, 0.0),
+                baseOrientation=yaw_quaternion(start.yaw),
+                flags=pb.URDF_USE_IMPLICIT_CYLINDER | pb.URDF_USE_INERTIA_FROM_FILE,
+                physicsClientId=c,
+            )
+        except pb.error as err:
+            raise ConfigError(
+                f"{self.where}: robot.urdf: cannot load {self.scenario.robot.urdf!r}: "
+                f"PyBullet: {err}"
+            ) from None
+        for link in range(-1, pb.getNumJoints(robot, physicsClientId=c)):
+            pb.setCollisionFilterGroupMask(robot, link, ROBOT_GROUP, -1, physicsClientId=c)
+        self.robot = robot
+        self.set_base_pose(start.x, start.y, start.yaw)
+        return robot
+
+    # -- lookups ----------------------------------------------------------
+
+    def resolve(self, ref: str, field: str) -> Path:
+        """A model file: absolute, else next to the scenario file, else in robot_models/."""
+        given = Path(ref).expanduser()
+        if given.is_absolute():
+            candidates = [given]
+        else:
+            folders = [self.scenario.base_dir, robot_models_dir()]
+            candidates = [folder / given for folder in folders if folder is not None]
+        for candidate in candidates:
+            if candidate.is_file():
+                return candidate
+        looked = ", ".join(str(c.parent) for c in candidates)
+        raise ConfigError(
+            f"{self.where}: {field}: cannot load {ref!r}: no such file (looked in {looked})"
+        )
+
+    def link_names(self) -> list[str]:
+        """The robot's link names; index i + 1 holds link i (index 0 is the root, -1)."""
+        c = self.client
+        root = pb.getBodyInfo(self.robot, physicsClientId=c)[0].decode()
+        joints = range(pb.getNumJoints(self.robot, physicsClientId=c))
+        return [root] + [
+            pb.getJointInfo(self.robot, j, physicsClientId=c)[12].decode() for j in joints
+        ]
+
+    def joint_names(self) -> list[str]:
+        """The robot's joint names, by joint index."""
+        c = self.client
+        joints = range(pb.getNumJoints(self.robot, physicsClientId=c))
+        return [pb.getJointInfo(self.robot, j, physicsClientId=c)[1].decode() for j in joints]
+
+    def link_index(self, name: str, field: str = "robot.lidar_link") -> int:
+        """PyBullet index of the named robot link (-1 for the root link)."""
+        names = self.link_names()
+        if name not in names:
+            raise ConfigError(
+                f"{self.where}: {field}: no link named {name!r} in "
+                f"{self.scenario.robot.urdf!r} (links: {', '.join(names)})"
+            )
+        return names.index(name) - 1
+
+    def joint_index(self, name: str, field: str) -> int:
+        """PyBullet index of the named robot joint."""
+        names = self.joint_names()
+        if name not in names:
+            raise ConfigError(
+                f"{self.where}: {field}: no joint named {name!r} in "
+                f"{self.scenario.robot.urdf!r} (joints: {', '.join(names) or 'none'})"
+            )
+        return names.index(name)
+
+    # -- robot pose and motion ----------------------------------------------
+
+    def link_pose(self, link: int) -> tuple[tuple[float, ...], tuple[float, ...]]:
+        """World position and orientation (x, y, z, w) of a robot link's URDF frame."""
+        return link_frame_pose(self.client, self.robot, link)
+
+    def base_pose(self) -> tuple[float, float, float]:
+        """Planar pose (x, y, yaw) of the robot's root link frame."""
+        pos, orn = self.link_pose(-1)
+        return pos[0], pos[1], quaternion_yaw(orn)
+
+    def set_base_pose(self, x: float, y: float, yaw: float) -> None:
+        """Put the robot's root link frame at (x, y, 0) facing `yaw`, at rest."""
+        c = self.client
+        info = pb.getDynamicsInfo(self.robot, -1, physicsClientId=c)
+        pos, orn = pb.multiplyTransforms((x, y, 0.0), yaw_quaternion(yaw), info[3], info[4])
+        pb.resetBasePositionAndOrientation(self.robot, pos, orn, physicsClientId=c)
+
+    def wheel_geometry(self, left: str, right: str) -> WheelGeometry:
+        """Radius, track and spin signs of two wheel joints, read from the loaded URDF."""
+        c = self.client
+        field = "motion.mode"
+        joints = (self.joint_index(left, field), self.joint_index(right, field))
+        radii, positions, signs = [], [], []
+        _, base_orn = self.link_pose(-1)
+        base_y = np.array(pb.rotateVector(base_orn, (0.0, 1.0, 0.0)))
+        for name, joint in zip((left, right), joints, strict=True):
+            info = pb.getJointInfo(self.robot, joint, physicsClientId=c)
+            if info[2] != pb.JOINT_REVOLUTE:
+                raise ConfigError(f"{self.where}: {field}: wheel joint {name!r} does not rotate")
+            radii.append(self._wheel_radius(name, joint))
+            pos, orn = self.link_pose(joint)
+            positions.append(np.array(pos))
+            axis = np.array(pb.rotateVector(orn, info[13]))
+            signs.append(1 if float(axis @ base_y) > 0 else -1)
+        track = abs(float((positions[0] - positions[1]) @ base_y))
+        return WheelGeometry(
+            joints[0], joints[1], (radii[0] + radii[1]) / 2.0, track, signs[0], signs[1]
+        )
+
+    def _wheel_radius(self, name: str, joint: int) -> float:
+        shapes = pb.getCollisionShapeData(self.robot, joint, physicsClientId=self.client)
+        for shape in shapes:
+            if shape[2] == pb.GEOM_CYLINDER:
+                return float(shape[3][1])
+            if shape[2] == pb.GEOM_SPHERE:
+                return float(shape[3][0])
+        raise ConfigError(
+            f"{self.where}: motion.mode: wheels mode needs a cylinder or sphere "
+            f"collision shape on the link of wheel joint {name!r}"
+        )
+
+    def set_wheel_velocities(
+        self, wheels: WheelGeometry, left: float, right: float, max_torque: float
+    ) -> None:
+        """Command the wheel motors (rad/s of forward roll) with a torque limit (N m)."""
+        pb.setJointMotorControlArray(
+            self.robot,
+            [wheels.left_joint, wheels.right_joint],
+            pb.VELOCITY_CONTROL,
+            targetVelocities=[wheels.left_sign * left, wheels.right_sign * right],
+            forces=[max_torque, max_torque],
+            physicsClientId=self.client,
+        )
+
+    def step(self, n: int = 1) -> None:
+        """Advance the physics by n fixed steps of TIME_STEP."""
+        for _ in range(n):
+            pb.stepSimulation(physicsClientId=self.client)
+
+    # -- lifetime -----------------------------------------------------------
+
+    def close(self) -> None:
+        """Disconnect the physics client (idempotent)."""
+        if getattr(self, "client", -1) >= 0:
+            try:
+                pb.disconnect(physicsClientId=self.client)
+            except pb.error:
+                pass
+            self.client = -1
+
+    def __enter__(self) -> World:
+        return self
+
+    def __exit__(
+        self,
+        exc_type: type[BaseException] | None,
+        exc: BaseException | None,
+        tb: TracebackType | None,
+    ) -> None:
+        self.close()
+
+
+def link_frame_pose(
+    client: int, body: int, link: int
+) -> tuple[tuple[float, ...], tuple[float, ...]]:
+    """World pose of a link's URDF frame; -1 is the root, whose COM PyBullet tracks instead."""
+    if link >= 0:
+        state = pb.getLinkState(body, link, computeForwardKinematics=1, physicsClientId=client)
+        return tuple(state[4]), tuple(state[5])
+    com_pos, com_orn = pb.getBasePositionAndOrientation(body, physicsClientId=client)
+    info = pb.getDynamicsInfo(body, -1, physicsClientId=client)
+    inv_pos, inv_orn = pb.invertTransform(info[3], info[4])
+    pos, orn = pb.multiplyTransforms(com_pos, com_orn, inv_pos, inv_orn)
+    return tuple(pos), tuple(orn)
+
+
+def cylinder_prism(radius: float, height: float) -> tuple[list[list[float]], list[int]]:
+    """A closed triangle-mesh prism around an upright cylinder centred at the origin."""
+    step = math.acos(max(-1.0, 1.0 - CYLINDER_SAGITTA / radius))
+    lo, hi = _CYLINDER_SEGMENTS
+    n = min(hi, max(lo, math.ceil(math.pi / step)))
+    ring = [
+        (radius * math.cos(2 * math.pi * k / n), radius * math.sin(2 * math.pi * k / n))
+        for k in range(n)
+    ]
+    h = height / 2.0
+    vertices = [[x, y, -h] for x, y in ring] + [[x, y, h] for x, y in ring]
+    vertices += [[0.0, 0.0, -h], [0.0, 0.0, h]]
+    indices: list[int] = []
+    for i in range(n):
+        j = (i + 1) % n
+        indices += [i, j, n + j, i, n + j, n + i]  # side, outward CCW
+        indices += [2 * n, j, i]  # bottom cap
+        indices += [2 * n + 1, n + i, n + j]  # top cap
+    return vertices, indices
