@@ -1,0 +1,381 @@
+"""Seeded fault profiles: the simulator's truth in, the emitted Scan out (pure).
+
+The simulator knows the true distance of every beam. Real sensors and their
+drivers add noise, lose returns, report ghosts closer than range_min, and
+disagree on how to write "no return" and "too close". A ``FaultProfile``
+models all of that in one fixed pipeline so a scenario can name what its
+node must survive::
+
+    truth -> noise -> classify (too close / no return / valid)
+          -> dropouts -> spurious -> convention encoding -> float32 Scan
+
+Every random draw has a fixed size per fault (one number per beam), so the
+stream an ``np.random.Generator`` yields does not depend on what the robot
+sees: same profile + seed gives byte-identical scans.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any, ClassVar
+
+import numpy as np
+
+from harness.errors import ConfigError
+from harness.lidar_spec import LidarSpec
+from harness.scan import Scan
+
+__all__ = [
+    "CONVENTIONS",
+    "NAMED_PROFILES",
+    "DROPOUT_VALUES",
+    "Convention",
+    "Dropouts",
+    "Fault",
+    "FaultProfile",
+    "Noise",
+    "Spurious",
+    "build_profile",
+]
+
+# Beam classes inside the pipeline.
+_VALID, _TOO_CLOSE, _NO_RETURN, _DROPPED, _GHOST = 0, 1, 2, 3, 4
+
+#: Intensity of a beam that carries a return (valid or spurious); 0 elsewhere.
+RETURN_INTENSITY = 1.0
+
+#: Driver conventions: name -> (no return, too close, who does it).
+CONVENTIONS: dict[str, tuple[str, str, str]] = {
+    "rep117": ("+inf", "-inf", "REP-117 as Gazebo publishes it"),
+    "inf": ("+inf", "+inf", "rplidar_ros and the FOSSBot v2 bridge: every empty bin +inf"),
+    "range_max": ("range_max", "-inf", "drivers that clamp no return to range_max"),
+    "nan": ("nan", "nan", "LDROBOT LD06/LD19 vendor driver"),
+    "zero": ("0", "0", "raw device distance 0 passed through"),
+}
+
+#: What a dropped return reads as.
+DROPOUT_VALUES: dict[str, float] = {"nan": math.nan, "zero": 0.0, "inf": math.inf}
+
+
+def _encoded(word: str, range_max: float) -> float:
+    return {
+        "+inf": math.inf,
+        "-inf": -math.inf,
+        "nan": math.nan,
+        "0": 0.0,
+        "range_max": range_max,
+    }[word]
+
+
+@dataclass(frozen=True)
+class Noise:
+    """Gaussian range noise on every true hit, before classification.
+
+    Noise can push a hit across range_min or range_max; it is then classified
+    (and encoded) like any other reading there.
+    """
+
+    sigma: float
+    kind: ClassVar[str] = "noise"
+    params: ClassVar[tuple[str, ...]] = ("sigma",)
+
+    def __post_init__(self) -> None:
+        if not (math.isfinite(self.sigma) and 0 <= self.sigma <= 1.0):
+            raise ConfigError(f"noise sigma must be in [0, 1] m, got {self.sigma}")
+
+    def describe(self) -> str:
+        return f"gaussian range noise sigma {self.sigma:g} m"
+
+
+@dataclass(frozen=True)
+class Dropouts:
+    """A fraction of the valid returns is lost and reads as ``value``."""
+
+    rate: float
+    value: str = "nan"
+    kind: ClassVar[str] = "dropouts"
+    params: ClassVar[tuple[str, ...]] = ("rate", "value")
+
+    def __post_init__(self) -> None:
+        _check_rate(self.rate, "dropouts rate")
+        if self.value not in DROPOUT_VALUES:
+            known = ", ".join(DROPOUT_VALUES)
+            raise ConfigError(f"dropouts value must be one of {known}, got {self.value!r}")
+
+    def describe(self) -> str:
+        return f"{self.rate:.0%} of valid returns read {self.value}"
+
+
+@dataclass(frozen=True)
+class Spurious:
+    """Ghost returns closer than range_min on a fraction of all beams.
+
+    Values are drawn from [0.05, 0.95) * range_min, so they stay strictly
+    inside (0, range_min) even after rounding to float32: invalid by REP-117,
+    a trap for nodes that take ``min(ranges)`` without checking range_min.
+    """
+
+    rate: float
+    kind: ClassVar[str] = "spurious"
+    params: ClassVar[tuple[str, ...]] = ("rate",)
+
+    def __post_init__(self) -> None:
+        _check_rate(self.rate, "spurious rate")
+
+    def describe(self) -> str:
+        return f"{self.rate:.0%} of beams read a ghost below range_min"
+
+
+@dataclass(frozen=True)
+class Convention:
+    """How the driver writes 'no return' and 'too close' (see ``CONVENTIONS``)."""
+
+    name: str
+    kind: ClassVar[str] = "convention"
+    params: ClassVar[tuple[str, ...]] = ("name",)
+
+    def __post_init__(self) -> None:
+        _check_convention(self.name)
+
+    def describe(self) -> str:
+        no_return, too_close, _ = CONVENTIONS[self.name]
+        return f"{self.name} convention (no return {no_return}, too close {too_close})"
+
+
+Fault = Noise | Dropouts | Spurious
+_Item = Noise | Dropouts | Spurious | Convention
+_FAULT_ORDER: tuple[str, ...] = ("noise", "dropouts", "spurious")
+_KINDS: dict[str, type[Any]] = {
+    "convention": Convention,
+    "dropouts": Dropouts,
+    "noise": Noise,
+    "spurious": Spurious,
+}
+
+
+def _check_rate(rate: float, what: str) -> None:
+    if not (isinstance(rate, (int, float)) and 0.0 <= rate <= 1.0):
+        raise ConfigError(f"{what} must be in [0, 1], got {rate!r}")
+
+
+def _check_convention(name: str) -> None:
+    if name not in CONVENTIONS:
+        known = ", ".join(CONVENTIONS)
+        raise ConfigError(f"unknown driver convention {name!r} (known: {known})")
+
+
+@dataclass(frozen=True)
+class FaultProfile:
+    """A composition of faults plus a driver convention; ``emit`` applies them."""
+
+    faults: tuple[Fault, ...] = ()
+    convention: str = "rep117"
+    name: str = "clean"
+
+    def __post_init__(self) -> None:
+        _check_convention(self.convention)
+        kinds = [f.kind for f in self.faults]
+        if len(set(kinds)) != len(kinds):
+            raise ConfigError(f"fault profile {self.name!r}: one fault of each kind, got {kinds}")
+        # Store in pipeline order so equal profiles compare equal.
+        ordered = tuple(sorted(self.faults, key=lambda f: _FAULT_ORDER.index(f.kind)))
+        object.__setattr__(self, "faults", ordered)
+
+    def _get(self, kind: str) -> Any:
+        return next((f for f in self.faults if f.kind == kind), None)
+
+    @property
+    def noise_sigma(self) -> float:
+        """Standard deviation of the range noise (0 without noise), for oracle tolerances."""
+        noise = self._get("noise")
+        return float(noise.sigma) if noise is not None else 0.0
+
+    def describe(self) -> str:
+        """One line for reports: the name and what it does."""
+        parts = [f.describe() for f in self.faults] + [Convention(self.convention).describe()]
+        return f"{self.name}: " + "; ".join(parts)
+
+    def emit(
+        self, truth: np.ndarray, spec: LidarSpec, rng: np.random.Generator, *, stamp: float
+    ) -> Scan:
+        """Turn true distances (np.inf = no hit) into the scan a driver would publish."""
+        truth = np.asarray(truth, dtype=np.float64)
+        n = spec.samples
+        if truth.shape != (n,):
+            raise ValueError(f"truth has shape {truth.shape}, the LIDAR has {n} beams")
+        values = truth.copy()
+        values[np.isnan(values)] = np.inf  # defensive: a NaN truth is "no hit"
+
+        noise = self._get("noise")
+        if noise is not None:
+            z = rng.standard_normal(n)
+            hit = np.isfinite(values)
+            values[hit] += noise.sigma * z[hit]
+
+        # Classify in float32, as the node and the oracle compare (Scan.valid_mask).
+        v32 = values.astype(np.float32)
+        rmin, rmax = np.float32(spec.range_min), np.float32(spec.range_max)
+        cls = np.full(n, _NO_RETURN, dtype=np.int8)
+        with np.errstate(invalid="ignore"):
+            cls[v32 < rmin] = _TOO_CLOSE
+            cls[(v32 >= rmin) & (v32 <= rmax)] = _VALID
+
+        dropouts = self._get("dropouts")
+        if dropouts is not None:
+            u = rng.random(n)
+            lost = (cls == _VALID) & (u < dropouts.rate)
+            v32[lost] = DROPOUT_VALUES[dropouts.value]
+            cls[lost] = _DROPPED
+
+        spurious = self._get("spurious")
+        if spurious is not None:
+            u = rng.random(n)
+            ghost = rng.uniform(0.05, 0.95, n) * spec.range_min
+            hit = u < spurious.rate
+            v32[hit] = ghost[hit]
+            cls[hit] = _GHOST  # a return, but an invalid one
+
+        no_return, too_close, _ = CONVENTIONS[self.convention]
+        v32[cls == _NO_RETURN] = _encoded(no_return, spec.range_max)
+        v32[cls == _TOO_CLOSE] = _encoded(too_close, spec.range_max)
+
+        intensities = np.where((cls == _VALID) | (cls == _GHOST), RETURN_INTENSITY, 0.0).astype(
+            np.float32
+        )
+        return Scan(
+            angle_min=spec.angle_min,
+            angle_max=spec.angle_max,
+            angle_increment=spec.angle_increment,
+            time_increment=spec.time_increment,
+            scan_time=spec.scan_time,
+            range_min=spec.range_min,
+            range_max=spec.range_max,
+            ranges=v32,
+            intensities=intensities,
+            stamp=float(stamp),
+        )
+
+
+def _named(description: str, *items: _Item) -> tuple[str, tuple[_Item, ...]]:
+    return description, items
+
+
+# The building blocks of build_profile: a description and the items a name adds.
+_NAMED: dict[str, tuple[str, tuple[_Item, ...]]] = {
+    "clean": _named("no faults; REP-117 encoding (+inf no return, -inf too close)"),
+    "noisy": _named("gaussian range noise, sigma 0.01 m", Noise(0.01)),
+    "dropouts_nan": _named("5% of valid returns lost as NaN", Dropouts(0.05, "nan")),
+    "dropouts_zero": _named("5% of valid returns lost as 0.0", Dropouts(0.05, "zero")),
+    "dropouts_inf": _named("5% of valid returns lost as +inf", Dropouts(0.05, "inf")),
+    "spurious_close": _named("2% of beams read a ghost below range_min", Spurious(0.02)),
+    "driver_rep117": _named("REP-117: +inf no return, -inf too close", Convention("rep117")),
+    "driver_rplidar_ros": _named(
+        "rplidar_ros / FOSSBot v2 bridge: device distance 0 (no return or too close) as +inf",
+        Convention("inf"),
+    ),
+    "driver_nan": _named(
+        "LD06/LD19 vendor driver: NaN for no return and too close", Convention("nan")
+    ),
+    "driver_zero": _named("raw distance 0.0 for no return and too close", Convention("zero")),
+    "driver_range_max": _named(
+        "no return written as range_max (too close -inf)", Convention("range_max")
+    ),
+    "harsh": _named(
+        "everything at once: noise 0.02 m, 10% NaN dropouts, 5% ghosts, NaN driver",
+        Noise(0.02),
+        Dropouts(0.10, "nan"),
+        Spurious(0.05),
+        Convention("nan"),
+    ),
+}
+
+
+def _compose(items: Sequence[_Item], name: str) -> FaultProfile:
+    """Later items replace earlier ones of the same kind."""
+    by_kind: dict[str, _Item] = {}
+    for item in items:
+        by_kind[item.kind] = item
+    convention = by_kind.pop("convention", Convention("rep117"))
+    assert isinstance(convention, Convention)
+    faults = tuple(f for f in by_kind.values() if not isinstance(f, Convention))
+    return FaultProfile(faults=faults, convention=convention.name, name=name)
+
+
+#: name -> (description, profile); the names a scenario's ``faults:`` list may use.
+NAMED_PROFILES: dict[str, tuple[str, FaultProfile]] = {
+    name: (desc, _compose(items, name)) for name, (desc, items) in _NAMED.items()
+}
+
+
+_DEFAULTS: dict[str, dict[str, Any]] = {"dropouts": {"value": "nan"}}
+
+
+def _inline(where: str, spec: Mapping[str, Any]) -> tuple[_Item, str]:
+    """One inline dict -> a fault; ConfigError names the item and field."""
+    known_kinds = ", ".join(sorted(_KINDS))
+    if "type" not in spec:
+        raise ConfigError(f"{where}: missing 'type' (known: {known_kinds})")
+    kind = spec["type"]
+    if not isinstance(kind, str) or kind not in _KINDS:
+        raise ConfigError(f"{where}: unknown fault type {kind!r} (known: {known_kinds})")
+    cls = _KINDS[kind]
+    args = {k: v for k, v in spec.items() if k != "type"}
+    for key in args:
+        if key not in cls.params:
+            raise ConfigError(
+                f"{where}: unknown key {key!r} for {kind} (known: {', '.join(cls.params)})"
+            )
+    for key in cls.params:
+        if key not in args and key not in _DEFAULTS.get(kind, {}):
+            raise ConfigError(f"{where}.{key}: required for {kind}")
+        value = args.get(key)
+        if key in ("sigma", "rate") and value is not None:
+            if isinstance(value, bool) or not isinstance(value, (int, float)):
+                raise ConfigError(f"{where}.{key}: must be a number, got {value!r}")
+            lo, hi = (0, 1)
+            if not (math.isfinite(value) and lo <= value <= hi):
+                unit = " m" if key == "sigma" else ""
+                raise ConfigError(f"{where}.{key}: must be in [{lo}, {hi}]{unit}, got {value!r}")
+            args[key] = float(value)
+        if key in ("value", "name") and value is not None and not isinstance(value, str):
+            raise ConfigError(f"{where}.{key}: must be a string, got {value!r}")
+    try:
+        item = cls(**args)
+    except ConfigError as err:
+        raise ConfigError(f"{where}: {err}") from None
+    shown = (f"{k}={args[k]:g}" if isinstance(args[k], float) else f"{k}={args[k]}" for k in args)
+    return item, f"{kind}({','.join(shown)})"
+
+
+def build_profile(
+    items: Sequence[str | Mapping[str, Any]], *, field_name: str = "faults"
+) -> FaultProfile:
+    """A scenario's ``faults:`` list -> one profile; later items override earlier kinds.
+
+    Items are names from ``NAMED_PROFILES`` or inline dicts such as
+    ``{type: noise, sigma: 0.01}``. Errors name the item, e.g.
+    ``faults[1]: unknown fault type 'nosie' (known: ...)``.
+    """
+    if isinstance(items, (str, bytes)) or not isinstance(items, Sequence):
+        raise ConfigError(f"{field_name}: must be a list of profile names or fault mappings")
+    collected: list[_Item] = []
+    labels: list[str] = []
+    for i, entry in enumerate(items):
+        where = f"{field_name}[{i}]"
+        if isinstance(entry, str):
+            if entry not in _NAMED:
+                known = ", ".join(_NAMED)
+                raise ConfigError(f"{where}: unknown fault profile {entry!r} (known: {known})")
+            collected.extend(_NAMED[entry][1])
+            labels.append(entry)
+        elif isinstance(entry, Mapping):
+            item, label = _inline(where, entry)
+            collected.append(item)
+            labels.append(label)
+        else:
+            raise ConfigError(
+                f"{where}: expected a profile name or a mapping with 'type', got {entry!r}"
+            )
+    return _compose(collected, "+".join(labels) or "clean")
