@@ -21,10 +21,11 @@ from pathlib import Path
 from types import TracebackType
 
 import numpy as np
-import pybullet as pb
 
 from harness.errors import ConfigError
 from harness.scenario import Box, Cylinder, Model, Scenario, Wall
+from harness.sim import bullet
+from harness.sim.bullet import pb
 from harness.sim.motion import WheelGeometry
 
 TIME_STEP = 1.0 / 240.0  # s; the only physics step the harness uses
@@ -69,7 +70,7 @@ class World:
         self.where = scenario.source or "<scenario>"
         if gui and sys.platform.startswith("linux") and not os.environ.get("DISPLAY"):
             raise ConfigError("--gui needs a display")
-        self.client: int = pb.connect(pb.GUI if gui else pb.DIRECT)
+        self.client: int = bullet.connect(gui)
         if self.client < 0:
             raise ConfigError("cannot start PyBullet" + (" with a GUI" if gui else ""))
         try:

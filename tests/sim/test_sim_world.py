@@ -8,11 +8,11 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-import pybullet as pb
 import pytest
 
 from harness.errors import ConfigError
 from harness.scenario import Scenario, parse_scenario
+from harness.sim.bullet import pb
 from harness.sim.lidar import LidarModel
 from harness.sim.world import World, robot_models_dir
 
