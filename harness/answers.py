@@ -11,6 +11,7 @@ class Received:
 
     value: str | bool
     after: float  # seconds between sending the scan and this message arriving
+    tick: int | None = None  # the scan it answers, when it arrived late (see Answers.late)
 
 
 @dataclass
@@ -22,4 +23,22 @@ class Answers:
     waited: float = 0.0  # seconds the link waited for this scan's answers
     timed_out: bool = False  # the per-scan deadline passed without a status
     problem: str | None = None  # link-level failure, e.g. "node exited with code 1: ..."
-    late: list[Received] = field(default_factory=list)  # answers to an earlier scan
+    late: list[Received] = field(default_factory=list)  # answers to earlier scans, by tick
+
+    def take_late(self, late: list[Received], tick: int) -> list[Received]:
+        """Adopt the late answers that belong to `tick`; return the others.
+
+        An answer to a scan whose deadline had passed stays late: it must
+        not turn a timeout into a pass.
+        """
+        rest = []
+        for item in late:
+            if item.tick != tick:
+                rest.append(item)
+            elif self.timed_out:
+                self.late.append(item)
+            elif isinstance(item.value, bool):
+                self.warnings.append(item)
+            else:
+                self.statuses.append(item)
+        return rest

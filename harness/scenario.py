@@ -13,12 +13,13 @@ import math
 from collections.abc import Sequence
 from importlib import resources
 from pathlib import Path
-from typing import Annotated, Any, Literal, Union
+from typing import Annotated, Any, Literal
 
 import yaml
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
 
 from harness.errors import ConfigError
+from harness.faults import build_profile
 from harness.lidar_spec import PRESETS, LidarSpec, preset
 
 SCENARIO_SUFFIXES = (".yaml", ".yml")
@@ -133,7 +134,7 @@ class Model(_Strict):
         return value
 
 
-Obstacle = Annotated[Union[Wall, Box, Cylinder, Model], Field(discriminator="type")]
+Obstacle = Annotated[Wall | Box | Cylinder | Model, Field(discriminator="type")]
 
 
 class Until(_Strict):
@@ -181,7 +182,7 @@ class Scenario(_Strict):
     lidar: LidarConfig = LidarConfig()
     obstacles: list[Obstacle] = Field(default_factory=list, max_length=1000)
     motion: Motion
-    faults: list[Union[str, dict[str, Any]]] = Field(default_factory=list, max_length=50)
+    faults: list[str | dict[str, Any]] = Field(default_factory=list, max_length=50)
     threshold: Positive = 0.5
     seed: Annotated[int, Field(ge=0, le=2**32 - 1)] = 0
     source: str = Field(default="", exclude=True)  # file the scenario came from
@@ -236,6 +237,10 @@ def parse_scenario(data: Any, *, source: str = "<scenario>") -> Scenario:
         raise ConfigError(f"{source}: {_first_error(err)}") from None
     except ConfigError as err:
         raise ConfigError(f"{source}: lidar: {err}") from None
+    try:
+        build_profile(scenario.faults)
+    except ConfigError as err:
+        raise ConfigError(f"{source}: {err}") from None
     if not scenario.name:
         scenario = scenario.model_copy(update={"name": Path(source).stem})
     return scenario

@@ -5,10 +5,11 @@ from __future__ import annotations
 import importlib
 import pkgutil
 from abc import ABC, abstractmethod
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Callable, ClassVar, TypeVar
+from typing import ClassVar, TypeVar
 
-from harness.answers import Answers
+from harness.answers import Answers, Received
 from harness.errors import ConfigError
 from harness.scan import Scan
 
@@ -26,6 +27,9 @@ class LinkOptions:
     executable: str | None = None
     workspace: str | None = None
     params: tuple[str, ...] = ()  # NAME:=VALUE items passed to the node verbatim
+    threshold_param: str | None = "threshold"  # node parameter that gets the threshold
+    domain_id: int | None = None  # None: reserve a free one for this run
+    ros_network: bool = False  # False: localhost-only discovery
     scan_topic: str = "/scan"
     status_topic: str = "/lidar_status"
     warning_topic: str = "/obstacle_warning"
@@ -55,6 +59,10 @@ class Link(ABC):
         """Lockstep: send a scan, then collect its answers."""
         self.send(scan, tick)
         return self.collect(scan, tick)
+
+    def settle(self) -> list[Received]:
+        """After the last scan: answers still on their way, each tagged with its tick."""
+        return []
 
     def diagnostics(self) -> str:
         """Extra text for failure reports (e.g. the node's last stderr lines)."""
@@ -92,9 +100,7 @@ def known_links() -> list[str]:
     """Names of the link modules shipped in this package."""
     import harness.links as package
 
-    return sorted(
-        m.name for m in pkgutil.iter_modules(package.__path__) if m.name not in ("base",)
-    )
+    return sorted(m.name for m in pkgutil.iter_modules(package.__path__) if m.name not in ("base",))
 
 
 def create_link(name: str, options: LinkOptions) -> Link:

@@ -1,0 +1,287 @@
+"""`fossbot-hil`: list scenarios and run them against a node or a board.
+
+Exit codes: 0 every expectation held, 1 some failed, 2 usage or
+configuration error (one line on stderr naming the file or field).
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+from collections.abc import Sequence
+from pathlib import Path
+
+from rich.console import Console
+
+from harness import __version__
+from harness.errors import ConfigError, HarnessError, LinkError
+from harness.links.base import LinkOptions, create_link, known_links
+from harness.scenario import Scenario, resolve_scenario, shipped_scenarios
+from harness.trace import RunResult
+
+DEFAULT_LINK = "inprocess"
+EXIT_OK, EXIT_FAILED, EXIT_USAGE, EXIT_INTERRUPTED = 0, 1, 2, 130
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse, but usage errors are one line and exit 2."""
+
+    def error(self, message: str) -> None:  # type: ignore[override]
+        raise ConfigError(f"{message} (see '{self.prog} --help')")
+
+
+def _positive(kind: str):
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{kind} must be a number, got {text!r}") from None
+        if not math.isfinite(value) or value <= 0:
+            raise argparse.ArgumentTypeError(f"{kind} must be a positive number, got {text!r}")
+        return value
+
+    return parse
+
+
+def _seed(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"seed must be a whole number, got {text!r}") from None
+    if not 0 <= value < 2**32:
+        raise argparse.ArgumentTypeError(f"seed must be in 0..2**32-1, got {text!r}")
+    return value
+
+
+def _domain_id(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        value = -1
+    if not 0 <= value <= 232:
+        raise argparse.ArgumentTypeError(f"domain id must be a whole number 0..232, got {text!r}")
+    return value
+
+
+def _param(text: str) -> str:
+    name, sep, value = text.partition(":=")
+    if not sep or not name or not value or any(c.isspace() for c in name):
+        raise argparse.ArgumentTypeError(f"expected NAME:=VALUE, got {text!r}")
+    return text
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = _Parser(prog="fossbot-hil", description=__doc__.splitlines()[0])
+    parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
+    commands = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
+
+    commands.add_parser("list", help="list the shipped scenarios")
+
+    run = commands.add_parser("run", help="run scenarios and judge the node's answers")
+    run.add_argument(
+        "scenarios",
+        nargs="*",
+        metavar="SCENARIO",
+        help="shipped scenario name or path to a scenario file (default: all shipped)",
+    )
+    run.add_argument("--link", default=DEFAULT_LINK, help=f"one of {', '.join(known_links())}")
+    run.add_argument("--seed", type=_seed, help="override the scenarios' seed")
+    run.add_argument(
+        "--threshold",
+        type=_positive("threshold"),
+        metavar="M",
+        help="the oracle's warning threshold in metres (default: the scenario's)",
+    )
+    run.add_argument(
+        "--faults",
+        metavar="NAME[,NAME]",
+        help="fault profiles replacing the scenarios' own (see docs/faults.md)",
+    )
+    run.add_argument(
+        "--status-regex",
+        metavar="REGEX",
+        help="parse the status with this regex (named groups distance, angle)",
+    )
+    run.add_argument(
+        "--timeout",
+        type=_positive("timeout"),
+        default=1.0,
+        metavar="S",
+        help="seconds to wait for the answers to one scan (default 1)",
+    )
+    run.add_argument("--gui", action="store_true", help="open the PyBullet viewer")
+
+    run.add_argument("--junit-xml", metavar="FILE", help="write a JUnit XML report")
+
+    node = run.add_argument_group("node under test (ros2 link; default: the reference node)")
+    node.add_argument("--node", metavar="CMD", help='shell command, e.g. "python3 my_node.py"')
+    node.add_argument("--package", metavar="PKG", help="package in a colcon workspace")
+    node.add_argument("--executable", metavar="EXE", help="executable of --package")
+    node.add_argument("--workspace", metavar="DIR", help="colcon workspace (has install/)")
+    node.add_argument(
+        "--param",
+        action="append",
+        type=_param,
+        default=[],
+        metavar="NAME:=VALUE",
+        help="node parameter, passed verbatim (repeatable)",
+    )
+    node.add_argument(
+        "--threshold-param",
+        default="threshold",
+        metavar="NAME",
+        help="node parameter that receives the threshold ('' for none)",
+    )
+    node.add_argument("--scan-topic", default="/scan", metavar="T")
+    node.add_argument("--status-topic", default="/lidar_status", metavar="T")
+    node.add_argument("--warning-topic", default="/obstacle_warning", metavar="T")
+    node.add_argument(
+        "--ready-timeout",
+        type=_positive("ready timeout"),
+        default=20.0,
+        metavar="S",
+        help="seconds for the node to come up (default 20)",
+    )
+    node.add_argument(
+        "--domain-id",
+        type=_domain_id,
+        metavar="N",
+        help="ROS_DOMAIN_ID (default: a free one reserved for the run)",
+    )
+    node.add_argument(
+        "--ros-network",
+        action="store_true",
+        help="discover beyond localhost (to watch a board on the network)",
+    )
+    node.add_argument(
+        "--realtime",
+        action="store_true",
+        help="send scans at the sensor's rate instead of lockstep",
+    )
+
+    inprocess = run.add_argument_group("inprocess link")
+    inprocess.add_argument(
+        "--processor",
+        metavar="MODULE:FUNCTION",
+        help="fn(scan, threshold) -> (status, warning) instead of the reference",
+    )
+    return parser
+
+
+def _print_error(message: str) -> None:
+    print(f"fossbot-hil: error: {message}", file=sys.stderr)
+
+
+def _selected(names: Sequence[str]) -> list[Scenario]:
+    return [resolve_scenario(n) for n in names] if names else shipped_scenarios()
+
+
+def _link_options(args: argparse.Namespace, threshold: float) -> LinkOptions:
+    return LinkOptions(
+        threshold=threshold,
+        scan_timeout=args.timeout,
+        ready_timeout=args.ready_timeout,
+        processor=args.processor,
+        node=args.node,
+        package=args.package,
+        executable=args.executable,
+        workspace=args.workspace,
+        params=tuple(args.param),
+        threshold_param=args.threshold_param or None,
+        scan_topic=args.scan_topic,
+        status_topic=args.status_topic,
+        warning_topic=args.warning_topic,
+        domain_id=args.domain_id,
+        ros_network=args.ros_network,
+        realtime=args.realtime,
+    )
+
+
+def _run_one(scenario: Scenario, args: argparse.Namespace) -> RunResult:
+    from harness.runner import RunSettings, effective_threshold, run_scenario
+
+    faults = [f.strip() for f in args.faults.split(",") if f.strip()] if args.faults else None
+    settings = RunSettings(
+        seed=args.seed,
+        threshold=args.threshold,
+        faults=faults,
+        status_pattern=args.status_regex,
+        gui=args.gui,
+    )
+    threshold = effective_threshold(scenario, settings)
+    link = create_link(args.link, _link_options(args, threshold))
+    try:
+        link.open()
+    except LinkError as err:
+        link.close()
+        return RunResult(
+            scenario.name,
+            args.link,
+            args.seed or scenario.seed,
+            threshold,
+            "",
+            error=str(err),
+            diagnostics=link.diagnostics(),
+        )
+    try:
+        return run_scenario(scenario, link, settings)
+    finally:
+        link.close()
+
+
+def cmd_list(args: argparse.Namespace, console: Console) -> int:
+    from harness.report.terminal import scenario_table
+
+    console.print(scenario_table(shipped_scenarios()))
+    return EXIT_OK
+
+
+def cmd_run(args: argparse.Namespace, console: Console) -> int:
+    from harness.report.terminal import print_results
+
+    scenarios = _selected(args.scenarios)  # all resolved before anything runs
+    if args.junit_xml and not Path(args.junit_xml).resolve().parent.is_dir():
+        raise ConfigError(f"--junit-xml {args.junit_xml}: its folder does not exist")
+    if args.status_regex:
+        from harness.status import parse_status
+
+        parse_status("", args.status_regex)  # a bad regex is a usage error, now
+    results = [_run_one(s, args) for s in scenarios]
+    print_results(console, results)
+    if args.junit_xml:
+        from harness.report.junit import write_junit
+
+        try:
+            write_junit(args.junit_xml, results)
+        except OSError as err:
+            raise ConfigError(f"--junit-xml {args.junit_xml}: {err.strerror or err}") from None
+    return EXIT_OK if all(r.ok for r in results) else EXIT_FAILED
+
+
+COMMANDS = {"list": cmd_list, "run": cmd_run}
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    console = Console(highlight=False)
+    if not console.is_terminal:
+        console = Console(highlight=False, width=200)  # files and pipes: no wrapping
+    try:
+        args = build_parser().parse_args(argv)
+        if args.command is None:
+            build_parser().print_help()
+            return EXIT_USAGE
+        return COMMANDS[args.command](args, console)
+    except ConfigError as err:
+        _print_error(str(err))
+        return EXIT_USAGE
+    except KeyboardInterrupt:
+        _print_error("interrupted")
+        return EXIT_INTERRUPTED
+    except HarnessError as err:
+        _print_error(str(err))
+        return EXIT_FAILED
+
+
+if __name__ == "__main__":
+    sys.exit(main())

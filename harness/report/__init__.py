@@ -1,0 +1,1 @@
+"""Turning run results into things people read: terminal tables, files."""

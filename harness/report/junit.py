@@ -1,0 +1,59 @@
+"""JUnit XML: one test case per scenario, the oracle's explanation as the failure."""
+
+from __future__ import annotations
+
+import xml.etree.ElementTree as ET
+from collections.abc import Sequence
+from pathlib import Path
+
+from harness.report.files import write_atomically
+from harness.trace import RunResult
+
+MAX_LISTED_FAILURES = 50
+
+
+def junit_xml(results: Sequence[RunResult], *, suite: str = "fossbot-hil") -> bytes:
+    """The report as bytes (CI systems read `failure/@message` and the properties)."""
+    failures = sum(1 for r in results if r.failed_ticks)
+    errors = sum(1 for r in results if r.error and not r.failed_ticks)
+    root = ET.Element("testsuites")
+    node = ET.SubElement(
+        root,
+        "testsuite",
+        name=suite,
+        tests=str(len(results)),
+        failures=str(failures),
+        errors=str(errors),
+        time=f"{sum(r.wall_s for r in results):.3f}",
+    )
+    for r in results:
+        case = ET.SubElement(
+            node, "testcase", classname=f"{suite}.{r.link}", name=r.scenario, time=f"{r.wall_s:.3f}"
+        )
+        props = ET.SubElement(case, "properties")
+        for key, value in (
+            ("link", r.link),
+            ("seed", r.seed),
+            ("threshold", r.threshold),
+            ("faults", r.faults),
+            ("ticks", len(r.records)),
+            ("failed_ticks", len(r.failed_ticks)),
+        ):
+            ET.SubElement(props, "property", name=key, value=str(value))
+        if r.ok:
+            continue
+        kind = "failure" if r.failed_ticks else "error"
+        lines = [t.verdict.explanation for t in r.failed_ticks[:MAX_LISTED_FAILURES]]
+        if len(r.failed_ticks) > MAX_LISTED_FAILURES:
+            lines.append(f"... and {len(r.failed_ticks) - MAX_LISTED_FAILURES} more failed ticks")
+        if r.error:
+            lines.append(f"run ended: {r.error}")
+        if r.diagnostics:
+            lines.append(r.diagnostics)
+        ET.SubElement(case, kind, message=r.first_failure or "", type=kind).text = "\n".join(lines)
+    ET.indent(root)
+    return ET.tostring(root, encoding="utf-8", xml_declaration=True)
+
+
+def write_junit(path: str | Path, results: Sequence[RunResult]) -> Path:
+    return write_atomically(path, junit_xml(results))

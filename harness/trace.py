@@ -1,0 +1,56 @@
+"""What one run produced, tick by tick (pure records)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from harness.answers import Answers
+from harness.oracle import Verdict
+from harness.scan import Scan
+
+
+@dataclass(frozen=True)
+class TickRecord:
+    """One scan: where the robot was, what was sent, what came back, the verdict."""
+
+    tick: int
+    t: float
+    x: float
+    y: float
+    yaw: float
+    scan: Scan
+    answers: Answers
+    verdict: Verdict
+
+
+@dataclass
+class RunResult:
+    """A scenario run through one link. `error` ends a run before its last tick."""
+
+    scenario: str
+    link: str
+    seed: int
+    threshold: float
+    faults: str
+    records: list[TickRecord] = field(default_factory=list)
+    error: str | None = None
+    diagnostics: str = ""  # e.g. the node's last stderr lines, shown on failure
+    wall_s: float = 0.0
+
+    @property
+    def ok(self) -> bool:
+        return self.error is None and all(r.verdict.ok for r in self.records)
+
+    @property
+    def failed_ticks(self) -> list[TickRecord]:
+        return [r for r in self.records if not r.verdict.ok]
+
+    @property
+    def first_failure(self) -> str | None:
+        """The explanation a user reads first: the run error or the first failed tick."""
+        failed = self.failed_ticks
+        if failed:
+            return f"{self.scenario}: {failed[0].verdict.explanation}"
+        if self.error is not None:
+            return f"{self.scenario}: {self.error}"
+        return None

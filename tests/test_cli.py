@@ -1,0 +1,92 @@
+"""The `fossbot-hil` command line: exit codes and one-line errors."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from harness.cli import main
+
+STUDENTS = Path(__file__).parent / "student_functions.py"
+
+
+def cli(*args: str, timeout: float = 120) -> subprocess.CompletedProcess[str]:
+    """Run the installed console script for real."""
+    return subprocess.run(
+        [sys.executable, "-m", "harness.cli", *args],
+        capture_output=True,
+        text=True,
+        timeout=timeout,
+    )
+
+
+def test_list_names_every_shipped_scenario(capsys: pytest.CaptureFixture[str]) -> None:
+    """`list` shows names and descriptions."""
+    assert main(["list"]) == 0
+    out = capsys.readouterr().out
+    for name in ("approach_wall", "drive_past_10m", "out_of_range"):
+        assert name in out
+
+
+def test_run_inprocess_passes() -> None:
+    """A real process: the reference logic passes a lab scenario, exit 0."""
+    done = cli("run", "approach_wall", "--link", "inprocess")
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert "approach_wall" in done.stdout and "PASS" in done.stdout
+
+
+def test_run_buggy_processor_exits_1_with_explanation() -> None:
+    """A failing node exits 1 and the first failure is explained."""
+    done = cli(
+        "run",
+        "drive_past_10m",
+        "--link",
+        "inprocess",
+        "--processor",
+        f"{STUDENTS}:min_over_raw_ranges",
+    )
+    assert done.returncode == 1
+    assert "drive_past_10m: t=" in done.stdout and "expected no obstacle" in done.stdout
+
+
+@pytest.mark.parametrize(
+    ("args", "needle"),
+    [
+        (["run", "no_such_scenario"], "unknown scenario 'no_such_scenario'"),
+        (["run", "--seed", "x"], "seed must be a whole number"),
+        (["run", "--threshold", "-1"], "threshold must be a positive number"),
+        (["run", "--threshold", "nan"], "threshold must be a positive number"),
+        (["run", "--link", "carrier_pigeon"], "unknown link 'carrier_pigeon'"),
+        (["run", "--processor", "nothing"], "expected MODULE:FUNCTION"),
+        (["run", "--processor", "no_module_here:fn"], "cannot import"),
+        (["run", "--faults", "sparkles"], "sparkles"),
+        (["run", "--status-regex", "(unclosed"], "regex"),
+        (["frobnicate"], "invalid choice"),
+    ],
+)
+def test_usage_errors_exit_2_with_one_line(
+    args: list[str], needle: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Bad input: exit 2, one line on stderr, no traceback."""
+    assert main(args) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and err.startswith("fossbot-hil: error: ")
+    assert needle in err
+
+
+def test_malformed_scenario_file_exits_2_naming_file_and_field(tmp_path: Path) -> None:
+    """The real command on a broken file: exit 2, `file: field: reason`, nothing else."""
+    bad = tmp_path / "broken.yaml"
+    bad.write_text(
+        "description: x\nmotion:\n  segments:\n    - linear: fast\n      until: {duration: 1}\n"
+    )
+    done = cli("run", str(bad), "--link", "inprocess")
+    assert done.returncode == 2
+    assert done.stderr.strip() == (
+        f"fossbot-hil: error: {bad}: motion.segments[0].linear: "
+        "Input should be a valid number, unable to parse string as a number"
+    )
+    assert "Traceback" not in done.stderr and done.stdout == ""
