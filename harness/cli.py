@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import signal
 import sys
 from collections.abc import Sequence
 from pathlib import Path
@@ -20,7 +21,7 @@ from harness.links.base import LinkOptions, create_link, known_links
 from harness.scenario import Scenario, resolve_scenario, shipped_scenarios
 from harness.trace import RunResult
 
-DEFAULT_LINK = "inprocess"
+DEFAULT_LINK = "ros2"
 EXIT_OK, EXIT_FAILED, EXIT_USAGE, EXIT_INTERRUPTED = 0, 1, 2, 130
 
 
@@ -262,7 +263,17 @@ def cmd_run(args: argparse.Namespace, console: Console) -> int:
 COMMANDS = {"list": cmd_list, "run": cmd_run}
 
 
+def _interrupt_on_sigterm() -> None:
+    """SIGTERM ends a run like Ctrl-C does: links close, nodes are stopped and reaped."""
+
+    def handler(signum: int, frame: object) -> None:
+        raise KeyboardInterrupt
+
+    signal.signal(signal.SIGTERM, handler)
+
+
 def main(argv: Sequence[str] | None = None) -> int:
+    """Run one command; return its exit code (for tests and embedding)."""
     console = Console(highlight=False)
     if not console.is_terminal:
         console = Console(highlight=False, width=200)  # files and pipes: no wrapping
@@ -283,5 +294,11 @@ def main(argv: Sequence[str] | None = None) -> int:
         return EXIT_FAILED
 
 
-if __name__ == "__main__":
+def entry() -> None:
+    """The `fossbot-hil` console script."""
+    _interrupt_on_sigterm()
     sys.exit(main())
+
+
+if __name__ == "__main__":
+    entry()

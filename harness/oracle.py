@@ -205,7 +205,9 @@ class Oracle:
         claim: StatusClaim | None = None
         if not texts:
             if answers.timed_out:
-                failures.append(f"no status within the deadline ({answers.waited:.2f} s)")
+                came = [r for r in answers.late if r.tick == tick and isinstance(r.value, str)]
+                late = f"; it came after {came[0].after:.2f} s: {came[0].value!r}" if came else ""
+                failures.append(f"no status within the deadline ({answers.waited:.2f} s){late}")
             else:
                 failures.append("no status arrived")
         else:

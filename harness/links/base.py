@@ -44,7 +44,7 @@ class Link(ABC):
     def __init__(self, options: LinkOptions) -> None:
         self.options = options
 
-    def open(self) -> None:
+    def open(self) -> None:  # noqa: B027 - optional hook
         """Bring the software under test up and wait (bounded) until it is ready."""
 
     @abstractmethod
@@ -68,7 +68,7 @@ class Link(ABC):
         """Extra text for failure reports (e.g. the node's last stderr lines)."""
         return ""
 
-    def close(self) -> None:
+    def close(self) -> None:  # noqa: B027 - optional hook
         """Stop everything this link started; safe to call twice."""
 
     def __enter__(self) -> Link:
@@ -80,6 +80,7 @@ class Link(ABC):
 
 
 _REGISTRY: dict[str, type[Link]] = {}
+ROS_MODULES = {"rclpy", "sensor_msgs", "std_msgs", "rosgraph_msgs", "builtin_interfaces"}
 L = TypeVar("L", bound=type[Link])
 
 
@@ -111,5 +112,11 @@ def create_link(name: str, options: LinkOptions) -> Link:
         try:
             importlib.import_module(f"harness.links.{name}")
         except ImportError as err:
-            raise ConfigError(f"link {name!r} cannot start: {err}") from None
+            hint = ""
+            if (err.name or "").split(".")[0] in ROS_MODULES:
+                hint = (
+                    " (install the ROS 2 wheels: pip install 'fossbot-hil[ros]',"
+                    " or source ROS 2 Jazzy)"
+                )
+            raise ConfigError(f"link {name!r} cannot start: {err}{hint}") from None
     return _REGISTRY[name](options)

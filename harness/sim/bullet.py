@@ -19,19 +19,23 @@ _LIBC = ctypes.CDLL(None)
 
 @contextlib.contextmanager
 def _stdout_silenced() -> Iterator[None]:
+    """Point fds 1 and 2 at /dev/null (the banner's stream varies with buffering)."""
     sys.stdout.flush()
+    sys.stderr.flush()
     _LIBC.fflush(None)
-    saved = os.dup(1)
+    saved = {fd: os.dup(fd) for fd in (1, 2)}
     try:
         with open(os.devnull, "wb") as devnull:
-            os.dup2(devnull.fileno(), 1)
+            for fd in saved:
+                os.dup2(devnull.fileno(), fd)
             try:
                 yield
             finally:
                 _LIBC.fflush(None)
     finally:
-        os.dup2(saved, 1)
-        os.close(saved)
+        for fd, copy in saved.items():
+            os.dup2(copy, fd)
+            os.close(copy)
 
 
 with _stdout_silenced():

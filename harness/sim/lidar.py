@@ -14,9 +14,9 @@ lab's nodes cannot tell from a snapshot.
 from __future__ import annotations
 
 import numpy as np
-import pybullet as pb
 
 from harness.lidar_spec import LidarSpec
+from harness.sim.bullet import pb
 from harness.sim.world import RAY_MASK, World, link_frame_pose
 
 MAX_RAYS_PER_BATCH = 16383  # rayTestBatch silently returns nothing above this

@@ -1,0 +1,262 @@
+"""The ros2 link: a real node in its own process, over a real DDS graph.
+
+Lockstep: publish scan k, then spin until the node's status for it arrives
+or the per-scan deadline passes. Answers are matched to scans by the DDS
+source timestamp the node's publisher put on them, so a message published
+before scan k was sent can never be taken as an answer to scan k.
+
+Whether a node publishes its Bool before or after its String is learned as
+the run goes: a node seen to publish the Bool first costs no wait at all; for
+others a short grace after the String lets the Bool of the same callback
+arrive (bounded, a few ms; never a fixed per-scan wait of the deadline).
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+
+from harness.answers import Answers, Received
+from harness.errors import ConfigError, LinkError
+from harness.links.base import Link, LinkOptions, register
+from harness.node_process import (
+    NodeCommand,
+    NodeProcess,
+    package_node,
+    reference_node,
+    ros_arguments,
+    shell_node,
+)
+from harness.ros.observer import Heard, Observer, discovery_environment
+from harness.ros_domain import DomainReservation, reserve_domain
+from harness.scan import Scan
+
+POLL_S = 0.05  # longest single spin; liveness of the node is checked this often
+MIN_GRACE_S = 0.002  # wait for a Bool after the String while the order is unknown
+STOPPED_AFTER = 3  # consecutive missed deadlines end the run
+CATCH_UP_S = 2.0  # after a missed deadline, wait this long (at least) for the late answer
+
+
+def node_command(options: LinkOptions) -> NodeCommand:
+    """The node the options name: a command, a package in a workspace, or the reference."""
+    if options.node and options.package:
+        raise ConfigError("give either --node or --package/--executable, not both")
+    if options.node:
+        return shell_node(options.node)
+    if options.package or options.executable:
+        if not (options.package and options.executable):
+            raise ConfigError("--package and --executable go together")
+        return package_node(options.package, options.executable, options.workspace)
+    return reference_node()
+
+
+def node_parameters(options: LinkOptions) -> tuple[str, ...]:
+    """The user's --param items, plus the threshold unless the user set it."""
+    params = tuple(options.params)
+    name = options.threshold_param
+    if name and not any(p.split(":=", 1)[0] == name for p in params):
+        params = (f"{name}:={options.threshold!r}", *params)
+    return params
+
+
+@register("ros2")
+class Ros2Link(Link):
+    """Drive a ROS 2 node process through its scan topic; watch status and warning."""
+
+    def __init__(self, options: LinkOptions) -> None:
+        super().__init__(options)
+        self.command = node_command(options)  # resolve now: bad input exits 2 early
+        self.process: NodeProcess | None = None
+        self.observer: Observer | None = None
+        self.domain: DomainReservation | None = None
+        self._sent_ns: int = 0
+        self._sent_at: float = 0.0
+        self._sends: list[tuple[int, int]] = []  # (tick, sent_ns) of recent scans
+        self._bool_first_seen = 0
+        self._bool_after_gap = 0.0  # longest String -> Bool gap seen, seconds
+        self._silent_scans = 0
+        self.startup_s = 0.0
+
+    # -- life cycle -------------------------------------------------------
+    def open(self) -> None:
+        opts = self.options
+        self.domain = reserve_domain(opts.domain_id)
+        env = {
+            "ROS_DOMAIN_ID": str(self.domain.domain_id),
+            **discovery_environment(network=opts.ros_network),
+        }
+        args = ros_arguments(node_parameters(opts))
+        self.process = NodeProcess(self.command, args, env)
+        started = time.perf_counter()
+        self.process.start()  # before our DDS threads exist: fork stays simple
+        self.observer = Observer(
+            self.domain.domain_id,
+            scan_topic=opts.scan_topic,
+            status_topic=opts.status_topic,
+            warning_topic=opts.warning_topic,
+            network=opts.ros_network,
+        )
+        deadline = time.monotonic() + opts.ready_timeout
+        while not self.observer.ready():
+            if self.process.returncode() is not None:
+                raise LinkError(
+                    f"node {self.command.description} {self.process.exit_summary()} "
+                    "before it was ready"
+                )
+            if time.monotonic() >= deadline:
+                raise LinkError(
+                    f"node {self.command.description} never became ready within "
+                    f"{opts.ready_timeout:g} s: it must subscribe to {opts.scan_topic} and "
+                    f"publish {opts.status_topic} ({self.observer.graph_summary()})"
+                )
+            self.observer.spin(POLL_S)
+        self.startup_s = time.perf_counter() - started
+
+    def close(self) -> None:
+        if self.observer is not None:
+            self.observer.close()
+        if self.process is not None:
+            self.process.stop()
+        if self.domain is not None:
+            self.domain.release()
+
+    def diagnostics(self) -> str:
+        if self.process is None:
+            return ""
+        parts = []
+        for which in ("stderr", "stdout"):
+            tail = self.process.tail(which)
+            if tail:
+                parts.append(f"node {which} (last lines):\n{tail}")
+        return "\n".join(parts)
+
+    # -- lockstep ---------------------------------------------------------
+    def send(self, scan: Scan, tick: int) -> None:
+        assert self.observer is not None, "open() the link first"
+        self._sent_ns = self.observer.publish(scan)
+        self._sent_at = time.perf_counter()
+        self._sends = [*self._sends[-7:], (tick, self._sent_ns)]
+
+    def _grace(self) -> float:
+        if self._bool_first_seen and not self._bool_after_gap:
+            return 0.0
+        return min(max(MIN_GRACE_S, 4 * self._bool_after_gap), self.options.scan_timeout)
+
+    def _node_gone(self) -> str | None:
+        assert self.process is not None
+        if self.process.returncode() is not None:
+            return f"node {self.process.exit_summary()}"
+        return None
+
+    def _wait_for(self, done: Callable[[], bool], seconds: float) -> str | None:
+        """Spin until `done()`; None if it came, else "timeout" or why the node is gone."""
+        assert self.observer is not None
+        end = time.perf_counter() + seconds
+        while not done():
+            now = time.perf_counter()
+            if now >= end:
+                return "timeout"
+            gone = self._node_gone()
+            if gone:
+                self.observer.drain()
+                return None if done() else gone
+            self.observer.spin(min(POLL_S, end - now))
+        return None
+
+    def collect(self, scan: Scan, tick: int) -> Answers:
+        assert self.observer is not None and self.process is not None
+        obs = self.observer
+        timeout = self.options.scan_timeout
+        answers = Answers()
+
+        def mine(h: Heard) -> bool:
+            return h.source_ns >= self._sent_ns
+
+        def status_in() -> bool:
+            return any(h.kind == "status" and mine(h) for h in obs.inbox)
+
+        def warning_in() -> bool:
+            return any(h.kind == "warning" and mine(h) for h in obs.inbox)
+
+        outcome = self._wait_for(status_in, self._sent_at + timeout - time.perf_counter())
+        if outcome == "timeout":
+            answers.timed_out = True
+            # The node is behind. Let it catch up before the next scan, or its
+            # answer to this scan would be taken for an answer to the next one.
+            outcome = self._wait_for(status_in, max(CATCH_UP_S, 3 * timeout))
+            outcome = None if outcome == "timeout" else outcome
+        answers.problem = outcome
+        if status_in():
+            self._wait_for(warning_in, self._grace())
+            obs.drain()
+        self._sort(answers, obs.inbox, mine)
+        obs.inbox.clear()
+        if answers.timed_out:  # whatever came after the deadline is late, not an answer
+            answers.late += [
+                Received(r.value, r.after, tick) for r in (*answers.statuses, *answers.warnings)
+            ]
+            answers.statuses, answers.warnings = [], []
+            answers.waited = timeout
+        else:
+            answers.waited = time.perf_counter() - self._sent_at
+        self._watch_silence(answers, tick)
+        return answers
+
+    def _sort(self, answers: Answers, heard: list[Heard], mine) -> None:
+        """Split what arrived into this scan's answers and late ones; learn the Bool order."""
+        first_status = next((h for h in heard if h.kind == "status" and mine(h)), None)
+        for h in heard:
+            item = Received(h.value, h.arrived - self._sent_at)
+            if not mine(h):
+                answers.late.append(Received(h.value, item.after, self._tick_of(h.source_ns)))
+            elif h.kind == "status":
+                answers.statuses.append(item)
+            else:
+                answers.warnings.append(item)
+                if first_status is not None:
+                    if h.source_ns <= first_status.source_ns:
+                        self._bool_first_seen += 1
+                    else:
+                        gap = (h.source_ns - first_status.source_ns) / 1e9
+                        self._bool_after_gap = max(self._bool_after_gap, gap, 1e-4)
+
+    def _tick_of(self, source_ns: int) -> int | None:
+        """The last scan sent before the node published this message."""
+        earlier = [tick for tick, sent in self._sends if sent <= source_ns]
+        return earlier[-1] if earlier else None
+
+    def settle(self) -> list[Received]:
+        """Answers to the last scan that come after its status (e.g. a trailing Bool)."""
+        if self.observer is None:
+            return []
+        end = time.perf_counter() + self._grace()
+        while time.perf_counter() < end:
+            self.observer.spin(end - time.perf_counter())
+        self.observer.drain()
+        late = [
+            Received(h.value, h.arrived - self._sent_at, self._tick_of(h.source_ns))
+            for h in self.observer.inbox
+        ]
+        self.observer.inbox.clear()
+        return late
+
+    def _watch_silence(self, answers: Answers, tick: int) -> None:
+        """End the run when the node misses its deadline on several scans in a row."""
+        if not answers.timed_out:
+            self._silent_scans = 0
+            return
+        self._silent_scans += 1
+        if self._silent_scans < STOPPED_AFTER or answers.problem is not None:
+            return
+        deadline = f"the {self.options.scan_timeout:g} s deadline"
+        came_late = [r for r in answers.late if r.tick == tick and isinstance(r.value, str)]
+        if came_late:
+            answers.problem = (
+                f"node answers too late: {self._silent_scans} scans in a row missed {deadline} "
+                f"(the last answer came after {came_late[0].after:.2f} s)"
+            )
+        else:
+            answers.problem = (
+                f"node stopped answering: no status on {self.options.status_topic} for "
+                f"{self._silent_scans} scans in a row"
+            )

@@ -1,0 +1,128 @@
+"""The harness's own ROS 2 node: publishes /scan and /clock, hears the answers.
+
+It lives in its own rclpy Context (domain id given explicitly), is spun by
+hand with bounded ``spin_once`` calls (no threads), and stamps everything it
+hears with the publisher's DDS source timestamp, so answers can be matched
+to the scan they belong to.
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import rclpy
+from rclpy.context import Context
+from rclpy.executors import SingleThreadedExecutor
+from rclpy.qos import QoSProfile, ReliabilityPolicy
+from rosgraph_msgs.msg import Clock
+from sensor_msgs.msg import LaserScan
+from std_msgs.msg import Bool, String
+
+from harness.ros.messages import clock_message, scan_message
+from harness.scan import Scan
+
+QOS = QoSProfile(depth=50, reliability=ReliabilityPolicy.RELIABLE)
+
+
+@dataclass(frozen=True)
+class Heard:
+    """One message from the node under test."""
+
+    kind: str  # "status" or "warning"
+    value: str | bool
+    source_ns: int  # when the node published it (DDS source timestamp, system clock)
+    arrived: float  # time.perf_counter() when the harness took it
+
+
+def discovery_environment(*, network: bool) -> dict[str, str]:
+    """Environment that keeps discovery on this machine unless a network is wanted."""
+    return {} if network else {"ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST"}
+
+
+class Observer:
+    """Publish scans and collect the node's String and Bool answers."""
+
+    def __init__(
+        self,
+        domain_id: int,
+        *,
+        scan_topic: str,
+        status_topic: str,
+        warning_topic: str,
+        network: bool = False,
+    ) -> None:
+        # rmw reads the discovery range from the environment at init.
+        os.environ.pop("ROS_AUTOMATIC_DISCOVERY_RANGE", None)
+        os.environ.update(discovery_environment(network=network))
+        self.context = Context()
+        rclpy.init(context=self.context, domain_id=domain_id)
+        self.node = rclpy.create_node("fossbot_hil", context=self.context)
+        self.executor = SingleThreadedExecutor(context=self.context)
+        self.executor.add_node(self.node)
+        self.scan_topic, self.status_topic = scan_topic, status_topic
+        self.scan_pub = self.node.create_publisher(LaserScan, scan_topic, QOS)
+        self.clock_pub = self.node.create_publisher(Clock, "/clock", QOS)
+        self.inbox: list[Heard] = []
+        self.status_sub = self.node.create_subscription(
+            String, status_topic, self._hear("status", lambda m: m.data), QOS
+        )
+        self.warning_sub = self.node.create_subscription(
+            Bool, warning_topic, self._hear("warning", lambda m: bool(m.data)), QOS
+        )
+
+    def _hear(self, kind: str, value_of: Callable[[object], str | bool]):
+        def callback(msg: object, info: dict) -> None:
+            self.inbox.append(
+                Heard(kind, value_of(msg), int(info["source_timestamp"]), time.perf_counter())
+            )
+
+        return callback
+
+    def publish(self, scan: Scan) -> int:
+        """Publish /clock then the scan; return the send time in system-clock ns."""
+        msg = scan_message(scan)
+        self.clock_pub.publish(clock_message(scan.stamp))
+        sent = time.time_ns()
+        self.scan_pub.publish(msg)
+        return sent
+
+    def spin(self, timeout: float) -> None:
+        """Handle what arrived, waiting at most `timeout` seconds for something."""
+        self.executor.spin_once(timeout_sec=max(0.0, timeout))
+
+    def drain(self, limit: int = 100) -> None:
+        """Handle everything already queued without waiting."""
+        for _ in range(limit):
+            before = len(self.inbox)
+            self.executor.spin_once(timeout_sec=0.0)
+            if len(self.inbox) == before:
+                return
+
+    def ready(self) -> bool:
+        """The node reads our scans and publishes its status (matched, not just announced)."""
+        return (
+            self.scan_pub.get_subscription_count() > 0 and self.status_sub.get_publisher_count() > 0
+        )
+
+    def graph_summary(self) -> str:
+        """What the node under test offers, for 'never became ready' explanations."""
+        topics = [
+            f"{name} [{', '.join(t.split('/')[-1] for t in types)}]"
+            for name, types in self.node.get_topic_names_and_types()
+            if name not in ("/rosout", "/parameter_events", "/clock")
+        ]
+        return (
+            f"subscribers on {self.scan_topic}: {self.scan_pub.get_subscription_count()}, "
+            f"publishers on {self.status_topic}: {self.status_sub.get_publisher_count()}; "
+            f"topics seen: {', '.join(topics) or 'none'}"
+        )
+
+    def close(self) -> None:
+        """Tear the node and its context down; safe to call twice."""
+        if self.context.ok():
+            self.executor.shutdown(timeout_sec=1.0)
+            self.node.destroy_node()
+            self.context.try_shutdown()

@@ -1,0 +1,63 @@
+"""Reserve a ROS_DOMAIN_ID per run so parallel runs never see each other.
+
+Like ROS 2's domain_coordinator, a reservation is held by an open OS
+resource that the kernel frees when the process dies, so a crashed run
+never leaks an id: here an exclusive ``flock`` on one file per id.
+"""
+
+from __future__ import annotations
+
+import fcntl
+import os
+import tempfile
+from pathlib import Path
+
+from harness.errors import LinkError
+
+# 0 is everyone's default; ids above 101 can collide with ephemeral ports on Linux.
+FIRST_ID, LAST_ID = 1, 101
+LOCK_DIR = Path(tempfile.gettempdir()) / "fossbot-hil-domains"
+
+
+class DomainReservation:
+    """An id held until `release()` (or process exit)."""
+
+    def __init__(self, domain_id: int, handle: int | None) -> None:
+        self.domain_id = domain_id
+        self._handle = handle
+
+    def release(self) -> None:
+        if self._handle is not None:
+            os.close(self._handle)
+            self._handle = None
+
+    def __enter__(self) -> DomainReservation:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.release()
+
+
+def _try_lock(domain_id: int) -> int | None:
+    LOCK_DIR.mkdir(parents=True, exist_ok=True)
+    handle = os.open(LOCK_DIR / f"{domain_id}.lock", os.O_RDWR | os.O_CREAT, 0o666)
+    try:
+        fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except OSError:
+        os.close(handle)
+        return None
+    return handle
+
+
+def reserve_domain(preferred: int | None = None) -> DomainReservation:
+    """A free domain id; `preferred` is taken as given (joining a board's graph)."""
+    if preferred is not None:
+        return DomainReservation(preferred, None)
+    start = FIRST_ID + os.getpid() % (LAST_ID - FIRST_ID + 1)
+    span = LAST_ID - FIRST_ID + 1
+    for offset in range(span):
+        domain_id = FIRST_ID + (start - FIRST_ID + offset) % span
+        handle = _try_lock(domain_id)
+        if handle is not None:
+            return DomainReservation(domain_id, handle)
+    raise LinkError(f"no free ROS domain id in {FIRST_ID}..{LAST_ID}: too many runs at once")

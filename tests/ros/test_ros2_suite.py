@@ -1,0 +1,183 @@
+"""The default suite over real DDS: the reference node and student-style nodes.
+
+Every node runs in its own process, started by the real `fossbot-hil`
+command, and talks to the harness over Fast DDS in its own domain.
+"""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+pytest.importorskip("rclpy", reason="needs the ROS 2 wheels: pip install '.[ros]'")
+
+pytestmark = [pytest.mark.ros, pytest.mark.timeout(300)]
+
+STUDENT = Path(__file__).parent / "student_node.py"
+
+
+def fossbot_hil(*args: str, timeout: float = 240) -> subprocess.CompletedProcess[str]:
+    """The real command line, as a user runs it."""
+    return subprocess.run(
+        [sys.executable, "-m", "harness.cli", *args],
+        capture_output=True,
+        text=True,
+        timeout=timeout,
+    )
+
+
+def student(variant: str) -> str:
+    return f"{sys.executable} {STUDENT} {variant}"
+
+
+def test_default_run_is_the_whole_suite_over_ros2() -> None:
+    """`fossbot-hil run` with no arguments: every shipped scenario, reference node, ros2."""
+    done = fossbot_hil("run")
+    assert done.returncode == 0, done.stdout + done.stderr
+    for name in ("approach_wall", "drive_past_10m", "out_of_range", "rotate_beside_wall"):
+        assert f"{name} " in done.stdout
+    assert " ros2 " in done.stdout and "FAIL" not in done.stdout
+
+
+@pytest.mark.parametrize("variant", ["correct", "correct_bool_when_close"])
+def test_correct_students_pass(variant: str) -> None:
+    """Other wording, and a Bool published only when close, are right."""
+    done = fossbot_hil("run", "--node", student(variant))
+    assert done.returncode == 0, done.stdout + done.stderr
+
+
+# Bug -> a phrase its explanation must contain.
+BUGS = {
+    "min_over_raw_ranges": "expected",
+    "no_range_min_filter": "expected no obstacle",
+    "angle_without_angle_min": "expected angle",
+    "angle_in_degrees": "looks like degrees",
+    "no_bool": "got no Bool",
+    "inverted_bool": "expected warning",
+    "threshold_hard_coded": "expected warning False",
+    "answers_twice": "answered twice",
+    "unparseable": "obstacle: yes-ish",
+}
+
+
+@pytest.mark.parametrize(("variant", "phrase"), BUGS.items())
+def test_buggy_student_is_caught_by_default_suite(variant: str, phrase: str) -> None:
+    """Each bug fails the default suite; the explanation names scenario, tick and expectation."""
+    done = fossbot_hil("run", "--node", student(variant))
+    assert done.returncode == 1, done.stdout + done.stderr
+    assert " tick " in done.stdout and phrase in done.stdout, done.stdout
+
+
+def test_crash_when_nothing_in_range_shows_exit_code_and_stderr() -> None:
+    """A node that dies mid-run: its exit code and last stderr lines are shown."""
+    done = fossbot_hil("run", "drive_past_10m", "--node", student("crash_when_nothing_in_range"))
+    assert done.returncode == 1
+    assert "node exited with code" in done.stdout and "ValueError" in done.stdout
+
+
+def test_slow_callbacks_are_too_late_then_stopped() -> None:
+    """Answers slower than the deadline fail, say when they came, and end the run."""
+    done = fossbot_hil(
+        "run", "approach_wall", "--timeout", "0.5", "--node", student("slow_callback")
+    )
+    assert done.returncode == 1
+    assert "no status within the deadline (0.50 s); it came after 1.5" in done.stdout
+    assert "node answers too late: 3 scans in a row missed the 0.5 s deadline" in done.stdout
+
+
+def test_node_that_stops_answering_ends_the_run() -> None:
+    """A node that goes silent mid-run: a bounded wait, then a clear end."""
+    done = fossbot_hil("run", "approach_wall", "--timeout", "0.3", "--node", student("goes_silent"))
+    assert done.returncode == 1
+    assert "tick 10: " in done.stdout and "no status within the deadline" in done.stdout
+    assert "node stopped answering: no status on /lidar_status for 3 scans" in done.stdout
+
+
+def test_ignored_topic_parameter_never_becomes_ready() -> None:
+    """A node that ignores lidar_topic never subscribes to the harness's scan topic."""
+    done = fossbot_hil(
+        "run",
+        "approach_wall",
+        "--node",
+        student("topic_parameter_ignored"),
+        "--param",
+        "lidar_topic:=/robot/scan",
+        "--scan-topic",
+        "/robot/scan",
+        "--ready-timeout",
+        "3",
+    )
+    assert done.returncode == 1
+    assert "never became ready within 3 s" in done.stdout
+    assert "subscribers on /robot/scan: 0" in done.stdout
+
+
+def test_non_default_topics_and_threshold_as_parameters() -> None:
+    """Topics and threshold passed to the node as parameters, matched by the harness."""
+    done = fossbot_hil(
+        "run",
+        "obstacle_at_side",
+        "approach_wall",
+        "--threshold",
+        "0.35",
+        "--param",
+        "lidar_topic:=/robot/scan",
+        "--scan-topic",
+        "/robot/scan",
+        "--param",
+        "lidar_status_topic:=/robot/status",
+        "--status-topic",
+        "/robot/status",
+        "--param",
+        "warning_topic:=/robot/too_close",
+        "--warning-topic",
+        "/robot/too_close",
+    )
+    assert done.returncode == 0, done.stdout + done.stderr
+
+
+def test_node_that_exits_before_ready() -> None:
+    """A node that exits at once: its exit code, not a hang."""
+    done = fossbot_hil(
+        "run", "approach_wall", "--node", f"{sys.executable} -c 'import sys; sys.exit(3)'"
+    )
+    assert done.returncode == 1
+    assert "exited with code 3 before it was ready" in done.stdout
+
+
+@pytest.mark.parametrize(
+    ("args", "needle"),
+    [
+        (["--node", "no-such-program --x"], "'no-such-program' not found on PATH"),
+        (["--node", "./nope.py"], "no such file ./nope.py"),
+        (["--package", "fossbot_lidar_processing"], "--package and --executable go together"),
+        (["--package", "p", "--executable", "e", "--workspace", "/nonexistent"], "no such folder"),
+        (["--param", "threshold=0.3"], "expected NAME:=VALUE"),
+        (["--domain-id", "999"], "domain id must be"),
+    ],
+)
+def test_bad_node_options_exit_2(args: list[str], needle: str) -> None:
+    """Bad node options: exit 2 with one line, before anything starts."""
+    done = fossbot_hil("run", "approach_wall", *args, timeout=60)
+    assert done.returncode == 2, done.stdout + done.stderr
+    assert done.stderr.count("\n") == 1 and needle in done.stderr
+
+
+def test_junit_report(tmp_path: Path) -> None:
+    """--junit-xml: one case per scenario, the oracle's explanation as the failure."""
+    report = tmp_path / "report.xml"
+    done = fossbot_hil(
+        "run",
+        "approach_wall",
+        "rotate_beside_wall",
+        "--node",
+        student("angle_in_degrees"),
+        "--junit-xml",
+        str(report),
+    )
+    assert done.returncode == 1
+    xml = report.read_text()
+    assert 'tests="2"' in xml and "looks like degrees" in xml and 'name="seed"' in xml
