@@ -3,39 +3,15 @@
 from __future__ import annotations
 
 import math
-from typing import Any
 
 import numpy as np
 import pytest
+from sim_scenarios import make_scenario
 
 from harness.lidar_spec import PRESETS
-from harness.scenario import Scenario, parse_scenario
 from harness.sim import lidar as lidar_module
 from harness.sim.lidar import LidarModel, beam_angles
 from harness.sim.world import World
-
-
-def make_scenario(
-    *,
-    obstacles: list[dict[str, Any]] | None = None,
-    start: tuple[float, float, float] = (0.0, 0.0, 0.0),
-    lidar: dict[str, Any] | None = None,
-    segments: list[dict[str, Any]] | None = None,
-    mode: str = "kinematic",
-    robot: dict[str, Any] | None = None,
-    source: str = "test.yaml",
-) -> Scenario:
-    """A valid scenario from the few fields a test cares about."""
-    x, y, yaw = start
-    data = {
-        "description": "simulator test",
-        "robot": {**(robot or {}), "start": {"x": x, "y": y, "yaw": yaw}},
-        "lidar": lidar or {"preset": "gazebo"},
-        "obstacles": obstacles or [],
-        "motion": {"mode": mode, "segments": segments or [{"until": {"duration": 0.1}}]},
-    }
-    return parse_scenario(data, source=source)
-
 
 LIDAR_BACK = 0.016  # m, the FOSSBot LIDAR sits this far behind the base origin
 MM = 1e-3

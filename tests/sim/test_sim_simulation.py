@@ -7,38 +7,15 @@ import json
 import math
 import subprocess
 import sys
-from typing import Any
 
 import numpy as np
 import pytest
+from sim_scenarios import make_scenario
 
 from harness.errors import ConfigError
-from harness.scenario import Scenario, parse_scenario
+from harness.scenario import parse_scenario
 from harness.sim import SimTick, Simulation
 from harness.sim.motion import ahead_mask, nearest_ahead
-
-
-def make_scenario(
-    *,
-    obstacles: list[dict[str, Any]] | None = None,
-    start: tuple[float, float, float] = (0.0, 0.0, 0.0),
-    lidar: dict[str, Any] | None = None,
-    segments: list[dict[str, Any]] | None = None,
-    mode: str = "kinematic",
-    robot: dict[str, Any] | None = None,
-    source: str = "test.yaml",
-) -> Scenario:
-    """A valid scenario from the few fields a test cares about."""
-    x, y, yaw = start
-    data = {
-        "description": "simulator test",
-        "robot": {**(robot or {}), "start": {"x": x, "y": y, "yaw": yaw}},
-        "lidar": lidar or {"preset": "gazebo"},
-        "obstacles": obstacles or [],
-        "motion": {"mode": mode, "segments": segments or [{"until": {"duration": 0.1}}]},
-    }
-    return parse_scenario(data, source=source)
-
 
 WALL_AT_2 = {"type": "wall", "start": [2.0, -2.0], "end": [2.0, 2.0], "thickness": 0.1}
 CLUTTER = [

@@ -5,39 +5,16 @@ from __future__ import annotations
 import math
 import xml.etree.ElementTree as ET
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 import pytest
+from sim_scenarios import make_scenario
 
 from harness.errors import ConfigError
-from harness.scenario import Scenario, parse_scenario
+from harness.scenario import parse_scenario
 from harness.sim.bullet import pb
 from harness.sim.lidar import LidarModel
 from harness.sim.world import World, robot_models_dir
-
-
-def make_scenario(
-    *,
-    obstacles: list[dict[str, Any]] | None = None,
-    start: tuple[float, float, float] = (0.0, 0.0, 0.0),
-    lidar: dict[str, Any] | None = None,
-    segments: list[dict[str, Any]] | None = None,
-    mode: str = "kinematic",
-    robot: dict[str, Any] | None = None,
-    source: str = "test.yaml",
-) -> Scenario:
-    """A valid scenario from the few fields a test cares about."""
-    x, y, yaw = start
-    data = {
-        "description": "simulator test",
-        "robot": {**(robot or {}), "start": {"x": x, "y": y, "yaw": yaw}},
-        "lidar": lidar or {"preset": "gazebo"},
-        "obstacles": obstacles or [],
-        "motion": {"mode": mode, "segments": segments or [{"until": {"duration": 0.1}}]},
-    }
-    return parse_scenario(data, source=source)
-
 
 URDF = robot_models_dir() / "fossbot_v2.urdf"
 
