@@ -199,7 +199,8 @@ def _link_options(args: argparse.Namespace, threshold: float) -> LinkOptions:
     )
 
 
-def _run_one(scenario: Scenario, args: argparse.Namespace) -> RunResult:
+def _run_one(scenario: Scenario, args: argparse.Namespace) -> tuple[RunResult, bool]:
+    """Run one scenario; the flag says whether the node under test came up at all."""
     from harness.runner import RunSettings, effective_threshold, run_scenario
 
     faults = [f.strip() for f in args.faults.split(",") if f.strip()] if args.faults else None
@@ -211,6 +212,7 @@ def _run_one(scenario: Scenario, args: argparse.Namespace) -> RunResult:
         gui=args.gui,
     )
     threshold = effective_threshold(scenario, settings)
+    seed = args.seed if args.seed is not None else scenario.seed
     link = create_link(args.link, _link_options(args, threshold))
     try:
         link.open()
@@ -219,16 +221,33 @@ def _run_one(scenario: Scenario, args: argparse.Namespace) -> RunResult:
         return RunResult(
             scenario.name,
             args.link,
-            args.seed or scenario.seed,
+            seed,
             threshold,
             "",
             error=str(err),
             diagnostics=link.diagnostics(),
-        )
+        ), False
     try:
-        return run_scenario(scenario, link, settings)
+        return run_scenario(scenario, link, settings), True
     finally:
         link.close()
+
+
+def _run_all(scenarios: Sequence[Scenario], args: argparse.Namespace) -> list[RunResult]:
+    """Run each scenario; once the node fails to come up, the rest are not tried."""
+    results: list[RunResult] = []
+    failed_start: str | None = None
+    for scenario in scenarios:
+        if failed_start is not None:
+            reason = f"not run: the node did not start in {failed_start}"
+            skipped = RunResult(scenario.name, args.link, 0, 0.0, "", error=reason, not_run=True)
+            results.append(skipped)
+            continue
+        result, started = _run_one(scenario, args)
+        results.append(result)
+        if not started:
+            failed_start = scenario.name
+    return results
 
 
 def cmd_list(args: argparse.Namespace, console: Console) -> int:
@@ -248,7 +267,7 @@ def cmd_run(args: argparse.Namespace, console: Console) -> int:
         from harness.status import parse_status
 
         parse_status("", args.status_regex)  # a bad regex is a usage error, now
-    results = [_run_one(s, args) for s in scenarios]
+    results = _run_all(scenarios, args)
     print_results(console, results)
     if args.junit_xml:
         from harness.report.junit import write_junit

@@ -228,14 +228,14 @@ class NodeProcess:
             return ""
         return "\n".join(text.rstrip().splitlines()[-lines:])
 
-    def exit_summary(self) -> str:
-        """`exited with code 1; last stderr: ...` for failure explanations."""
+    def exit_summary(self, when: str = "") -> str:
+        """`exited with code 1 <when>; last stderr: ...` for failure explanations."""
         code = self.returncode()
         if code is None:
             return "still running"
         how = f"was killed by signal {-code}" if code < 0 else f"exited with code {code}"
         last = self.tail("stderr", 3).replace("\n", " | ")
-        return f"{how}" + (f"; last stderr: {last}" if last else "")
+        return " ".join(filter(None, [how, when])) + (f"; last stderr: {last}" if last else "")
 
     def _signal_group(self, sig: int) -> None:
         assert self._popen is not None

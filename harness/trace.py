@@ -36,6 +36,7 @@ class RunResult:
     error: str | None = None
     diagnostics: str = ""  # e.g. the node's last stderr lines, shown on failure
     wall_s: float = 0.0
+    not_run: bool = False  # skipped because the node under test never came up
 
     @property
     def ok(self) -> bool:

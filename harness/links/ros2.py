@@ -100,8 +100,8 @@ class Ros2Link(Link):
         while not self.observer.ready():
             if self.process.returncode() is not None:
                 raise LinkError(
-                    f"node {self.command.description} {self.process.exit_summary()} "
-                    "before it was ready"
+                    f"node {self.command.description} "
+                    f"{self.process.exit_summary('before it was ready')}"
                 )
             if time.monotonic() >= deadline:
                 raise LinkError(

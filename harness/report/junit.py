@@ -15,7 +15,7 @@ MAX_LISTED_FAILURES = 50
 def junit_xml(results: Sequence[RunResult], *, suite: str = "fossbot-hil") -> bytes:
     """The report as bytes (CI systems read `failure/@message` and the properties)."""
     failures = sum(1 for r in results if r.failed_ticks)
-    errors = sum(1 for r in results if r.error and not r.failed_ticks)
+    errors = sum(1 for r in results if r.error and not r.failed_ticks and not r.not_run)
     root = ET.Element("testsuites")
     node = ET.SubElement(
         root,
@@ -41,6 +41,9 @@ def junit_xml(results: Sequence[RunResult], *, suite: str = "fossbot-hil") -> by
         ):
             ET.SubElement(props, "property", name=key, value=str(value))
         if r.ok:
+            continue
+        if r.not_run:
+            ET.SubElement(case, "skipped", message=r.error or "not run")
             continue
         kind = "failure" if r.failed_ticks else "error"
         lines = [t.verdict.explanation for t in r.failed_ticks[:MAX_LISTED_FAILURES]]

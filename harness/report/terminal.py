@@ -32,11 +32,12 @@ def results_table(results: Sequence[RunResult]) -> Table:
             column, justify="right" if column in ("ticks", "failed", "wall s") else "left"
         )
     for r in results:
-        verdict = (
-            "[green]PASS[/]"
-            if r.ok
-            else ("[red]ERROR[/]" if r.error and not r.failed_ticks else "[red]FAIL[/]")
-        )
+        if r.ok:
+            verdict = "[green]PASS[/]"
+        elif r.not_run:
+            verdict = "[yellow]NOT RUN[/]"
+        else:
+            verdict = "[red]ERROR[/]" if r.error and not r.failed_ticks else "[red]FAIL[/]"
         table.add_row(
             r.scenario,
             r.link,
@@ -52,7 +53,10 @@ def print_results(console: Console, results: Sequence[RunResult]) -> None:
     """The table, then for each failed scenario its first failure and diagnostics."""
     console.print(results_table(results))
     failed = [r for r in results if not r.ok]
+    shown: set[str] = set()
     for r in failed:
+        if r.not_run:
+            continue
         console.print()
         console.print(
             r.first_failure, style="bold red", markup=False, highlight=False, soft_wrap=True
@@ -62,9 +66,20 @@ def print_results(console: Console, results: Sequence[RunResult]) -> None:
             console.print(f"  ({more} more failed tick{'s' if more > 1 else ''})", highlight=False)
         if r.error and r.failed_ticks and r.error not in (r.first_failure or ""):
             console.print(f"  run ended: {r.error}", markup=False, highlight=False, soft_wrap=True)
-        if r.diagnostics:
+        if r.diagnostics in shown:
+            console.print("  (node output as above)", highlight=False)
+        elif r.diagnostics:
+            shown.add(r.diagnostics)
             tail = r.diagnostics.rstrip().splitlines()[-DIAGNOSTIC_LINES:]
             console.print("  " + "\n  ".join(tail), highlight=False, markup=False, soft_wrap=True)
+    not_run = [r for r in failed if r.not_run]
+    if not_run:
+        console.print()
+        console.print(
+            f"{len(not_run)} not run: {not_run[0].error.removeprefix('not run: ')}",
+            highlight=False,
+            markup=False,
+        )
     total = len(results)
     passed = total - len(failed)
     console.print()

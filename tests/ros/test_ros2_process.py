@@ -12,7 +12,6 @@ from pathlib import Path
 
 import pytest
 
-pytest.importorskip("rclpy", reason="needs the ROS 2 wheels: pip install '.[ros]'")
 
 pytestmark = [pytest.mark.ros, pytest.mark.timeout(300)]
 
