@@ -16,8 +16,8 @@ from pathlib import Path
 from rich.console import Console
 
 from harness import __version__
-from harness.errors import ConfigError, HarnessError, LinkError
-from harness.links.base import LinkOptions, create_link, known_links
+from harness.errors import ConfigError, HarnessError
+from harness.links.base import LinkOptions, known_links
 from harness.scenario import Scenario, resolve_scenario, shipped_scenarios
 from harness.trace import RunResult
 
@@ -178,9 +178,9 @@ def _selected(names: Sequence[str]) -> list[Scenario]:
     return [resolve_scenario(n) for n in names] if names else shipped_scenarios()
 
 
-def _link_options(args: argparse.Namespace, threshold: float) -> LinkOptions:
+def _link_options(args: argparse.Namespace) -> LinkOptions:
+    """Link settings from the command line (the runner fills in the threshold)."""
     return LinkOptions(
-        threshold=threshold,
         scan_timeout=args.timeout,
         ready_timeout=args.ready_timeout,
         processor=args.processor,
@@ -199,9 +199,8 @@ def _link_options(args: argparse.Namespace, threshold: float) -> LinkOptions:
     )
 
 
-def _run_one(scenario: Scenario, args: argparse.Namespace) -> tuple[RunResult, bool]:
-    """Run one scenario; the flag says whether the node under test came up at all."""
-    from harness.runner import RunSettings, effective_threshold, run_scenario
+def _run_one(scenario: Scenario, args: argparse.Namespace) -> RunResult:
+    from harness.runner import RunSettings, run
 
     faults = [f.strip() for f in args.faults.split(",") if f.strip()] if args.faults else None
     settings = RunSettings(
@@ -211,26 +210,7 @@ def _run_one(scenario: Scenario, args: argparse.Namespace) -> tuple[RunResult, b
         status_pattern=args.status_regex,
         gui=args.gui,
     )
-    threshold = effective_threshold(scenario, settings)
-    seed = args.seed if args.seed is not None else scenario.seed
-    link = create_link(args.link, _link_options(args, threshold))
-    try:
-        link.open()
-    except LinkError as err:
-        link.close()
-        return RunResult(
-            scenario.name,
-            args.link,
-            seed,
-            threshold,
-            "",
-            error=str(err),
-            diagnostics=link.diagnostics(),
-        ), False
-    try:
-        return run_scenario(scenario, link, settings), True
-    finally:
-        link.close()
+    return run(scenario, args.link, _link_options(args), settings)
 
 
 def _run_all(scenarios: Sequence[Scenario], args: argparse.Namespace) -> list[RunResult]:
@@ -243,11 +223,26 @@ def _run_all(scenarios: Sequence[Scenario], args: argparse.Namespace) -> list[Ru
             skipped = RunResult(scenario.name, args.link, 0, 0.0, "", error=reason, not_run=True)
             results.append(skipped)
             continue
-        result, started = _run_one(scenario, args)
+        result = _run_one(scenario, args)
         results.append(result)
-        if not started:
+        if result.not_started:
             failed_start = scenario.name
     return results
+
+
+NODE_OPTIONS = ("node", "package", "executable", "workspace")
+
+
+def _check_link_options(args: argparse.Namespace) -> None:
+    """Options that the chosen link would silently ignore are mistakes."""
+    if args.processor and args.link != "inprocess":
+        raise ConfigError(f"--processor needs --link inprocess (the {args.link} link runs a node)")
+    if args.link == "inprocess":
+        given = [f"--{name}" for name in NODE_OPTIONS if getattr(args, name)] + (
+            ["--param"] if args.param else []
+        )
+        if given:
+            raise ConfigError(f"{given[0]} needs a link that runs a node, not --link inprocess")
 
 
 def cmd_list(args: argparse.Namespace, console: Console) -> int:
@@ -260,6 +255,7 @@ def cmd_list(args: argparse.Namespace, console: Console) -> int:
 def cmd_run(args: argparse.Namespace, console: Console) -> int:
     from harness.report.terminal import print_results
 
+    _check_link_options(args)
     scenarios = _selected(args.scenarios)  # all resolved before anything runs
     if args.junit_xml and not Path(args.junit_xml).resolve().parent.is_dir():
         raise ConfigError(f"--junit-xml {args.junit_xml}: its folder does not exist")

@@ -49,14 +49,25 @@ def _try_lock(domain_id: int) -> int | None:
     return handle
 
 
+_reservations = 0
+
+
 def reserve_domain(preferred: int | None = None) -> DomainReservation:
-    """A free domain id; `preferred` is taken as given (joining a board's graph)."""
+    """A free domain id; `preferred` is taken as given (joining a board's graph).
+
+    Each reservation in a process starts one id further on: a domain used a
+    moment ago may still hold what the last run's participants announced,
+    and rediscovery there has been seen to take seconds.
+    """
+    global _reservations
     if preferred is not None:
         return DomainReservation(preferred, None)
-    start = FIRST_ID + os.getpid() % (LAST_ID - FIRST_ID + 1)
     span = LAST_ID - FIRST_ID + 1
+    worker = os.environ.get("PYTEST_XDIST_WORKER", "gw0").removeprefix("gw")
+    start = (os.getpid() + 17 * int(worker or 0) + _reservations) % span
+    _reservations += 1
     for offset in range(span):
-        domain_id = FIRST_ID + (start - FIRST_ID + offset) % span
+        domain_id = FIRST_ID + (start + offset) % span
         handle = _try_lock(domain_id)
         if handle is not None:
             return DomainReservation(domain_id, handle)

@@ -9,14 +9,15 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from harness.answers import Answers
+from harness.errors import ConfigError, LinkError
 from harness.faults import FaultProfile, build_profile
-from harness.links.base import Link
+from harness.links.base import Link, LinkOptions, create_link
 from harness.oracle import Oracle
 from harness.scan import Scan
 from harness.scenario import Scenario
@@ -44,7 +45,6 @@ def effective_threshold(scenario: Scenario, settings: RunSettings) -> float:
 
 def fault_profile(scenario: Scenario, settings: RunSettings) -> FaultProfile:
     """The scenario's fault profile, or the run's override; errors name the file."""
-    from harness.errors import ConfigError
 
     items = settings.faults if settings.faults is not None else scenario.faults
     try:
@@ -103,6 +103,8 @@ def run_scenario(
     with Simulation(scenario, gui=settings.gui) as sim:
         for sim_tick in sim.ticks():
             scan = profile.emit(sim_tick.truth, sim.spec, rng, stamp=sim_tick.t)
+            if sim_tick.tick == 0:
+                link.warm_up(scan)
             answers = link.exchange(scan, sim_tick.tick)
             if pending is not None:
                 answers.late = pending[2].take_late(answers.late, pending[0].tick)
@@ -117,3 +119,35 @@ def run_scenario(
     result.diagnostics = link.diagnostics()
     result.wall_s = time.perf_counter() - started
     return result
+
+
+def run(
+    scenario: Scenario,
+    link_name: str,
+    options: LinkOptions,
+    settings: RunSettings = RunSettings(),
+) -> RunResult:
+    """Open the named link, run the scenario through it, always close it.
+
+    A link that cannot bring the software under test up gives a result with
+    the reason and ``not_started`` set, not an exception.
+    """
+    threshold = effective_threshold(scenario, settings)
+    link = create_link(link_name, replace(options, threshold=threshold))
+    try:
+        link.open()
+        return run_scenario(scenario, link, settings)
+    except LinkError as err:
+        seed = settings.seed if settings.seed is not None else scenario.seed
+        return RunResult(
+            scenario.name,
+            link_name,
+            seed,
+            threshold,
+            fault_profile(scenario, settings).name,
+            error=str(err),
+            diagnostics=link.diagnostics(),
+            not_started=True,
+        )
+    finally:
+        link.close()

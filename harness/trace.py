@@ -36,7 +36,8 @@ class RunResult:
     error: str | None = None
     diagnostics: str = ""  # e.g. the node's last stderr lines, shown on failure
     wall_s: float = 0.0
-    not_run: bool = False  # skipped because the node under test never came up
+    not_started: bool = False  # the software under test never came up
+    not_run: bool = False  # skipped because it did not come up in an earlier scenario
 
     @property
     def ok(self) -> bool:

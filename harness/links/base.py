@@ -47,6 +47,9 @@ class Link(ABC):
     def open(self) -> None:  # noqa: B027 - optional hook
         """Bring the software under test up and wait (bounded) until it is ready."""
 
+    def warm_up(self, scan: Scan) -> None:  # noqa: B027 - optional hook
+        """Before tick 0: make sure answers to `scan` can reach us (answers discarded)."""
+
     @abstractmethod
     def send(self, scan: Scan, tick: int) -> None:
         """Deliver one scan."""

@@ -34,6 +34,7 @@ from harness.scan import Scan
 POLL_S = 0.05  # longest single spin; liveness of the node is checked this often
 MIN_GRACE_S = 0.002  # wait for a Bool after the String while the order is unknown
 STOPPED_AFTER = 3  # consecutive missed deadlines end the run
+WARM_UP_RETRY_S = 0.5  # resend the warm-up scan this often until it is answered
 CATCH_UP_S = 2.0  # after a missed deadline, wait this long (at least) for the late answer
 
 
@@ -111,6 +112,39 @@ class Ros2Link(Link):
                 )
             self.observer.spin(POLL_S)
         self.startup_s = time.perf_counter() - started
+
+    def warm_up(self, scan: Scan) -> None:
+        """Exchange the first scan until the node's answer reaches us, then forget it.
+
+        Our subscriptions matching the node's publishers does not mean its
+        publishers have matched us yet: its first answers could be lost.
+        Also wait (briefly) for its warning publisher, if it has one.
+        """
+        assert self.observer is not None
+        obs, opts = self.observer, self.options
+        deadline = time.perf_counter() + opts.ready_timeout
+        while True:
+            sent_ns = obs.publish(scan)
+
+            def answered(since: int = sent_ns) -> bool:
+                return any(h.kind == "status" and h.source_ns >= since for h in obs.inbox)
+
+            outcome = self._wait_for(answered, min(WARM_UP_RETRY_S, deadline - time.perf_counter()))
+            if outcome is None:
+                break
+            if outcome != "timeout":
+                raise LinkError(f"node {self.command.description} {outcome} while warming up")
+            if time.perf_counter() >= deadline:
+                raise LinkError(
+                    f"node {self.command.description} never answered a scan within "
+                    f"{opts.ready_timeout:g} s (it subscribes to {opts.scan_topic} and publishes "
+                    f"{opts.status_topic}, but no status arrived)"
+                )
+        if obs.node.count_publishers(opts.warning_topic) > 0:
+            self._wait_for(lambda: obs.warning_publishers() > 0, WARM_UP_RETRY_S)
+        self._wait_for(lambda: False, self._grace())  # the answer's Bool, if any
+        obs.drain()
+        obs.inbox.clear()
 
     def close(self) -> None:
         if self.observer is not None:

@@ -17,6 +17,7 @@ import rclpy
 from rclpy.context import Context
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.qos import QoSProfile, ReliabilityPolicy
+from rclpy.signals import SignalHandlerOptions
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import LaserScan
 from std_msgs.msg import Bool, String
@@ -58,7 +59,13 @@ class Observer:
         os.environ.pop("ROS_AUTOMATIC_DISCOVERY_RANGE", None)
         os.environ.update(discovery_environment(network=network))
         self.context = Context()
-        rclpy.init(context=self.context, domain_id=domain_id)
+        # The harness handles SIGINT/SIGTERM itself (stop the node, report);
+        # rclpy's own handlers would shut the context down under our feet.
+        rclpy.init(
+            context=self.context,
+            domain_id=domain_id,
+            signal_handler_options=SignalHandlerOptions.NO,
+        )
         self.node = rclpy.create_node("fossbot_hil", context=self.context)
         self.executor = SingleThreadedExecutor(context=self.context)
         self.executor.add_node(self.node)
@@ -101,6 +108,10 @@ class Observer:
             if len(self.inbox) == before:
                 return
 
+    def warning_publishers(self) -> int:
+        """Publishers of the node's warning topic matched to our subscription."""
+        return self.warning_sub.get_publisher_count()
+
     def ready(self) -> bool:
         """The node reads our scans and publishes its status (matched, not just announced)."""
         return (
@@ -121,8 +132,13 @@ class Observer:
         )
 
     def close(self) -> None:
-        """Tear the node and its context down; safe to call twice."""
+        """Tear down node, executor and context, in that order; safe to call twice.
+
+        The context must be destroyed too: until then its DDS participant
+        lives on and a later run in the same domain can still see it.
+        """
         if self.context.ok():
-            self.executor.shutdown(timeout_sec=1.0)
             self.node.destroy_node()
+            self.executor.shutdown(timeout_sec=1.0)
             self.context.try_shutdown()
+            self.context.destroy()

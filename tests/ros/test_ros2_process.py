@@ -12,7 +12,6 @@ from pathlib import Path
 
 import pytest
 
-
 pytestmark = [pytest.mark.ros, pytest.mark.timeout(300)]
 
 REPO = Path(__file__).resolve().parents[2]
