@@ -73,6 +73,7 @@ class Ros2Link(Link):
         self._sent_ns: int = 0
         self._sent_at: float = 0.0
         self._sends: list[tuple[int, int]] = []  # (tick, sent_ns) of recent scans
+        self._started_at: float | None = None  # real time: when scan 0 went out
         self._bool_first_seen = 0
         self._bool_after_gap = 0.0  # longest String -> Bool gap seen, seconds
         self._silent_scans = 0
@@ -167,9 +168,27 @@ class Ros2Link(Link):
     # -- lockstep ---------------------------------------------------------
     def send(self, scan: Scan, tick: int) -> None:
         assert self.observer is not None, "open() the link first"
+        if self.options.realtime:
+            self._pace(scan, tick)
         self._sent_ns = self.observer.publish(scan)
         self._sent_at = time.perf_counter()
         self._sends = [*self._sends[-7:], (tick, self._sent_ns)]
+
+    def _pace(self, scan: Scan, tick: int) -> None:
+        """Real time: scan k goes out k * scan_time after scan 0, hearing answers meanwhile."""
+        assert self.observer is not None
+        if tick == 0 or self._started_at is None:
+            self._started_at = time.perf_counter()
+            return
+        due = self._started_at + tick * scan.scan_time
+        while (left := due - time.perf_counter()) > 0:
+            self.observer.spin(min(POLL_S, left))
+
+    def _deadline(self, scan: Scan) -> float:
+        """Seconds a scan's answers may take: in real time, also before the next scan."""
+        if self.options.realtime:
+            return min(self.options.scan_timeout, scan.scan_time)
+        return self.options.scan_timeout
 
     def _grace(self) -> float:
         if self._bool_first_seen and not self._bool_after_gap:
@@ -200,7 +219,6 @@ class Ros2Link(Link):
     def collect(self, scan: Scan, tick: int) -> Answers:
         assert self.observer is not None and self.process is not None
         obs = self.observer
-        timeout = self.options.scan_timeout
         answers = Answers()
 
         def mine(h: Heard) -> bool:
@@ -212,13 +230,16 @@ class Ros2Link(Link):
         def warning_in() -> bool:
             return any(h.kind == "warning" and mine(h) for h in obs.inbox)
 
+        timeout = self._deadline(scan)
         outcome = self._wait_for(status_in, self._sent_at + timeout - time.perf_counter())
         if outcome == "timeout":
             answers.timed_out = True
-            # The node is behind. Let it catch up before the next scan, or its
-            # answer to this scan would be taken for an answer to the next one.
-            outcome = self._wait_for(status_in, max(CATCH_UP_S, 3 * timeout))
-            outcome = None if outcome == "timeout" else outcome
+            outcome = None
+            if not self.options.realtime:
+                # The node is behind. Let it catch up before the next scan, or its
+                # answer to this scan would be taken for an answer to the next one.
+                outcome = self._wait_for(status_in, max(CATCH_UP_S, 3 * timeout))
+                outcome = None if outcome == "timeout" else outcome
         answers.problem = outcome
         if status_in():
             self._wait_for(warning_in, self._grace())

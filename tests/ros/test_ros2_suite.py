@@ -180,3 +180,19 @@ def test_junit_report(tmp_path: Path) -> None:
     assert done.returncode == 1
     xml = report.read_text()
     assert 'tests="2"' in xml and "looks like degrees" in xml and 'name="seed"' in xml
+
+
+def test_realtime_mode_paces_scans_at_the_sensor_rate(tmp_path: Path) -> None:
+    """--realtime: scans go out at the LIDAR's rate (never faster) and are still judged."""
+    scenario = tmp_path / "beside_wall.yaml"
+    scenario.write_text(
+        "description: One second beside a wall.\n"
+        "obstacles: [{type: wall, start: [0.4, -1.0], end: [0.4, 1.0]}]\n"
+        "motion: {segments: [{until: {duration: 1.0}}]}\n"
+    )
+    done = fossbot_hil("run", str(scenario), "--realtime", "--junit-xml", str(tmp_path / "r.xml"))
+    assert done.returncode == 0, done.stdout + done.stderr
+    xml = (tmp_path / "r.xml").read_text()
+    assert 'name="ticks" value="11"' in xml
+    wall = float(xml.split('name="beside_wall" time="')[1].split('"')[0])
+    assert wall >= 10 * 0.1  # ten periods of the gazebo preset's 10 Hz, at the least
