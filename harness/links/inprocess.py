@@ -25,16 +25,9 @@ Processor = Callable[[Scan, float], "tuple[str, bool | None]"]
 
 def reference_processor(scan: Scan, threshold: float) -> tuple[str, bool | None]:
     """The lab's full solution, as the bundled ROS 2 node runs it."""
-    from harness.reference.scan_logic import analyse_scan, status_text
+    from harness.reference.scan_logic import analyse_message, status_text
 
-    report = analyse_scan(
-        scan.ranges,
-        scan.angle_min,
-        scan.angle_increment,
-        scan.range_min,
-        scan.range_max,
-        threshold,
-    )
+    report = analyse_message(scan, threshold)
     return status_text(report), report.warning
 
 

@@ -8,7 +8,7 @@ import time
 
 import pytest
 
-from harness.reference.scan_logic import analyse_scan, status_text
+from harness.reference.scan_logic import analyse_message, status_text
 
 pytestmark = [pytest.mark.ros, pytest.mark.timeout(45)]
 
@@ -17,14 +17,7 @@ INF, NAN = math.inf, math.nan
 
 def expected_answer(msg, threshold: float) -> tuple[str, bool]:
     """What the node must answer for `msg`, from the pure logic on the float32 ranges."""
-    report = analyse_scan(
-        msg.ranges,
-        msg.angle_min,
-        msg.angle_increment,
-        msg.range_min,
-        msg.range_max,
-        threshold,
-    )
+    report = analyse_message(msg, threshold)
     return status_text(report), report.warning
 
 

@@ -27,7 +27,7 @@ from rclpy.qos import QoSPresetProfiles, QoSProfile
 from sensor_msgs.msg import LaserScan
 from std_msgs.msg import Bool, String
 
-from .scan_logic import analyse_scan, check_threshold, status_text
+from .scan_logic import analyse_message, check_threshold, status_text
 
 __all__ = ['EXIT_CONFIG_ERROR', 'EXIT_OK', 'ConfigError', 'LidarProcessingNode', 'main']
 
@@ -128,14 +128,7 @@ class LidarProcessingNode(Node):
 
     def _on_scan(self, msg: LaserScan) -> None:
         """Answer one scan: Bool warning first, then the status String."""
-        report = analyse_scan(
-            msg.ranges,
-            msg.angle_min,
-            msg.angle_increment,
-            msg.range_min,
-            msg.range_max,
-            self._threshold,
-        )
+        report = analyse_message(msg, self._threshold)
         text = status_text(report)
         # The Bool goes out before the String: a lockstep tester that treats
         # the String as "answer complete" then already holds the Bool (both

@@ -16,10 +16,11 @@ import array
 from collections.abc import Sequence
 from dataclasses import dataclass
 from math import isfinite
+from typing import Any
 
 import numpy as np
 
-__all__ = ['ObstacleReport', 'analyse_scan', 'check_threshold', 'status_text']
+__all__ = ['ObstacleReport', 'analyse_message', 'analyse_scan', 'check_threshold', 'status_text']
 
 NO_OBSTACLE_TEXT = 'No obstacle detected'
 
@@ -91,6 +92,22 @@ def analyse_scan(
     distance = float(values[index])
     angle = float(angle_min) + index * float(angle_increment)
     return ObstacleReport(True, distance, angle, index, distance < threshold)
+
+
+def analyse_message(scan: Any, threshold: float) -> ObstacleReport:
+    """
+    Run ``analyse_scan`` on anything with LaserScan's field names.
+
+    A sensor_msgs/LaserScan and the harness's own Scan both qualify.
+    """
+    return analyse_scan(
+        scan.ranges,
+        scan.angle_min,
+        scan.angle_increment,
+        scan.range_min,
+        scan.range_max,
+        threshold,
+    )
 
 
 def status_text(report: ObstacleReport) -> str:
