@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+from harness.scan import Scan
+
 
 @dataclass(frozen=True)
 class Received:
@@ -24,6 +26,7 @@ class Answers:
     timed_out: bool = False  # the per-scan deadline passed without a status
     problem: str | None = None  # link-level failure, e.g. "node exited with code 1: ..."
     late: list[Received] = field(default_factory=list)  # answers to earlier scans, by tick
+    seen: Scan | None = None  # the scan the node received, when a device and driver made it
 
     def take_late(self, late: list[Received], tick: int) -> list[Received]:
         """Adopt the late answers that belong to `tick`; return the others.

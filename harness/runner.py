@@ -82,7 +82,10 @@ def run_scenario(
     pending: tuple[SimTick, Scan, Answers] | None = None
 
     def judge(sim_tick: SimTick, scan: Scan, answers: Answers) -> None:
-        verdict = oracle.judge(sim_tick.tick, sim_tick.t, scan, answers)
+        # Judge against what the node saw: over a serial link that is the
+        # board driver's scan, quantised and re-binned, not ours.
+        seen = answers.seen if answers.seen is not None else scan
+        verdict = oracle.judge(sim_tick.tick, sim_tick.t, seen, answers)
         record = TickRecord(
             sim_tick.tick,
             sim_tick.t,

@@ -87,24 +87,12 @@ class Ros2Link(Link):
             "ROS_DOMAIN_ID": str(self.domain.domain_id),
             **discovery_environment(network=opts.ros_network),
         }
-        args = ros_arguments(node_parameters(opts))
-        self.process = NodeProcess(self.command, args, env)
         started = time.perf_counter()
-        self.process.start()  # before our DDS threads exist: fork stays simple
-        self.observer = Observer(
-            self.domain.domain_id,
-            scan_topic=opts.scan_topic,
-            status_topic=opts.status_topic,
-            warning_topic=opts.warning_topic,
-            network=opts.ros_network,
-        )
+        self._start_processes(env)  # before our DDS threads exist: fork stays simple
+        self.observer = self._make_observer(self.domain.domain_id)
         deadline = time.monotonic() + opts.ready_timeout
-        while not self.observer.ready():
-            if self.process.returncode() is not None:
-                raise LinkError(
-                    f"node {self.command.description} "
-                    f"{self.process.exit_summary('before it was ready')}"
-                )
+        while not self._ready():
+            self._check_processes("before it was ready")
             if time.monotonic() >= deadline:
                 raise LinkError(
                     f"node {self.command.description} never became ready within "
@@ -113,6 +101,39 @@ class Ros2Link(Link):
                 )
             self.observer.spin(POLL_S)
         self.startup_s = time.perf_counter() - started
+
+    # Hooks a link that delivers scans another way (a device and its driver)
+    # overrides; the lockstep machinery below stays the same.
+    def _start_processes(self, env: dict[str, str]) -> None:
+        """Start the node under test."""
+        args = ros_arguments(node_parameters(self.options))
+        self.process = NodeProcess(self.command, args, env)
+        self.process.start()
+
+    def _make_observer(self, domain_id: int) -> Observer:
+        opts = self.options
+        return Observer(
+            domain_id,
+            scan_topic=opts.scan_topic,
+            status_topic=opts.status_topic,
+            warning_topic=opts.warning_topic,
+            network=opts.ros_network,
+        )
+
+    def _ready(self) -> bool:
+        assert self.observer is not None
+        return self.observer.ready()
+
+    def _check_processes(self, when: str) -> None:
+        """Raise LinkError if a process this link started has exited."""
+        assert self.process is not None
+        if self.process.returncode() is not None:
+            raise LinkError(f"node {self.command.description} {self.process.exit_summary(when)}")
+
+    def _deliver(self, scan: Scan, tick: int) -> int:
+        """Put the scan in front of the node; return its send time (system-clock ns)."""
+        assert self.observer is not None
+        return self.observer.publish(scan)
 
     def warm_up(self, scan: Scan) -> None:
         """Exchange the first scan until the node's answer reaches us, then forget it.
@@ -125,7 +146,7 @@ class Ros2Link(Link):
         obs, opts = self.observer, self.options
         deadline = time.perf_counter() + opts.ready_timeout
         while True:
-            sent_ns = obs.publish(scan)
+            sent_ns = self._deliver(scan, -1)
 
             def answered(since: int = sent_ns) -> bool:
                 return any(h.kind == "status" and h.source_ns >= since for h in obs.inbox)
@@ -170,7 +191,7 @@ class Ros2Link(Link):
         assert self.observer is not None, "open() the link first"
         if self.options.realtime:
             self._pace(scan, tick)
-        self._sent_ns = self.observer.publish(scan)
+        self._sent_ns = self._deliver(scan, tick)
         self._sent_at = time.perf_counter()
         self._sends = [*self._sends[-7:], (tick, self._sent_ns)]
 
