@@ -12,6 +12,7 @@ import os
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 import rclpy
 from rclpy.context import Context
@@ -22,7 +23,7 @@ from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import LaserScan
 from std_msgs.msg import Bool, String
 
-from harness.ros.messages import clock_message, scan_message
+from harness.ros.messages import clock_message, scan_from_message, scan_message
 from harness.scan import Scan
 
 QOS = QoSProfile(depth=50, reliability=ReliabilityPolicy.RELIABLE)
@@ -32,8 +33,8 @@ QOS = QoSProfile(depth=50, reliability=ReliabilityPolicy.RELIABLE)
 class Heard:
     """One message from the node under test."""
 
-    kind: str  # "status" or "warning"
-    value: str | bool
+    kind: str  # "status", "warning", or "scan" (a driver's scan, when watching)
+    value: str | bool | Scan
     source_ns: int  # when the node published it (DDS source timestamp, system clock)
     arrived: float  # time.perf_counter() when the harness took it
 
@@ -54,6 +55,7 @@ class Observer:
         status_topic: str,
         warning_topic: str,
         network: bool = False,
+        publish_scans: bool = True,
     ) -> None:
         # rmw reads the discovery range from the environment at init.
         os.environ.pop("ROS_AUTOMATIC_DISCOVERY_RANGE", None)
@@ -70,7 +72,18 @@ class Observer:
         self.executor = SingleThreadedExecutor(context=self.context)
         self.executor.add_node(self.node)
         self.scan_topic, self.status_topic = scan_topic, status_topic
-        self.scan_pub = self.node.create_publisher(LaserScan, scan_topic, QOS)
+        # Either we publish the scans (ros2 link) or a board's driver does and
+        # we listen to what the node under test receives (serial links).
+        self.scan_pub = (
+            self.node.create_publisher(LaserScan, scan_topic, QOS) if publish_scans else None
+        )
+        self.scan_sub = (
+            None
+            if publish_scans
+            else self.node.create_subscription(
+                LaserScan, scan_topic, self._hear("scan", scan_from_message), QOS
+            )
+        )
         self.clock_pub = self.node.create_publisher(Clock, "/clock", QOS)
         self.inbox: list[Heard] = []
         self.status_sub = self.node.create_subscription(
@@ -80,7 +93,10 @@ class Observer:
             Bool, warning_topic, self._hear("warning", lambda m: bool(m.data)), QOS
         )
 
-    def _hear(self, kind: str, value_of: Callable[[object], str | bool]):
+    def publish_clock(self, seconds: float) -> None:
+        self.clock_pub.publish(clock_message(seconds))
+
+    def _hear(self, kind: str, value_of: Callable[[Any], str | bool | Scan]):
         def callback(msg: object, info: dict) -> None:
             self.inbox.append(
                 Heard(kind, value_of(msg), int(info["source_timestamp"]), time.perf_counter())
@@ -90,6 +106,7 @@ class Observer:
 
     def publish(self, scan: Scan) -> int:
         """Publish /clock then the scan; return the send time in system-clock ns."""
+        assert self.scan_pub is not None, "this observer watches a driver's scans"
         msg = scan_message(scan)
         self.clock_pub.publish(clock_message(scan.stamp))
         sent = time.time_ns()
@@ -114,9 +131,21 @@ class Observer:
 
     def ready(self) -> bool:
         """The node reads our scans and publishes its status (matched, not just announced)."""
-        return (
-            self.scan_pub.get_subscription_count() > 0 and self.status_sub.get_publisher_count() > 0
-        )
+        if self.scan_pub is not None:
+            reads_scans = self.scan_pub.get_subscription_count() > 0
+        else:  # the driver publishes scans and someone besides us reads them
+            assert self.scan_sub is not None
+            reads_scans = (
+                self.scan_sub.get_publisher_count() > 0
+                and self.node.count_subscribers(self.scan_topic) > 1
+            )
+        return reads_scans and self.status_sub.get_publisher_count() > 0
+
+    def _scan_readers(self) -> int:
+        """Readers of the scan topic other than this observer."""
+        if self.scan_pub is not None:
+            return self.scan_pub.get_subscription_count()
+        return self.node.count_subscribers(self.scan_topic) - 1
 
     def graph_summary(self) -> str:
         """What the node under test offers, for 'never became ready' explanations."""
@@ -126,7 +155,7 @@ class Observer:
             if name not in ("/rosout", "/parameter_events", "/clock")
         ]
         return (
-            f"subscribers on {self.scan_topic}: {self.scan_pub.get_subscription_count()}, "
+            f"subscribers on {self.scan_topic}: {self._scan_readers()}, "
             f"publishers on {self.status_topic}: {self.status_sub.get_publisher_count()}; "
             f"topics seen: {', '.join(topics) or 'none'}"
         )
