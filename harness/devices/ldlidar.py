@@ -1,0 +1,183 @@
+"""LDROBOT LD06 / LD19: the packet stream the device sends, as pure code.
+
+The device takes no commands: once its motor is stable it streams 47-byte
+packets at 230400 baud, 12 measurements each. ``LdlidarDevice`` turns one
+revolution of device samples into those packets; ``decode_packets`` is the
+slow, obvious reference decoder the tests check it against. Facts and their
+sources: docs/devices.md.
+"""
+
+from __future__ import annotations
+
+import struct
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+from harness.devices.revolution import Sample
+
+HEADER = 0x54
+VER_LEN = 0x2C  # top 3 bits reserved, low 5 bits: points per packet (12)
+POINTS_PER_PACKET = 12
+PACKET_LEN = 47
+BAUD = 230400
+TIMESTAMP_WRAP_MS = 30000
+CRC_POLY = 0x4D
+MAX_DISTANCE_MM = 0xFFFF
+SAMPLES_PER_S = 4500
+SPEED_DEG_S = 3600.0  # 10 Hz
+# A return's intensity. Weak returns are removed by the vendor driver's near
+# filter (mean intensity <= 15 in a group, < 220 for groups of 1-2 points).
+DEFAULT_INTENSITY = 200
+
+_HEAD = struct.Struct("<BBHH")  # header, ver_len, speed, start angle
+_POINT = struct.Struct("<HB")  # distance mm, intensity
+_TAIL = struct.Struct("<HH")  # end angle, timestamp
+
+
+def _crc_table(poly: int) -> tuple[int, ...]:
+    """The 256-entry lookup table of an MSB-first CRC-8 with this polynomial."""
+    table = []
+    for byte in range(256):
+        crc = byte
+        for _ in range(8):
+            crc = ((crc << 1) ^ poly if crc & 0x80 else crc << 1) & 0xFF
+        table.append(crc)
+    return tuple(table)
+
+
+CRC_TABLE: tuple[int, ...] = _crc_table(CRC_POLY)
+
+
+def crc8(data: bytes) -> int:
+    """The packet CRC (init 0, no reflection, no final xor), over the first 46 bytes."""
+    crc = 0
+    for byte in data:
+        crc = CRC_TABLE[crc ^ byte]
+    return crc
+
+
+@dataclass(frozen=True)
+class LdPacket:
+    """One decoded packet, fields as on the wire."""
+
+    speed_deg_s: int
+    start_angle_cdeg: int  # 0.01 degree, clockwise
+    end_angle_cdeg: int
+    timestamp_ms: int  # wraps at 30000
+    points: tuple[tuple[int, int], ...]  # (distance mm, intensity)
+
+    def samples(self) -> list[Sample]:
+        """The points with angles interpolated from start to end, as hosts do."""
+        span = (self.end_angle_cdeg - self.start_angle_cdeg) % 36000
+        step = span / (len(self.points) - 1)
+        return [
+            Sample(((self.start_angle_cdeg + i * step) / 100.0) % 360.0, float(dist), intensity)
+            for i, (dist, intensity) in enumerate(self.points)
+        ]
+
+
+def _angle_cdeg(angle_deg: float) -> int:
+    return int(round((angle_deg % 360.0) * 100)) % 36000
+
+
+def encode_packet(samples: Sequence[Sample], *, speed_deg_s: float, timestamp_ms: int) -> bytes:
+    """One 47-byte packet of 12 samples; hosts interpolate the angles in between."""
+    if len(samples) != POINTS_PER_PACKET:
+        raise ValueError(f"a packet holds {POINTS_PER_PACKET} samples, got {len(samples)}")
+    body = bytearray(
+        _HEAD.pack(HEADER, VER_LEN, int(round(speed_deg_s)), _angle_cdeg(samples[0].angle_deg))
+    )
+    for sample in samples:
+        dist = min(max(int(round(sample.distance_mm)), 0), MAX_DISTANCE_MM)
+        intensity = min(max(int(sample.quality), 0), 255) if dist else 0
+        body += _POINT.pack(dist, intensity)
+    body += _TAIL.pack(_angle_cdeg(samples[-1].angle_deg), timestamp_ms % TIMESTAMP_WRAP_MS)
+    return bytes(body) + bytes((crc8(body),))
+
+
+def parse_packet(packet: bytes) -> LdPacket:
+    """Decode one packet; ValueError for a wrong length, header or CRC."""
+    if len(packet) != PACKET_LEN:
+        raise ValueError(f"a packet is {PACKET_LEN} bytes, got {len(packet)}")
+    header, ver_len, speed, start = _HEAD.unpack_from(packet)
+    if header != HEADER or ver_len != VER_LEN:
+        raise ValueError(f"bad packet header {packet[:2].hex(' ')}")
+    if crc8(packet[:-1]) != packet[-1]:
+        raise ValueError("packet CRC mismatch")
+    points = tuple(
+        _POINT.unpack_from(packet, _HEAD.size + i * _POINT.size) for i in range(POINTS_PER_PACKET)
+    )
+    end, timestamp = _TAIL.unpack_from(packet, _HEAD.size + POINTS_PER_PACKET * _POINT.size)
+    return LdPacket(speed, start, end, timestamp, points)
+
+
+def decode_packets(data: bytes) -> tuple[list[Sample], int]:
+    """Reference decoder: samples of every good packet, and how many failed the CRC.
+
+    Scans for 0x54 0x2C; after a bad CRC it resumes one byte later, so
+    garbage and damaged packets cost only themselves. A trailing incomplete
+    packet is ignored.
+    """
+    samples: list[Sample] = []
+    bad = 0
+    pos = 0
+    while (pos := data.find(bytes((HEADER, VER_LEN)), pos)) >= 0:
+        packet = data[pos : pos + PACKET_LEN]
+        if len(packet) < PACKET_LEN:
+            break
+        if crc8(packet[:-1]) != packet[-1]:
+            bad += 1
+            pos += 1
+            continue
+        samples.extend(parse_packet(packet).samples())
+        pos += PACKET_LEN
+    return samples, bad
+
+
+class LdlidarDevice:
+    """An LD06/LD19 streaming at a fixed rotation speed and sample rate."""
+
+    def __init__(self, *, speed_deg_s: float = SPEED_DEG_S, samples_per_s: int = SAMPLES_PER_S):
+        if speed_deg_s <= 0 or samples_per_s <= 0:
+            raise ValueError("speed_deg_s and samples_per_s must be positive")
+        self.speed_deg_s = speed_deg_s
+        self.samples_per_s = samples_per_s
+        self._pending: list[tuple[Sample, float]] = []  # samples and their times (ms)
+
+    @property
+    def samples_per_revolution(self) -> int:
+        """Native samples in one turn: 450 at 10 Hz and 4500 samples/s."""
+        return max(1, round(self.samples_per_s * 360.0 / self.speed_deg_s))
+
+    @property
+    def samples_per_packet(self) -> int:
+        return POINTS_PER_PACKET
+
+    @property
+    def rate_hz(self) -> float:
+        return self.speed_deg_s / 360.0
+
+    def encode_revolution(self, samples: Sequence[Sample], *, start_ms: float) -> bytes:
+        """Whole packets for one revolution whose first sample was taken at ``start_ms``.
+
+        Sample k is taken at start_ms + k / samples_per_s; a packet carries
+        the (wrapped) time of its first sample. A revolution is rarely a
+        multiple of 12 samples: the remainder waits for the next call, as the
+        real stream runs on across revolutions.
+        """
+        period_ms = 1000.0 / self.samples_per_s
+        self._pending.extend((s, start_ms + k * period_ms) for k, s in enumerate(samples))
+        out = bytearray()
+        while len(self._pending) >= POINTS_PER_PACKET:
+            chunk = self._pending[:POINTS_PER_PACKET]
+            del self._pending[:POINTS_PER_PACKET]
+            out += encode_packet(
+                [s for s, _ in chunk],
+                speed_deg_s=self.speed_deg_s,
+                timestamp_ms=int(chunk[0][1]),
+            )
+        return bytes(out)
+
+    def reset(self) -> None:
+        """Forget samples waiting for a packet (the stream was interrupted)."""
+        self._pending = []

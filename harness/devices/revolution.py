@@ -1,0 +1,105 @@
+"""Turning an emitted Scan into the measurements a spinning LIDAR would send.
+
+Both emulated devices (RPLIDAR A1, LD06/LD19) turn clockwise seen from above
+and report angles in degrees clockwise from their own forward direction,
+while a ``Scan`` follows REP-103 (radians, counter-clockwise). This module is
+the one place that flips the convention, so the codecs only ever see device
+samples. See docs/devices.md for the conventions and their sources.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from harness.scan import Scan
+
+# The quality the vendor SDK gives every express-scan sample (0x2F): a
+# plausible mid-range RPLIDAR quality for returns. LD devices want a higher
+# intensity (their ROS driver filters weak near returns): pass one.
+DEFAULT_QUALITY = 47
+
+
+@dataclass(frozen=True)
+class Sample:
+    """One device measurement, in the device's own convention."""
+
+    angle_deg: float  # clockwise from the device's forward, [0, 360)
+    distance_mm: float  # 0.0 = no return (also "too close": devices send 0 for both)
+    quality: int  # RPLIDAR: 0..63 (0 when distance is 0); LD: intensity 0..255
+
+
+def device_angle_deg(ccw_rad: float | np.ndarray) -> float | np.ndarray:
+    """A REP-103 angle (CCW, radians) as a device angle (CW, degrees, [0, 360))."""
+    deg = np.mod(-np.degrees(np.asarray(ccw_rad, dtype=np.float64)), 360.0)
+    # A tiny negative angle rounds to 360.0, and -0.0 prints oddly: both are 0.
+    deg = np.where(deg >= 360.0, 0.0, deg) + 0.0
+    return float(deg) if deg.ndim == 0 else deg
+
+
+def encode_distances_mm(ranges_m: np.ndarray, max_range_m: float | None = None) -> np.ndarray:
+    """Metres (REP-117 values) to device millimetres, with 0 for "nothing usable".
+
+    Non-finite, zero or negative readings become 0, as does anything beyond
+    ``max_range_m`` when given. A finite reading below the scan's range_min
+    (a spurious return) is kept: the device would report it, and filtering it
+    is the driver's job.
+    """
+    r = np.asarray(ranges_m, dtype=np.float64)
+    with np.errstate(invalid="ignore"):
+        usable = np.isfinite(r) & (r > 0.0)
+        if max_range_m is not None:
+            usable &= r <= max_range_m
+    return np.where(usable, r * 1000.0, 0.0)
+
+
+def samples_from_scan(
+    scan: Scan,
+    *,
+    samples_per_rev: int | None = None,
+    max_range_m: float | None = None,
+    quality: int = DEFAULT_QUALITY,
+) -> list[Sample]:
+    """The samples of one revolution, in increasing device angle from about 0.
+
+    Without ``samples_per_rev`` there is one sample per beam. With it, the
+    revolution is resampled to the device's native count: sample ``j`` looks
+    at device angle ``j * 360 / samples_per_rev`` and takes the nearest beam,
+    or no return where the scan has no beam within half an increment.
+    """
+    distances = encode_distances_mm(scan.ranges, max_range_m)
+    if samples_per_rev is None:
+        angles = np.asarray(device_angle_deg(scan.angles()), dtype=np.float64)
+    else:
+        if samples_per_rev < 1:
+            raise ValueError(f"samples_per_rev must be positive, got {samples_per_rev}")
+        angles = np.arange(samples_per_rev, dtype=np.float64) * (360.0 / samples_per_rev)
+        distances = _nearest_beam(scan, angles, distances)
+    order = np.argsort(angles, kind="stable")
+    qualities = np.where(distances > 0.0, int(quality), 0)
+    return [
+        Sample(float(angles[i]), float(distances[i]), int(qualities[i])) for i in order.tolist()
+    ]
+
+
+def _nearest_beam(scan: Scan, device_deg: np.ndarray, distances: np.ndarray) -> np.ndarray:
+    """Distances seen at the given device angles: nearest beam, 0 if none is near."""
+    n = scan.ranges.size
+    if n == 0:
+        return np.zeros(device_deg.size)
+    ccw = np.radians(-device_deg)
+    inc = scan.angle_increment if n > 1 else 2 * math.pi
+    rel = np.mod(ccw - scan.angle_min, 2 * math.pi)  # [0, 2*pi) past the first beam
+    index = np.rint(rel / inc).astype(np.int64)
+    gap = np.abs(rel - index * inc)
+    beyond = index > n - 1
+    # Past the last beam: the nearer of the last beam and (wrapping) the first.
+    to_last = rel - (n - 1) * inc
+    to_first = 2 * math.pi - rel
+    use_first = beyond & (to_first <= to_last)
+    index = np.where(beyond, np.where(use_first, 0, n - 1), index)
+    gap = np.where(beyond, np.minimum(to_first, to_last), gap)
+    covered = gap <= inc / 2 + 1e-9
+    return np.where(covered, distances[index], 0.0)

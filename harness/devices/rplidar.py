@@ -1,0 +1,622 @@
+"""Slamtec RPLIDAR A1M8: the device's side of its serial protocol, as pure code.
+
+``RplidarDevice`` is a state machine fed with the bytes the host writes; it
+returns the device's immediate replies and, once scanning, encodes each
+revolution as the device would stream it (standard 5-byte nodes or legacy
+express capsules). No I/O here: the serial front end paces the bytes, drives
+the motor line (DTR) and decides when a revolution is due.
+
+The module also holds host-side helpers (``encode_request``) and slow,
+obvious reference decoders (``decode_standard``, ``decode_express``) that the
+tests check the encoders against. Facts and their sources: docs/devices.md.
+"""
+
+from __future__ import annotations
+
+import struct
+from collections.abc import Sequence
+from dataclasses import dataclass
+from functools import reduce
+from operator import xor
+
+from harness.devices.revolution import DEFAULT_QUALITY, Sample
+
+# -- wire constants (Slamtec protocol v2.x, sl_lidar_cmd.h) --------------------
+
+BAUD = 115200
+SYNC = 0xA5  # first byte of every request
+ANSWER_SYNC = b"\xa5\x5a"  # first two bytes of every response descriptor
+CMD_HAS_PAYLOAD = 0x80  # set in the command byte of requests carrying a payload
+
+CMD_STOP = 0x25
+CMD_SCAN = 0x20
+CMD_FORCE_SCAN = 0x21
+CMD_RESET = 0x40
+CMD_GET_INFO = 0x50
+CMD_GET_HEALTH = 0x52
+CMD_GET_SAMPLERATE = 0x59
+CMD_EXPRESS_SCAN = 0x82
+CMD_GET_LIDAR_CONF = 0x84
+CMD_SET_MOTOR_PWM = 0xF0
+CMD_GET_ACC_BOARD_FLAG = 0xFF
+
+ANS_DEVINFO = 0x04
+ANS_HEALTH = 0x06
+ANS_SAMPLERATE = 0x15
+ANS_GET_LIDAR_CONF = 0x20
+ANS_MEASUREMENT = 0x81
+ANS_CAPSULED = 0x82
+ANS_ACC_BOARD_FLAG = 0xFF
+
+SEND_SINGLE = 0  # descriptor send mode: one response packet
+SEND_MULTIPLE = 1  # descriptor send mode: a stream of response packets
+
+CONF_SCAN_MODE_COUNT = 0x70
+CONF_SCAN_MODE_US_PER_SAMPLE = 0x71
+CONF_SCAN_MODE_MAX_DISTANCE = 0x74
+CONF_SCAN_MODE_ANS_TYPE = 0x75
+CONF_SCAN_MODE_TYPICAL = 0x7C
+CONF_SCAN_MODE_NAME = 0x7F
+
+HEALTH_OK = 0
+HEALTH_WARNING = 1
+HEALTH_ERROR = 2  # "Protection Stop": scan requests are refused until RESET
+
+DESCRIPTOR_LEN = 7
+NODE_LEN = 5
+CAPSULE_LEN = 84
+CABINS_PER_CAPSULE = 16
+SAMPLES_PER_CAPSULE = 32
+FULL_TURN_Q6 = 360 * 64
+MAX_DISTANCE_Q2 = 0xFFFF
+MAX_EXPRESS_DISTANCE_MM = 0x3FFF  # 14 bits
+MAX_ANGLE_OFFSET_Q3 = 31  # dtheta kept in 0..31 so signed and unsigned readers agree
+
+# A1M8 firmware 1.29 as measured on a real unit (GET_SAMPLERATE: 508 / 254 us).
+STANDARD_SAMPLE_US = 508
+EXPRESS_SAMPLE_US = 254
+A1_MAX_DISTANCE_M = 12.0
+DEFAULT_SERIAL = b"FOSSBOT-HIL-A1M8"  # 16 bytes, obviously not a real unit's
+# The protocol asks hosts to wait >= 2 ms after RESET; the banner follows the reboot.
+RESET_REBOOT_S = 0.002
+
+COUNTER_NAMES = (
+    "requests",  # well-formed requests (valid checksum where there is one)
+    "bad_checksum",  # payload requests dropped for a wrong checksum
+    "garbage_bytes",  # bytes skipped while looking for the 0xA5 sync byte
+    "unknown_command",  # well-formed requests with a command the device ignores
+    "truncated",  # partial requests abandoned by the front end (inter-byte timeout)
+    "bad_payload",  # known commands with a payload of the wrong size
+    "unknown_conf",  # GET_LIDAR_CONF for a type or mode the device does not answer
+    "unsupported_mode",  # EXPRESS_SCAN with a working mode the emulator does not stream
+    "refused_scan",  # scan requests ignored in Protection Stop
+    "ignored_rebooting",  # bytes that arrived while the core was rebooting
+)
+
+
+@dataclass(frozen=True)
+class ScanMode:
+    """One entry of the GET_LIDAR_CONF scan-mode table."""
+
+    name: str
+    us_per_sample: float
+    max_distance_m: float
+    ans_type: int  # ANS_MEASUREMENT (standard nodes) or ANS_CAPSULED (legacy express)
+
+
+def default_scan_modes(
+    standard_sample_us: float = STANDARD_SAMPLE_US, express_sample_us: float = EXPRESS_SAMPLE_US
+) -> tuple[ScanMode, ...]:
+    """The modes the emulator streams: Standard (id 0) and legacy Express (id 1).
+
+    A real A1M8 on firmware 1.29 also lists Boost, Sensitivity and Stability,
+    which stream ultra capsules (answer type 0x84) that are not emulated.
+    """
+    return (
+        ScanMode("Standard", standard_sample_us, A1_MAX_DISTANCE_M, ANS_MEASUREMENT),
+        ScanMode("Express", express_sample_us, A1_MAX_DISTANCE_M, ANS_CAPSULED),
+    )
+
+
+# -- host side: requests --------------------------------------------------------
+
+
+def _xor_all(data: bytes | bytearray) -> int:
+    return reduce(xor, data, 0)
+
+
+def encode_request(cmd: int, payload: bytes = b"") -> bytes:
+    """A request as a host sends it: ``A5 cmd`` or ``A5 cmd size payload checksum``.
+
+    A payload sets the 0x80 flag in the command byte (as the SDK does); a
+    command that already has the flag gets size and checksum even when empty.
+    """
+    if not 0 <= cmd <= 0xFF:
+        raise ValueError(f"command must be a byte, got {cmd}")
+    if len(payload) > 0xFF:
+        raise ValueError(f"payload is at most 255 bytes, got {len(payload)}")
+    if not payload and not cmd & CMD_HAS_PAYLOAD:
+        return bytes((SYNC, cmd))
+    head = bytes((SYNC, cmd | CMD_HAS_PAYLOAD, len(payload))) + bytes(payload)
+    return head + bytes((_xor_all(head),))
+
+
+def encode_descriptor(size: int, send_mode: int, data_type: int) -> bytes:
+    """A response descriptor: A5 5A, then size (30 bits) | mode (2 bits) LE, then the type."""
+    return ANSWER_SYNC + struct.pack("<IB", (size & 0x3FFFFFFF) | (send_mode << 30), data_type)
+
+
+def decode_descriptor(data: bytes) -> tuple[int, int, int]:
+    """(size, send_mode, data_type) of a 7-byte response descriptor."""
+    if len(data) != DESCRIPTOR_LEN or data[:2] != ANSWER_SYNC:
+        raise ValueError(f"not a response descriptor: {data.hex(' ')}")
+    size_mode, data_type = struct.unpack("<IB", data[2:])
+    return size_mode & 0x3FFFFFFF, size_mode >> 30, data_type
+
+
+# -- standard scan nodes --------------------------------------------------------
+
+
+def _angle_q6(angle_deg: float) -> int:
+    """Degrees to q6 in [0, 360 * 64): an angle just under 360 stays the last step."""
+    return min(int(round((angle_deg % 360.0) * 64)), FULL_TURN_Q6 - 1)
+
+
+def _distance_q2(distance_mm: float) -> int:
+    return min(max(int(round(distance_mm * 4)), 0), MAX_DISTANCE_Q2)
+
+
+def encode_node(sample: Sample, *, start: bool) -> bytes:
+    """One standard-scan node: quality<<2 | !S<<1 | S; angle_q6<<1 | 1; distance_q2 (LE)."""
+    dist = _distance_q2(sample.distance_mm)
+    quality = min(max(int(sample.quality), 0), 63) if dist else 0
+    flags = 0b01 if start else 0b10
+    return struct.pack("<BHH", (quality << 2) | flags, (_angle_q6(sample.angle_deg) << 1) | 1, dist)
+
+
+def encode_standard(samples: Sequence[Sample]) -> bytes:
+    """One revolution of nodes, starting at (and flagging) the smallest angle.
+
+    The device starts a new revolution where the angle wraps past zero, so
+    the start flag goes on the sample with the smallest angle; samples before
+    it in the list are rotated to the end, keeping the cyclic order.
+    """
+    if not samples:
+        return b""
+    ordered = list(samples)
+    first = min(range(len(ordered)), key=lambda i: _angle_q6(ordered[i].angle_deg))
+    ordered = ordered[first:] + ordered[:first]
+    return b"".join(encode_node(s, start=(i == 0)) for i, s in enumerate(ordered))
+
+
+def decode_standard(data: bytes) -> list[Sample]:
+    """Reference decoder for standard nodes; raises ValueError on a broken node."""
+    return [sample for sample, _ in decode_standard_nodes(data)]
+
+
+def decode_standard_nodes(data: bytes) -> list[tuple[Sample, bool]]:
+    """(sample, start flag) for each 5-byte node, checking S != !S and the check bit."""
+    if len(data) % NODE_LEN:
+        raise ValueError(f"{len(data)} bytes is not a whole number of {NODE_LEN}-byte nodes")
+    nodes = []
+    for offset in range(0, len(data), NODE_LEN):
+        b0, angle_field, dist_q2 = struct.unpack_from("<BHH", data, offset)
+        start, not_start = b0 & 1, (b0 >> 1) & 1
+        if start == not_start:
+            raise ValueError(f"node at {offset}: start flag and its inverse agree")
+        if not angle_field & 1:
+            raise ValueError(f"node at {offset}: check bit is 0")
+        sample = Sample((angle_field >> 1) / 64.0, dist_q2 / 4.0, b0 >> 2)
+        nodes.append((sample, bool(start)))
+    return nodes
+
+
+# -- legacy express capsules ----------------------------------------------------
+
+
+def _angle_diff_q6(start_q6: int, next_q6: int) -> int:
+    """AngleDiff of the protocol: next - start, plus a turn when it wraps."""
+    diff = next_q6 - start_q6
+    return diff + FULL_TURN_Q6 if diff < 0 else diff
+
+
+def _angle_offset_q3(raw_q16: int, angle_deg: float) -> int:
+    """The compensation dtheta (q3 degrees) that moves a raw angle onto the sample's."""
+    delta = (raw_q16 / 65536.0 - angle_deg + 180.0) % 360.0 - 180.0
+    return min(max(int(round(delta * 8)), 0), MAX_ANGLE_OFFSET_Q3)
+
+
+def encode_capsule(
+    samples: Sequence[Sample], next_start_deg: float, *, start_flag: bool = False
+) -> bytes:
+    """One 84-byte express capsule holding 32 samples.
+
+    The host only learns capsule i's angles from the start angle of capsule
+    i + 1: sample k sits at start + k * AngleDiff / 32 - dtheta_k. So the
+    encoder needs the angle of the next capsule's first sample. dtheta is
+    kept in 0..31 (0..3.875 degrees), where the protocol's signed reading
+    and the SDK's unsigned one agree; larger corrections are clipped.
+    """
+    if len(samples) != SAMPLES_PER_CAPSULE:
+        raise ValueError(f"a capsule holds {SAMPLES_PER_CAPSULE} samples, got {len(samples)}")
+    start_q6 = _angle_q6(samples[0].angle_deg)
+    inc_q16 = _angle_diff_q6(start_q6, _angle_q6(next_start_deg)) << 5  # diff / 32, in q16
+    body = bytearray(struct.pack("<H", start_q6 | (0x8000 if start_flag else 0)))
+    for cabin in range(CABINS_PER_CAPSULE):
+        fields = []
+        for k in (2 * cabin, 2 * cabin + 1):
+            sample = samples[k]
+            raw_q16 = (start_q6 << 10) + k * inc_q16
+            dist = min(max(int(round(sample.distance_mm)), 0), MAX_EXPRESS_DISTANCE_MM)
+            fields.append((dist, _angle_offset_q3(raw_q16, sample.angle_deg)))
+        (d1, t1), (d2, t2) = fields
+        offsets = (t1 & 0xF) | ((t2 & 0xF) << 4)
+        body += struct.pack("<HHB", (d1 << 2) | (t1 >> 4), (d2 << 2) | (t2 >> 4), offsets)
+    checksum = _xor_all(body)
+    return bytes((0xA0 | (checksum & 0xF), 0x50 | (checksum >> 4))) + bytes(body)
+
+
+def _check_capsule(capsule: bytes) -> None:
+    if len(capsule) != CAPSULE_LEN:
+        raise ValueError(f"a capsule is {CAPSULE_LEN} bytes, got {len(capsule)}")
+    if capsule[0] >> 4 != 0xA or capsule[1] >> 4 != 0x5:
+        raise ValueError("capsule sync nibbles are not 0xA, 0x5")
+    checksum = (capsule[0] & 0xF) | ((capsule[1] & 0xF) << 4)
+    if checksum != _xor_all(capsule[2:]):
+        raise ValueError("capsule checksum mismatch")
+
+
+def capsule_start_angle_q6(capsule: bytes) -> int:
+    return struct.unpack_from("<H", capsule, 2)[0] & 0x7FFF
+
+
+def capsule_start_flag(capsule: bytes) -> bool:
+    """S: set only on the first capsule after EXPRESS_SCAN (or after a restart)."""
+    return bool(struct.unpack_from("<H", capsule, 2)[0] & 0x8000)
+
+
+def decode_express(capsule_a: bytes, capsule_b: bytes) -> list[Sample]:
+    """Reference decoder: capsule_a's 32 samples, using capsule_b's start angle.
+
+    Integer arithmetic as in the vendor SDK (q16 angles, dtheta read unsigned),
+    so results match what ``rplidar_ros`` would compute. Distances are whole
+    millimetres; quality is the SDK's fixed value for a return.
+    """
+    _check_capsule(capsule_a)
+    _check_capsule(capsule_b)
+    start_q6 = capsule_start_angle_q6(capsule_a)
+    inc_q16 = _angle_diff_q6(start_q6, capsule_start_angle_q6(capsule_b)) << 5
+    raw_q16 = start_q6 << 10
+    samples = []
+    for cabin in range(CABINS_PER_CAPSULE):
+        word1, word2, offsets = struct.unpack_from("<HHB", capsule_a, 4 + 5 * cabin)
+        for word, nibble in ((word1, offsets & 0xF), (word2, offsets >> 4)):
+            dist_q2 = word & 0xFFFC
+            dtheta_q3 = nibble | ((word & 0x3) << 4)
+            angle_q6 = ((raw_q16 - (dtheta_q3 << 13)) >> 10) % FULL_TURN_Q6
+            raw_q16 += inc_q16
+            quality = DEFAULT_QUALITY if dist_q2 else 0
+            samples.append(Sample(angle_q6 / 64.0, dist_q2 / 4.0, quality))
+    return samples
+
+
+# -- the device -----------------------------------------------------------------
+
+
+class RplidarDevice:
+    """An A1M8 as seen from its serial line: requests in, replies and scans out.
+
+    Motor: on the A1 the USB adapter drives the motor from DTR (DTR asserted,
+    e.g. pyserial ``setDTR(True)``, stops it). The front end reports that
+    with ``set_motor``; MOTOR_PWM requests also switch it (pwm > 0 runs),
+    last writer wins, unless ``pwm_controls_motor`` is False (a bare A1 has
+    no PWM input). SCAN and EXPRESS_SCAN stream nothing while the motor is
+    off (the device waits for a stable rotation); FORCE_SCAN streams anyway.
+    """
+
+    def __init__(
+        self,
+        *,
+        model: int = 0x18,
+        firmware: tuple[int, int] = (1, 29),
+        hardware: int = 7,
+        serial_number: bytes = DEFAULT_SERIAL,
+        standard_sample_us: int = STANDARD_SAMPLE_US,
+        express_sample_us: int = EXPRESS_SAMPLE_US,
+        scan_modes: Sequence[ScanMode] | None = None,
+        typical_mode: int = 1,
+        pwm_controls_motor: bool = True,
+    ) -> None:
+        if len(serial_number) != 16:
+            raise ValueError(f"serial_number must be 16 bytes, got {len(serial_number)}")
+        self.model = model
+        self.firmware = firmware
+        self.hardware = hardware
+        self.serial_number = bytes(serial_number)
+        self.standard_sample_us = standard_sample_us
+        self.express_sample_us = express_sample_us
+        if scan_modes is None:
+            scan_modes = default_scan_modes(standard_sample_us, express_sample_us)
+        self.scan_modes = tuple(scan_modes)
+        self.typical_mode = typical_mode
+        self.pwm_controls_motor = pwm_controls_motor
+        major, minor = firmware
+        # What the A1 prints (CRLF text, no descriptor) at power-up and after RESET.
+        self.reset_banner = (
+            f"RP LIDAR System.\r\nFirmware Ver {major}.{minor:02d} - rtm, HW Ver {hardware}\r\n"
+            f"Model: {model:02x}\r\n"
+        ).encode("ascii")
+        self.motor_on = False
+        self.pwm: int | None = None  # last MOTOR_PWM value, None if never sent
+        self.health_status = HEALTH_OK
+        self.health_error = 0
+        self.fault_persists = False  # a fault that RESET does not clear
+        self.rebooting = False
+        self.session = 0  # bumped whenever a scan starts or ends: stale bytes can be dropped
+        self.counters: dict[str, int] = dict.fromkeys(COUNTER_NAMES, 0)
+        self._rx = bytearray()
+        self._mode = "idle"
+        self._forced = False
+        self._express_pending: list[Sample] = []
+        self._express_restart = True
+        self._handlers = {
+            CMD_STOP: self._on_stop,
+            CMD_RESET: self._on_reset,
+            CMD_SCAN: self._on_scan,
+            CMD_FORCE_SCAN: self._on_force_scan,
+            CMD_EXPRESS_SCAN: self._on_express_scan,
+            CMD_GET_INFO: self._on_get_info,
+            CMD_GET_HEALTH: self._on_get_health,
+            CMD_GET_SAMPLERATE: self._on_get_samplerate,
+            CMD_GET_LIDAR_CONF: self._on_get_lidar_conf,
+            CMD_SET_MOTOR_PWM: self._on_motor_pwm,
+            CMD_GET_ACC_BOARD_FLAG: self._on_acc_board_flag,
+        }
+
+    # -- state seen by the front end ----------------------------------------
+
+    @property
+    def mode(self) -> str:
+        """ "idle", "scan" (SCAN / FORCE_SCAN) or "express" (EXPRESS_SCAN)."""
+        return self._mode
+
+    @property
+    def sample_us(self) -> float:
+        """Time per sample in the current (or, when idle, standard) mode."""
+        return self.express_sample_us if self._mode == "express" else self.standard_sample_us
+
+    @property
+    def samples_per_packet(self) -> int:
+        """Samples per unit on the wire: one node, or one 32-sample capsule in express."""
+        return SAMPLES_PER_CAPSULE if self._mode == "express" else 1
+
+    def samples_per_revolution(self, rate_hz: float) -> int:
+        """How many samples one revolution holds at this rotation rate."""
+        return max(1, round(1e6 / (self.sample_us * rate_hz)))
+
+    def set_motor(self, on: bool) -> None:
+        """The motor line changed (DTR on the A1's adapter): True runs the motor."""
+        self.motor_on = bool(on)
+
+    def set_health(self, status: int, error_code: int = 0, *, persists: bool = False) -> None:
+        """Inject a health state; HEALTH_ERROR is Protection Stop (scans refused)."""
+        self.health_status, self.health_error, self.fault_persists = status, error_code, persists
+        if status == HEALTH_ERROR:
+            self._leave_scan()
+
+    # -- bytes from the host -------------------------------------------------
+
+    def receive(self, data: bytes) -> bytes:
+        """Feed bytes from the host; return the device's immediate replies.
+
+        Partial requests wait for more bytes; bytes before a 0xA5 are skipped;
+        payload requests with a wrong checksum are dropped whole, silently,
+        as is any request the device does not know. Any request other than
+        MOTOR_PWM ends a running scan (the protocol lets any request interrupt
+        one): the front end should drop revolution bytes it has not sent yet
+        when ``session`` changes.
+        """
+        if self.rebooting:
+            self.counters["ignored_rebooting"] += len(data)
+            return b""
+        self._rx += data
+        out = bytearray()
+        while (request := self._next_request()) is not None:
+            out += self._handle(*request)
+            if self.rebooting:  # RESET: whatever followed it dies with the core
+                self.counters["ignored_rebooting"] += len(self._rx)
+                self._rx.clear()
+                break
+        return bytes(out)
+
+    def drop_partial_request(self) -> None:
+        """Abandon an incomplete request (the front end saw the line go quiet)."""
+        if self._rx:
+            self.counters["truncated"] += 1
+            self._rx.clear()
+
+    def finish_reset(self) -> bytes:
+        """End the reboot started by RESET; returns the banner the device prints."""
+        self.rebooting = False
+        return self.reset_banner
+
+    def _next_request(self) -> tuple[int, bytes] | None:
+        rx = self._rx
+        while rx:
+            if rx[0] != SYNC:
+                skip = rx.find(SYNC)
+                skip = len(rx) if skip < 0 else skip
+                del rx[:skip]
+                self.counters["garbage_bytes"] += skip
+                continue
+            if len(rx) < 2:
+                return None
+            cmd = rx[1]
+            if cmd == SYNC:  # no command is 0xA5: the first sync byte was noise
+                del rx[:1]
+                self.counters["garbage_bytes"] += 1
+                continue
+            if not cmd & CMD_HAS_PAYLOAD:
+                del rx[:2]
+                return cmd, b""
+            if len(rx) < 3 or len(rx) < 4 + rx[2]:
+                return None
+            packet = bytes(rx[: 4 + rx[2]])
+            del rx[: len(packet)]
+            if _xor_all(packet[:-1]) != packet[-1]:
+                self.counters["bad_checksum"] += 1
+                continue
+            return cmd, packet[3:-1]
+        return None
+
+    def _handle(self, cmd: int, payload: bytes) -> bytes:
+        handler = self._handlers.get(cmd)
+        if handler is None:
+            self.counters["unknown_command"] += 1
+            return b""
+        self.counters["requests"] += 1
+        if cmd != CMD_SET_MOTOR_PWM:
+            self._leave_scan()
+        return handler(payload)
+
+    def _leave_scan(self) -> None:
+        if self._mode != "idle":
+            self._mode = "idle"
+            self._forced = False
+            self.session += 1
+
+    def _start_scan(self, mode: str, *, forced: bool = False) -> None:
+        self._mode = mode
+        self._forced = forced
+        self._express_pending = []
+        self._express_restart = True
+        self.session += 1
+
+    # -- request handlers ------------------------------------------------------
+
+    def _on_stop(self, payload: bytes) -> bytes:
+        return b""
+
+    def _on_reset(self, payload: bytes) -> bytes:
+        self.rebooting = True
+        if self.health_status == HEALTH_ERROR and not self.fault_persists:
+            self.health_status, self.health_error = HEALTH_OK, 0
+        return b""
+
+    def _scan_refused(self) -> bool:
+        if self.health_status == HEALTH_ERROR:
+            self.counters["refused_scan"] += 1
+            return True
+        return False
+
+    def _on_scan(self, payload: bytes, *, forced: bool = False) -> bytes:
+        if self._scan_refused():
+            return b""
+        self._start_scan("scan", forced=forced)
+        return encode_descriptor(NODE_LEN, SEND_MULTIPLE, ANS_MEASUREMENT)
+
+    def _on_force_scan(self, payload: bytes) -> bytes:
+        return self._on_scan(payload, forced=True)
+
+    def _on_express_scan(self, payload: bytes) -> bytes:
+        if len(payload) != 5:
+            self.counters["bad_payload"] += 1
+            return b""
+        working_mode = payload[0]
+        legacy = working_mode == 0 or (
+            working_mode < len(self.scan_modes)
+            and self.scan_modes[working_mode].ans_type == ANS_CAPSULED
+        )
+        if not legacy:
+            self.counters["unsupported_mode"] += 1
+            return b""
+        if self._scan_refused():
+            return b""
+        self._start_scan("express")
+        return encode_descriptor(CAPSULE_LEN, SEND_MULTIPLE, ANS_CAPSULED)
+
+    def _on_get_info(self, payload: bytes) -> bytes:
+        major, minor = self.firmware
+        body = struct.pack("<BBBB", self.model, minor, major, self.hardware) + self.serial_number
+        return encode_descriptor(len(body), SEND_SINGLE, ANS_DEVINFO) + body
+
+    def _on_get_health(self, payload: bytes) -> bytes:
+        body = struct.pack("<BH", self.health_status, self.health_error)
+        return encode_descriptor(len(body), SEND_SINGLE, ANS_HEALTH) + body
+
+    def _on_get_samplerate(self, payload: bytes) -> bytes:
+        body = struct.pack("<HH", self.standard_sample_us, self.express_sample_us)
+        return encode_descriptor(len(body), SEND_SINGLE, ANS_SAMPLERATE) + body
+
+    def _on_get_lidar_conf(self, payload: bytes) -> bytes:
+        if len(payload) < 4:
+            self.counters["bad_payload"] += 1
+            return b""
+        conf_type = struct.unpack_from("<I", payload)[0]
+        mode_id = struct.unpack_from("<H", payload, 4)[0] if len(payload) >= 6 else 0
+        data = self._conf_value(conf_type, mode_id)
+        if data is None:
+            self.counters["unknown_conf"] += 1
+            return b""
+        body = struct.pack("<I", conf_type) + data
+        return encode_descriptor(len(body), SEND_SINGLE, ANS_GET_LIDAR_CONF) + body
+
+    def _conf_value(self, conf_type: int, mode_id: int) -> bytes | None:
+        if conf_type == CONF_SCAN_MODE_COUNT:
+            return struct.pack("<H", len(self.scan_modes))
+        if conf_type == CONF_SCAN_MODE_TYPICAL:
+            return struct.pack("<H", self.typical_mode)
+        per_mode = {
+            CONF_SCAN_MODE_US_PER_SAMPLE: lambda m: struct.pack("<I", round(m.us_per_sample * 256)),
+            CONF_SCAN_MODE_MAX_DISTANCE: lambda m: struct.pack("<I", round(m.max_distance_m * 256)),
+            CONF_SCAN_MODE_ANS_TYPE: lambda m: bytes((m.ans_type,)),
+            CONF_SCAN_MODE_NAME: lambda m: m.name.encode("ascii") + b"\x00",
+        }
+        if conf_type not in per_mode or mode_id >= len(self.scan_modes):
+            return None
+        return per_mode[conf_type](self.scan_modes[mode_id])
+
+    def _on_motor_pwm(self, payload: bytes) -> bytes:
+        if len(payload) != 2:
+            self.counters["bad_payload"] += 1
+            return b""
+        self.pwm = struct.unpack("<H", payload)[0]
+        if self.pwm_controls_motor:
+            self.motor_on = self.pwm > 0
+        return b""
+
+    def _on_acc_board_flag(self, payload: bytes) -> bytes:
+        body = struct.pack("<I", 0)  # no accessory board: motor speed is not PWM-controlled
+        return encode_descriptor(len(body), SEND_SINGLE, ANS_ACC_BOARD_FLAG) + body
+
+    # -- revolutions out -------------------------------------------------------
+
+    def encode_revolution(self, samples: Sequence[Sample]) -> bytes:
+        """The bytes the device streams for one revolution in the current mode.
+
+        Empty when idle, rebooting, or when the motor is off (except after
+        FORCE_SCAN). Express capsules need the next capsule's start angle,
+        and a revolution is rarely a multiple of 32 samples, so samples not
+        yet in a complete capsule wait for the next call.
+        """
+        if self.rebooting or self._mode == "idle":
+            return b""
+        if not self.motor_on and not self._forced:
+            self._express_pending = []
+            self._express_restart = True  # rotation unstable: the next capsule restarts
+            return b""
+        if self._mode == "scan":
+            return encode_standard(samples)
+        return self._encode_express(samples)
+
+    def _encode_express(self, samples: Sequence[Sample]) -> bytes:
+        pending = self._express_pending
+        pending.extend(samples)
+        out = bytearray()
+        while len(pending) > SAMPLES_PER_CAPSULE:
+            chunk = pending[:SAMPLES_PER_CAPSULE]
+            next_start = pending[SAMPLES_PER_CAPSULE].angle_deg
+            out += encode_capsule(chunk, next_start, start_flag=self._express_restart)
+            self._express_restart = False
+            del pending[:SAMPLES_PER_CAPSULE]
+        return bytes(out)
