@@ -136,7 +136,8 @@ def run(
     the reason and ``not_started`` set, not an exception.
     """
     threshold = effective_threshold(scenario, settings)
-    link = create_link(link_name, replace(options, threshold=threshold))
+    rate = scenario.lidar_spec.rate_hz
+    link = create_link(link_name, replace(options, threshold=threshold, scan_rate_hz=rate))
     try:
         link.open()
         return run_scenario(scenario, link, settings)

@@ -34,6 +34,8 @@ class LinkOptions:
     status_topic: str = "/lidar_status"
     warning_topic: str = "/obstacle_warning"
     realtime: bool = False
+    port: str | None = None  # serial links: a real adapter wired to a board (None: virtual board)
+    scan_rate_hz: float = 10.0  # the scenario's LIDAR rate (the runner fills it in)
 
 
 class Link(ABC):

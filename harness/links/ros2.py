@@ -282,6 +282,8 @@ class Ros2Link(Link):
         """Split what arrived into this scan's answers and late ones; learn the Bool order."""
         first_status = next((h for h in heard if h.kind == "status" and mine(h)), None)
         for h in heard:
+            if h.kind == "scan":
+                continue  # a driver's scan (serial links): not an answer
             item = Received(h.value, h.arrived - self._sent_at)
             if not mine(h):
                 answers.late.append(Received(h.value, item.after, self._tick_of(h.source_ns)))
@@ -312,6 +314,7 @@ class Ros2Link(Link):
         late = [
             Received(h.value, h.arrived - self._sent_at, self._tick_of(h.source_ns))
             for h in self.observer.inbox
+            if h.kind != "scan"
         ]
         self.observer.inbox.clear()
         return late

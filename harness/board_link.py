@@ -1,0 +1,197 @@
+"""Links through a LIDAR on a serial line: the harness plays the device.
+
+Virtual board (default): a pty pair stands in for the USB cable; the board's
+own LIDAR driver node (bundled from node/fossbot_lidar_driver) reads the
+emulated device and publishes /scan, and the node under test answers it,
+each in its own process. Physical board (``--port``): the emulator drives a
+real USB-UART wired to the board's LIDAR input in real time, and the
+harness joins the board's ROS 2 graph to watch what it publishes.
+
+Either way the lockstep machinery of the ros2 link is reused; only the
+delivery differs: a scan becomes device samples, goes down the line, and the
+driver's /scan for that revolution (quantised and re-binned) is what the
+oracle judges, because it is what the node saw.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+import time
+from dataclasses import replace
+from typing import Any, ClassVar
+
+from harness.answers import Answers
+from harness.devices.profiles import DeviceProfile
+from harness.errors import ConfigError, LinkError
+from harness.links.base import LinkOptions
+from harness.links.ros2 import CATCH_UP_S, POLL_S, Ros2Link
+from harness.node_process import NodeCommand, NodeProcess, ros_arguments
+from harness.ros.observer import Observer
+from harness.scan import Scan
+
+DRIVER_READY_S = 10.0  # the driver connects to the device (info, health, scan request)
+
+
+class BoardLink(Ros2Link):
+    """A LIDAR device emulated on a serial line, read by the board's own driver."""
+
+    profile: ClassVar[DeviceProfile]
+
+    def __init__(self, options: LinkOptions) -> None:
+        physical = options.port is not None
+        if physical and (options.node or options.package):
+            raise ConfigError(
+                "--port drives a physical board, which runs its own nodes: drop --node/--package"
+            )
+        if physical and options.domain_id is None:
+            # Joining a board's graph: its domain, not a reserved private one.
+            env_id = os.environ.get("ROS_DOMAIN_ID", "0")
+            options = replace(options, domain_id=int(env_id) if env_id.isdigit() else 0)
+        super().__init__(options)
+        self.physical = physical
+        self.device = self.profile.make_device(options.scan_rate_hz)
+        self.port: Any = None
+        self.server: Any = None
+        self.driver: NodeProcess | None = None
+        self._seen: Scan | None = None
+        self._delivery_problem: str | None = None
+
+    # -- processes and ports ----------------------------------------------
+    def _start_processes(self, env: dict[str, str]) -> None:
+        from harness.serial_line.ports import PtyPort, SerialPort
+        from harness.serial_line.server import DeviceServer
+
+        opts = self.options
+        if self.physical:
+            assert opts.port is not None
+            self.port = SerialPort(opts.port, self.profile.baudrate)
+        else:
+            self.port = PtyPort()
+        mode = "realtime" if (opts.realtime or self.physical) else "lockstep"
+        self.server = DeviceServer(
+            self.device,
+            self.port,
+            mode=mode,
+            baudrate=self.profile.baudrate,
+            revolution_period_s=1.0 / opts.scan_rate_hz,
+            next_start="replace",  # no driver ever sees an extra, marker-only revolution
+        ).start()
+        if self.physical:
+            return  # the board runs its own driver and nodes
+        # In lockstep the line is quiet while the harness waits for the node
+        # (bounded: the deadline, then the catch-up wait); a real device never
+        # pauses, so the driver's read timeout must outlast those waits.
+        longest_wait = opts.scan_timeout + max(CATCH_UP_S, 3 * opts.scan_timeout)
+        read_timeout = 1.0 if opts.realtime else longest_wait + 2.0
+        driver_args = ros_arguments(
+            (
+                f"port:={self.port.slave_path}",
+                f"scan_topic:={opts.scan_topic}",
+                f"timeout:={read_timeout!r}",
+            ),
+            use_sim_time=False,
+        )
+        self.driver = NodeProcess(
+            NodeCommand(
+                (sys.executable, "-m", self.profile.driver_module),
+                description=f"board driver {self.profile.driver_module}",
+            ),
+            driver_args,
+            env,
+        )
+        self.driver.start()
+        super()._start_processes(env)
+
+    def _make_observer(self, domain_id: int) -> Observer:
+        opts = self.options
+        return Observer(
+            domain_id,
+            scan_topic=opts.scan_topic,
+            status_topic=opts.status_topic,
+            warning_topic=opts.warning_topic,
+            network=opts.ros_network,
+            publish_scans=False,
+        )
+
+    def _ready(self) -> bool:
+        assert self.observer is not None and self.server is not None
+        if not self.profile.streams_unasked and self.device.mode == "idle":
+            return False  # the driver has not asked for a scan yet
+        return self.observer.ready()
+
+    def _check_processes(self, when: str) -> None:
+        if self.server is not None and self.server.error is not None:
+            raise LinkError(f"{self.profile.name} line: {self.server.error}")
+        if self.driver is not None and self.driver.returncode() is not None:
+            raise LinkError(f"the board's LIDAR driver {self.driver.exit_summary(when)}")
+        if not self.physical:
+            super()._check_processes(when)
+
+    def _node_gone(self) -> str | None:
+        if self.driver is not None and self.driver.returncode() is not None:
+            return f"the board's LIDAR driver {self.driver.exit_summary()}"
+        if self.server is not None and self.server.error is not None:
+            return f"{self.profile.name} line: {self.server.error}"
+        return None if self.physical else super()._node_gone()
+
+    # -- delivery ---------------------------------------------------------
+    def _deliver(self, scan: Scan, tick: int) -> int:
+        """Send the revolution down the line; wait (bounded) for the driver's /scan of it."""
+        from harness.devices.revolution import samples_from_scan
+
+        assert self.observer is not None and self.server is not None
+        obs = self.observer
+        obs.publish_clock(scan.stamp)
+        rate = 1.0 / scan.scan_time if scan.scan_time > 0 else self.options.scan_rate_hz
+        samples = samples_from_scan(
+            scan,
+            samples_per_rev=self.profile.samples_per_rev(self.device, rate),
+            max_range_m=scan.range_max,
+        )
+        pushed = time.time_ns()
+        self.server.send_revolution(samples, tick)
+        self._seen, self._delivery_problem = None, None
+
+        def driver_scan() -> Any:
+            return next((h for h in obs.inbox if h.kind == "scan" and h.source_ns >= pushed), None)
+
+        deadline = time.perf_counter() + max(self.options.scan_timeout, 1.0 / rate)
+        while (heard := driver_scan()) is None:
+            gone = self._node_gone()
+            if gone or time.perf_counter() >= deadline:
+                self._delivery_problem = gone or (
+                    f"the board's driver published no {self.options.scan_topic} for this "
+                    "revolution in time"
+                )
+                return time.time_ns()
+            obs.spin(min(POLL_S, deadline - time.perf_counter()))
+        obs.inbox.remove(heard)
+        self._seen = heard.value
+        return heard.source_ns
+
+    def collect(self, scan: Scan, tick: int) -> Answers:
+        answers = super().collect(scan, tick)
+        answers.seen = self._seen
+        if self._delivery_problem and answers.problem is None:
+            answers.problem = self._delivery_problem
+        return answers
+
+    # -- reporting and teardown ---------------------------------------------
+    def diagnostics(self) -> str:
+        parts = [super().diagnostics()] if not self.physical else []
+        if self.driver is not None:
+            for which in ("stderr", "stdout"):
+                tail = self.driver.tail(which)
+                if tail:
+                    parts.append(f"board driver {which} (last lines):\n{tail}")
+        return "\n".join(p for p in parts if p)
+
+    def close(self) -> None:
+        if self.server is not None:
+            self.server.close()
+        super().close()
+        if self.driver is not None:
+            self.driver.stop()
+        if self.port is not None:
+            self.port.close()

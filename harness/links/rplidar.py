@@ -1,0 +1,14 @@
+"""The rplidar link: the harness plays the FOSSBot v2's RPLIDAR A1M8 (115200 baud)."""
+
+from __future__ import annotations
+
+from harness.board_link import BoardLink
+from harness.devices.profiles import PROFILES
+from harness.links.base import register
+
+
+@register("rplidar")
+class RplidarLink(BoardLink):
+    """An emulated A1M8 read by the board's rplidar-package driver."""
+
+    profile = PROFILES["rplidar"]
