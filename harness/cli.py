@@ -78,6 +78,22 @@ def build_parser() -> argparse.ArgumentParser:
     commands = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
 
     commands.add_parser("list", help="list the shipped scenarios")
+    commands.add_parser("ports", help="list serial adapters (for --port)")
+
+    emulate = commands.add_parser(
+        "emulate", help="serve a scenario's scans as a LIDAR device on a serial port"
+    )
+    emulate.add_argument("device", choices=["rplidar", "ldlidar"])
+    emulate.add_argument(
+        "--scenario", required=True, metavar="NAME", help="shipped scenario name or scenario file"
+    )
+    emulate.add_argument(
+        "--port",
+        metavar="DEV",
+        help="serial port to serve on (default: a new pty; its path is printed)",
+    )
+    emulate.add_argument("--seed", type=_seed, help="override the scenario's seed")
+    emulate.add_argument("--faults", metavar="NAME[,NAME]", help="fault profiles to apply")
 
     run = commands.add_parser("run", help="run scenarios and judge the node's answers")
     run.add_argument(
@@ -161,6 +177,14 @@ def build_parser() -> argparse.ArgumentParser:
         help="send scans at the sensor's rate instead of lockstep",
     )
 
+    serial = run.add_argument_group("serial links (rplidar, ldlidar)")
+    serial.add_argument(
+        "--port",
+        metavar="DEV",
+        help="drive a physical board through this USB-UART, in real time "
+        "(default: a virtual board on a pty)",
+    )
+
     inprocess = run.add_argument_group("inprocess link")
     inprocess.add_argument(
         "--processor",
@@ -196,13 +220,18 @@ def _link_options(args: argparse.Namespace) -> LinkOptions:
         domain_id=args.domain_id,
         ros_network=args.ros_network,
         realtime=args.realtime,
+        port=args.port,
     )
+
+
+def _fault_list(text: str | None) -> list[str] | None:
+    return [f.strip() for f in text.split(",") if f.strip()] if text else None
 
 
 def _run_one(scenario: Scenario, args: argparse.Namespace) -> RunResult:
     from harness.runner import RunSettings, run
 
-    faults = [f.strip() for f in args.faults.split(",") if f.strip()] if args.faults else None
+    faults = _fault_list(args.faults)
     settings = RunSettings(
         seed=args.seed,
         threshold=args.threshold,
@@ -235,6 +264,8 @@ NODE_OPTIONS = ("node", "package", "executable", "workspace")
 
 def _check_link_options(args: argparse.Namespace) -> None:
     """Options that the chosen link would silently ignore are mistakes."""
+    if args.port and args.link not in ("rplidar", "ldlidar"):
+        raise ConfigError(f"--port needs --link rplidar or ldlidar, not {args.link}")
     if args.processor and args.link != "inprocess":
         raise ConfigError(f"--processor needs --link inprocess (the {args.link} link runs a node)")
     if args.link == "inprocess":
@@ -275,7 +306,43 @@ def cmd_run(args: argparse.Namespace, console: Console) -> int:
     return EXIT_OK if all(r.ok for r in results) else EXIT_FAILED
 
 
-COMMANDS = {"list": cmd_list, "run": cmd_run}
+def cmd_ports(args: argparse.Namespace, console: Console) -> int:
+    from harness.serial_line.ports import list_serial_ports
+
+    ports = list_serial_ports()
+    for port in ports:
+        console.print(port.line(), markup=False)
+    if not ports:
+        console.print("no serial adapters found (plug in the USB-UART, then try again)")
+    return EXIT_OK
+
+
+def cmd_emulate(args: argparse.Namespace, console: Console) -> int:
+    from harness.devices.profiles import profile
+    from harness.emulate import emulate
+    from harness.runner import RunSettings
+
+    scenario = resolve_scenario(args.scenario)
+    settings = RunSettings(seed=args.seed, faults=_fault_list(args.faults))
+    summary = emulate(
+        profile(args.device),
+        scenario,
+        port=args.port,
+        settings=settings,
+        announce=lambda line: print(line, flush=True),
+    )
+    rate = summary.mean_rate_error_pct
+    console.print(
+        f"served {summary.revolutions_streamed} of {summary.revolutions} revolutions "
+        f"({summary.bytes_written} bytes"
+        + (f", line rate error {rate:+.2f} %" if rate is not None else "")
+        + ")",
+        markup=False,
+    )
+    return EXIT_OK
+
+
+COMMANDS = {"list": cmd_list, "run": cmd_run, "ports": cmd_ports, "emulate": cmd_emulate}
 
 
 def _interrupt_on_sigterm() -> None:

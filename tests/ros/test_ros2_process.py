@@ -170,7 +170,9 @@ def test_unknown_package_and_executable_in_workspace(workspace: Path) -> None:
         text=True,
         timeout=60,
     )
-    assert done.returncode == 2 and "packages: fossbot_lidar_processing" in done.stderr
+    assert done.returncode == 2 and "packages: fossbot_lidar_driver, fossbot_lidar_processing" in (
+        done.stderr
+    )
     done = subprocess.run(
         [*base, "--package", "fossbot_lidar_processing", "--executable", "x"],
         capture_output=True,

@@ -1,0 +1,16 @@
+"""ament_flake8 over the package, as `ros2 pkg create` generates it."""
+
+import pytest
+
+main_with_errors = pytest.importorskip(
+    'ament_flake8.main', reason='ament_flake8 is not installed'
+).main_with_errors
+pytest.importorskip('flake8', reason='flake8 is not installed (ament_flake8 runs it)')
+
+
+@pytest.mark.flake8
+@pytest.mark.linter
+def test_flake8():
+    """The code follows the ROS 2 flake8 configuration."""
+    rc, errors = main_with_errors(argv=[])
+    assert rc == 0, f'Found {len(errors)} code style errors / warnings:\n' + '\n'.join(errors)

@@ -1,0 +1,184 @@
+"""Fixtures for the LIDAR driver tests: the package on sys.path, ptys, driver processes, /scan.
+
+The driver package lives in node/fossbot_lidar_driver (an ament_python
+package, not part of the harness distribution), so its folder is put on
+sys.path here and on PYTHONPATH for the driver processes. Nothing imports
+rclpy at module level: the pure tests run without the ROS 2 wheels.
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import time
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from harness.ros_domain import reserve_domain
+
+REPO = Path(__file__).resolve().parents[2]
+PACKAGE_DIR = REPO / "node" / "fossbot_lidar_driver"
+sys.path.insert(0, str(PACKAGE_DIR))
+
+from driver_wire import Pty  # noqa: E402
+
+MATCH_TIMEOUT = 15.0  # process start (~0.4 s) + discovery (~0.2 s), with room for a slow CI
+SCAN_TIMEOUT = 10.0
+STOP_TIMEOUT = 5.0
+
+
+@pytest.fixture
+def pty() -> Iterator[Pty]:
+    """A fresh pseudo-terminal, closed at teardown."""
+    terminal = Pty.open()
+    try:
+        yield terminal
+    finally:
+        terminal.close()
+
+
+@pytest.fixture
+def ros_domain(monkeypatch: pytest.MonkeyPatch) -> Iterator[int]:
+    """A domain id of this test's own, exported (localhost only) before any rclpy.init."""
+    reservation = reserve_domain()
+    monkeypatch.setenv("ROS_DOMAIN_ID", str(reservation.domain_id))
+    monkeypatch.setenv("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
+    monkeypatch.delenv("ROS_LOCALHOST_ONLY", raising=False)
+    monkeypatch.delenv("ROS_STATIC_PEERS", raising=False)
+    try:
+        yield reservation.domain_id
+    finally:
+        reservation.release()
+
+
+@dataclass
+class DriverProcess:
+    """A driver running as a real child process."""
+
+    popen: subprocess.Popen[bytes]
+    stderr_path: Path
+
+    def stderr(self) -> str:
+        """Everything the driver logged so far (rclpy logs go to stderr)."""
+        return self.stderr_path.read_text(errors="replace")
+
+    def check_alive(self) -> None:
+        """Fail at once, with the driver's stderr, if it has exited."""
+        code = self.popen.poll()
+        if code is not None:
+            pytest.fail(f"driver exited early with code {code}; stderr:\n{self.stderr()}")
+
+    def wait(self, timeout: float = STOP_TIMEOUT) -> int:
+        """Wait (bounded) for the driver to exit; return its exit code."""
+        try:
+            return self.popen.wait(timeout=timeout)
+        except subprocess.TimeoutExpired:
+            pytest.fail(f"driver still running {timeout} s later; stderr:\n{self.stderr()}")
+
+    def stop(self, sig: signal.Signals = signal.SIGTERM) -> int:
+        """Send ``sig``; return the exit code."""
+        self.popen.send_signal(sig)
+        return self.wait()
+
+
+@pytest.fixture
+def start_driver(ros_domain: int, tmp_path: Path) -> Iterator[Callable[..., DriverProcess]]:
+    """Start ``python -m fossbot_lidar_driver.<module> --ros-args ...`` on this test's domain."""
+    pytest.importorskip("rclpy", reason="rclpy (ROS 2 Jazzy wheels) not installed")
+    pytest.importorskip("serial", reason="pyserial not installed (pip install pyserial)")
+    started: list[DriverProcess] = []
+
+    def start(
+        module: str,
+        *ros_args: str,
+        command: list[str] | None = None,
+        package_path: Path = PACKAGE_DIR,
+        extra_env: dict[str, str] | None = None,
+    ) -> DriverProcess:
+        err = tmp_path / f"driver{len(started)}.err"
+        argv = command or [sys.executable, "-m", f"fossbot_lidar_driver.{module}"]
+        if ros_args:
+            argv = [*argv, "--ros-args", *ros_args]
+        pythonpath = os.pathsep.join(
+            p for p in (str(package_path), os.environ.get("PYTHONPATH")) if p
+        )
+        env = {
+            **os.environ,
+            "PYTHONUNBUFFERED": "1",
+            "PYTHONPATH": pythonpath,
+            **(extra_env or {}),
+        }
+        with err.open("wb") as stderr:
+            popen = subprocess.Popen(argv, env=env, stdout=subprocess.DEVNULL, stderr=stderr)
+        process = DriverProcess(popen, err)
+        started.append(process)
+        return process
+
+    try:
+        yield start
+    finally:
+        for process in started:
+            if process.popen.poll() is None:
+                process.popen.kill()
+                process.popen.wait(timeout=STOP_TIMEOUT)
+
+
+@dataclass
+class ScanProbe:
+    """The test side of the graph: a /scan subscription in a Context of its own."""
+
+    node: Any
+    executor: Any
+    subscription: Any
+    scans: list[Any] = field(default_factory=list)
+
+    def wait_scans(self, count: int, process: DriverProcess, timeout: float = SCAN_TIMEOUT):
+        """Spin until ``count`` scans arrived; fail (with the driver's log) after ``timeout``."""
+        deadline = time.monotonic() + timeout
+        while len(self.scans) < count:
+            if time.monotonic() > deadline:
+                pytest.fail(
+                    f"{len(self.scans)} of {count} scans after {timeout} s; "
+                    f"driver stderr:\n{process.stderr()}"
+                )
+            process.check_alive()
+            self.executor.spin_once(timeout_sec=0.05)
+        return self.scans[:count]
+
+
+@pytest.fixture
+def scan_probe(ros_domain: int) -> Iterator[Callable[..., ScanProbe]]:
+    """A factory of /scan subscribers (reliable, keep-last 10) on this test's domain."""
+    rclpy = pytest.importorskip("rclpy", reason="rclpy (ROS 2 Jazzy wheels) not installed")
+    from rclpy.executors import SingleThreadedExecutor
+    from sensor_msgs.msg import LaserScan
+
+    # A Context of our own keeps rclpy's signal handlers out of pytest.
+    context = rclpy.Context()
+    rclpy.init(context=context, domain_id=ros_domain)
+    executor = SingleThreadedExecutor(context=context)
+    nodes: list[Any] = []
+
+    def probe(topic: str = "/scan") -> ScanProbe:
+        node = rclpy.create_node(f"driver_test_probe_{len(nodes)}", context=context)
+        nodes.append(node)
+        executor.add_node(node)
+        result = ScanProbe(node, executor, None)
+        result.subscription = node.create_subscription(LaserScan, topic, result.scans.append, 10)
+        return result
+
+    try:
+        yield probe
+    finally:
+        for node in nodes:
+            executor.remove_node(node)
+            node.destroy_node()
+        executor.shutdown(timeout_sec=1.0)
+        rclpy.try_shutdown(context=context)
+        context.destroy()

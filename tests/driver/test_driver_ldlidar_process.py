@@ -1,0 +1,91 @@
+"""ldlidar_node as a real process on a real pty, fed hand-made LD06/LD19 packets."""
+
+from __future__ import annotations
+
+import math
+import signal
+import time
+
+import numpy as np
+import pytest
+from driver_wire import BURST_PERIOD, POINTS_PER_TURN, LdStreamer, burst, point
+
+pytestmark = [pytest.mark.ros, pytest.mark.timeout(60)]
+
+MODULE = "ldlidar_node"
+
+
+def expected_ranges() -> np.ndarray:
+    """Bin k holds the point at clockwise 0.8 * m degrees with m = (450 - k) % 450."""
+    ranges = np.empty(POINTS_PER_TURN, dtype=np.float32)
+    for k in range(POINTS_PER_TURN):
+        distance, intensity = point((POINTS_PER_TURN - k) % POINTS_PER_TURN)
+        ranges[k] = math.nan if distance == 0 and intensity == 0 else distance / 1000.0
+    return ranges
+
+
+def assert_clean(stderr: str) -> None:
+    assert "Traceback" not in stderr, stderr
+
+
+def test_scans_follow_the_vendor_conventions_on_450_bins(pty, start_driver, scan_probe) -> None:
+    """Every turn is one scan: 450 CCW bins, NaN for no return, other readings as sent."""
+    LdStreamer(pty, burst, BURST_PERIOD).start()
+    driver = start_driver(MODULE, "-p", f"port:={pty.name}")
+    scans = scan_probe().wait_scans(3, driver)
+    increment = 2 * math.pi / POINTS_PER_TURN
+    expected = expected_ranges()
+    assert np.isnan(expected).sum() == 9 and (expected == 0.0).sum() == 9
+    for scan in scans:
+        assert scan.header.frame_id == "lidar_scan_frame"
+        assert scan.angle_min == 0.0
+        assert scan.angle_increment == pytest.approx(increment, rel=1e-6)
+        assert scan.angle_max == pytest.approx(2 * math.pi - increment, rel=1e-6)
+        assert (scan.range_min, scan.range_max) == (pytest.approx(0.02), pytest.approx(25.0))
+        np.testing.assert_array_equal(np.frombuffer(scan.ranges, np.float32), expected)
+        assert 0.02 < scan.scan_time < 1.0
+        assert scan.time_increment == pytest.approx(scan.scan_time / POINTS_PER_TURN, rel=1e-5)
+    assert driver.stop() == 0
+
+
+def test_sigterm_exits_0(pty, start_driver, scan_probe) -> None:
+    """SIGTERM while streaming: exit 0, no traceback."""
+    LdStreamer(pty, burst, BURST_PERIOD).start()
+    driver = start_driver(MODULE, "-p", f"port:={pty.name}")
+    scan_probe().wait_scans(1, driver)
+    assert driver.stop(signal.SIGTERM) == 0
+    assert_clean(driver.stderr())
+
+
+def test_port_that_cannot_be_opened_exits_2_with_one_line(start_driver) -> None:
+    """No such device: exit 2 and exactly one log line, naming the port."""
+    driver = start_driver(MODULE, "-p", "port:=/dev/fossbot-hil-no-such-tty")
+    assert driver.wait() == 2
+    lines = [line for line in driver.stderr().splitlines() if line.strip()]
+    assert len(lines) == 1, lines
+    assert "cannot open /dev/fossbot-hil-no-such-tty" in lines[0]
+
+
+def test_port_vanishing_mid_run_exits_1_promptly(pty, start_driver, scan_probe) -> None:
+    """Closing the pty ends the driver within about a second, exit 1."""
+    LdStreamer(pty, burst, BURST_PERIOD).start()
+    driver = start_driver(MODULE, "-p", f"port:={pty.name}", "-p", "timeout:=5.0")
+    scan_probe().wait_scans(1, driver)
+    pty.close()
+    started = time.monotonic()
+    assert driver.wait() == 1
+    assert time.monotonic() - started < 2.0
+    assert "[ERROR]" in driver.stderr() and pty.name in driver.stderr()
+    assert_clean(driver.stderr())
+
+
+def test_noise_without_packets_exits_1_after_the_timeout(pty, start_driver) -> None:
+    """Bytes that never make a valid packet count as silence: exit 1 after `timeout`."""
+    noise = bytes([0x54, 0x2C]) + bytes(range(60))
+    LdStreamer(pty, lambda number: noise, 0.02).start()
+    driver = start_driver(MODULE, "-p", f"port:={pty.name}", "-p", "timeout:=0.5")
+    assert driver.wait() == 1
+    stderr = driver.stderr()
+    assert "no valid packet for 0.5 s" in stderr
+    assert "0 CRC errors" not in stderr
+    assert_clean(stderr)
