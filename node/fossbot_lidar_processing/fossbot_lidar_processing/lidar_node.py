@@ -24,6 +24,7 @@ from rclpy.logging import LoggingSeverity
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.qos import QoSPresetProfiles, QoSProfile
+from rclpy.signals import SignalHandlerOptions
 from sensor_msgs.msg import LaserScan
 from std_msgs.msg import Bool, String
 
@@ -33,6 +34,7 @@ __all__ = ['EXIT_CONFIG_ERROR', 'EXIT_OK', 'ConfigError', 'LidarProcessingNode',
 
 NODE_NAME = 'fossbot_lidar_node'
 EXIT_OK = 0
+SPIN_STEP_S = 0.1  # longest a stop request waits to be noticed
 EXIT_CONFIG_ERROR = 2
 
 # Reliable, keep-last 10: what `create_subscription(LaserScan, topic, cb, 10)`
@@ -148,37 +150,26 @@ def main(args: list[str] | None = None) -> int:
     0 after a clean shutdown, 2 when a parameter is unusable (the reason is
     logged as one FATAL line, with no traceback).
     """
-    # Jazzy's rclpy.init installs SIGINT and SIGTERM handlers that shut the
-    # context down (asynchronously), which wakes the executor: spin then
-    # raises ExternalShutdownException. rclpy chains to the handlers found
-    # at init, so these Python ones run too. They only note that a stop was
-    # asked for: raising KeyboardInterrupt at an arbitrary point inside the
-    # executor can break rclpy mid-call, which is what Python's default
-    # SIGINT handler would do. Before init there is no executor to wake, so
-    # there they do raise KeyboardInterrupt.
-    initialised = False
+    # rclpy's own signal handlers are off: they shut the context down from
+    # under the executor, which surfaces as assorted exceptions and, in a
+    # narrow window, a spin that never wakes. Ours only note the request;
+    # the executor is spun in bounded steps that look at the note.
     stopping = False
 
     def on_signal(signum: int, frame: object) -> None:
         nonlocal stopping
         stopping = True
-        if not initialised:
-            raise KeyboardInterrupt
 
     signal.signal(signal.SIGINT, on_signal)
     signal.signal(signal.SIGTERM, on_signal)
     node = None
     try:
-        rclpy.init(args=args)
-        initialised = True
-        # The executor first: made after a signal has shut the context down,
-        # its constructor fails half-way and rclpy prints a traceback when
-        # the half-made object is collected. Node construction is the slow
-        # part, so a signal during it finds the executor already made.
+        rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
         executor = SingleThreadedExecutor()
         node = LidarProcessingNode()
         executor.add_node(node)
-        executor.spin()
+        while not stopping and rclpy.ok():
+            executor.spin_once(timeout_sec=SPIN_STEP_S)
     except (
         ConfigError,
         InvalidParameterTypeException,
@@ -189,16 +180,6 @@ def main(args: list[str] | None = None) -> int:
         return EXIT_CONFIG_ERROR
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
-    except RuntimeError:
-        # The context shut down by a signal can also surface as RCLError
-        # ("the given context is not valid") from the wait set or a take,
-        # instead of ExternalShutdownException (see ros2/ros2cli#854). After
-        # a signal (or once the context is down) that is a clean exit;
-        # anything else is a real error. rclpy.ok() is called first: the
-        # call also lets a pending Python signal handler run.
-        context_down = initialised and not rclpy.ok()
-        if not (stopping or context_down):
-            raise
     finally:
         if node is not None:
             node.destroy_node()
