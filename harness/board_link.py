@@ -189,7 +189,10 @@ class BoardLink(Ros2Link):
 
     def close(self) -> None:
         if self.server is not None:
-            self.server.close()
+            try:
+                self.server.close()
+            except LinkError:
+                pass  # already reported by the exchange that met it
         super().close()
         if self.driver is not None:
             self.driver.stop()

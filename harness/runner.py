@@ -108,7 +108,11 @@ def run_scenario(
             scan = profile.emit(sim_tick.truth, sim.spec, rng, stamp=sim_tick.t)
             if sim_tick.tick == 0:
                 link.warm_up(scan)
-            answers = link.exchange(scan, sim_tick.tick)
+            try:
+                answers = link.exchange(scan, sim_tick.tick)
+            except LinkError as err:  # the line or graph broke: end here, keep what we have
+                result.error = f"t={sim_tick.t:.2f} s tick {sim_tick.tick}: {err}"
+                break
             if pending is not None:
                 answers.late = pending[2].take_late(answers.late, pending[0].tick)
                 judge(*pending)

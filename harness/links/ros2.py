@@ -238,7 +238,7 @@ class Ros2Link(Link):
         return None
 
     def collect(self, scan: Scan, tick: int) -> Answers:
-        assert self.observer is not None and self.process is not None
+        assert self.observer is not None
         obs = self.observer
         answers = Answers()
 

@@ -1,0 +1,80 @@
+"""Serial HIL end to end: the harness plays the LIDAR, the board's driver and nodes run.
+
+Virtual board: a pty for the USB cable, the bundled board driver and the
+node under test each in their own process, watched over real DDS.
+"""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+pytestmark = [pytest.mark.ros, pytest.mark.timeout(300)]
+
+STUDENT = Path(__file__).resolve().parents[1] / "ros" / "student_node.py"
+
+
+def fossbot_hil(*args: str, timeout: float = 240) -> subprocess.CompletedProcess[str]:
+    return subprocess.run(
+        [sys.executable, "-m", "harness.cli", *args],
+        capture_output=True,
+        text=True,
+        timeout=timeout,
+    )
+
+
+@pytest.mark.parametrize("link", ["rplidar", "ldlidar"])
+def test_every_shipped_scenario_through_the_virtual_board(link: str) -> None:
+    """`fossbot-hil run --link rplidar|ldlidar` passes the reference node on every scenario."""
+    done = fossbot_hil("run", "--link", link)
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert "7 of 7 scenarios passed" in done.stdout
+
+
+# Bugs the lab robot's driver lets the node see, and the phrase explaining each.
+VISIBLE = {
+    "angle_in_degrees": "looks like degrees",
+    "no_bool": "got no Bool",
+    "inverted_bool": "expected warning",
+    "threshold_hard_coded": "expected warning False",
+    "crash_when_nothing_in_range": "node exited with code",
+    "answers_twice": "answered twice",
+}
+
+
+@pytest.mark.parametrize(("variant", "phrase"), VISIBLE.items())
+def test_student_bugs_caught_through_the_board(variant: str, phrase: str) -> None:
+    """The same student nodes, now behind the board's own LIDAR driver."""
+    done = fossbot_hil(
+        "run", "--link", "rplidar", "--node", f"{sys.executable} {STUDENT} {variant}"
+    )
+    assert done.returncode == 1, done.stdout + done.stderr
+    assert " tick " in done.stdout or "exited" in done.stdout
+    assert phrase in done.stdout
+
+
+@pytest.mark.parametrize(
+    "variant", ["correct", "min_over_raw_ranges", "no_range_min_filter", "angle_without_angle_min"]
+)
+def test_what_the_lab_driver_hides_is_not_a_failure(variant: str) -> None:
+    """Through the lab robot's driver these nodes are right.
+
+    It publishes +inf for every empty bin, drops out-of-limit returns and
+    starts at angle 0, so raw min(), a missing range_min filter and a
+    missing angle_min give correct answers there (over ROS 2, with other
+    driver conventions, the default suite catches them).
+    """
+    done = fossbot_hil(
+        "run",
+        "approach_wall",
+        "out_of_range",
+        "reverse_to_wall",
+        "--link",
+        "rplidar",
+        "--node",
+        f"{sys.executable} {STUDENT} {variant}",
+    )
+    assert done.returncode == 0, done.stdout + done.stderr

@@ -1,0 +1,122 @@
+"""`fossbot-hil emulate` read by independent RPLIDAR clients over a real pty.
+
+The `rplidar` package (what FOSSBot code uses) and Adafruit's client must get
+device info, health and scans whose angles and distances match the
+simulated scans within the A1's quantisation (1/64 degree, 1/4 mm).
+"""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from collections.abc import Iterator
+
+import numpy as np
+import pytest
+from pty_clients import tolerate_missing_dtr_on_pty
+
+from harness.devices.profiles import profile
+from harness.devices.revolution import samples_from_scan
+from harness.runner import RunSettings, fault_profile
+from harness.scenario import resolve_scenario
+from harness.sim.simulation import Simulation
+
+pytestmark = pytest.mark.timeout(90)
+
+SCENARIO = "approach_wall"
+ANGLE_TOL_DEG = 1 / 64 + 1e-6
+DISTANCE_TOL_MM = 0.25 + 1e-6
+
+
+def simulated_revolutions() -> list[list[tuple[float, float]]]:
+    """What the emulator serves, tick by tick: (device angle, distance mm) with a return."""
+    scenario = resolve_scenario(SCENARIO)
+    spec = scenario.lidar_spec
+    device = profile("rplidar").make_device(spec.rate_hz)
+    faults = fault_profile(scenario, RunSettings())
+    rng = np.random.default_rng(scenario.seed)
+    revolutions = []
+    with Simulation(scenario) as sim:
+        for tick in sim.ticks():
+            scan = faults.emit(tick.truth, spec, rng, stamp=tick.t)
+            samples = samples_from_scan(
+                scan,
+                samples_per_rev=device.samples_per_revolution(spec.rate_hz),
+                max_range_m=spec.range_max,
+            )
+            revolutions.append([(s.angle_deg, s.distance_mm) for s in samples if s.distance_mm])
+    return revolutions
+
+
+def matches(client_scan: list[tuple[float, float]], expected: list[tuple[float, float]]) -> bool:
+    """Every return the client read is one the simulation produced, within quantisation."""
+    if len(client_scan) != len(expected):
+        return False
+    return all(
+        abs(a - ea) <= ANGLE_TOL_DEG and abs(d - ed) <= DISTANCE_TOL_MM
+        for (a, d), (ea, ed) in zip(sorted(client_scan), sorted(expected), strict=True)
+    )
+
+
+@pytest.fixture
+def emulator() -> Iterator[str]:
+    """`fossbot-hil emulate rplidar` on a new pty; yields the port path it printed first."""
+    process = subprocess.Popen(
+        [sys.executable, "-m", "harness.cli", "emulate", "rplidar", "--scenario", SCENARIO],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        first = process.stdout.readline()  # bounded by pytest-timeout; printed at once
+        assert first.startswith("port: /dev/pts/"), first + process.stderr.read()
+        yield first.removeprefix("port: ").strip()
+    finally:
+        process.terminate()
+        process.wait(timeout=10)
+
+
+def read_with_rplidar_package(port: str) -> tuple[dict, tuple, list[list[tuple[float, float]]]]:
+    from rplidar import RPLidar
+
+    lidar = RPLidar(port, timeout=3)
+    try:
+        info, health = lidar.get_info(), lidar.get_health()
+        scans = []
+        for scan in lidar.iter_scans():
+            scans.append([(a, d) for _, a, d in scan])
+            if len(scans) == 5:
+                break
+        lidar.stop()
+    finally:
+        lidar.disconnect()
+    return info, health, scans
+
+
+def read_with_adafruit(port: str) -> tuple[dict, tuple, list[list[tuple[float, float]]]]:
+    from adafruit_rplidar import RPLidar
+
+    lidar = RPLidar(None, port, timeout=3)
+    try:
+        info, health = lidar.info, lidar.health
+        scans = []
+        for scan in lidar.iter_scans():
+            scans.append([(a, d) for _, a, d in scan])
+            if len(scans) == 5:
+                break
+        lidar.stop()
+    finally:
+        lidar.disconnect()
+    return info, health, scans
+
+
+@pytest.mark.parametrize("reader", [read_with_rplidar_package, read_with_adafruit])
+def test_client_reads_info_health_and_the_simulated_scans(emulator: str, reader) -> None:
+    """Info and health as an A1M8 answers them; every full scan is a simulated one."""
+    tolerate_missing_dtr_on_pty()
+    info, health, scans = reader(emulator)
+    assert info["model"] == 0x18 and info["firmware"] == (1, 29) and info["hardware"] == 7
+    assert health[0] == "Good"
+    expected = simulated_revolutions()
+    full = scans[1:]  # clients also yield the part-turn before the first start flag
+    assert full and all(any(matches(s, e) for e in expected) for s in full), full[0][:5]

@@ -1,0 +1,152 @@
+"""The physical-board path (--port), exercised here through a pty null-modem cable.
+
+The harness opens a serial device path with pyserial, exactly as it opens a
+USB-UART, paces the line in real time, and joins the board's ROS domain;
+the "board" on the other end is the bundled driver and reference node. The
+same test against real hardware is tests/hil (run with --hil-port).
+"""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+import time
+from collections.abc import Iterator
+from pathlib import Path
+
+import pytest
+from pty_clients import NullModem
+
+from harness.ros_domain import reserve_domain
+
+pytestmark = [pytest.mark.ros, pytest.mark.timeout(120)]
+
+SHORT = (
+    "description: Two seconds facing a wall.\n"
+    "obstacles: [{type: wall, start: [0.4, -1.0], end: [0.4, 1.0]}]\n"
+    "motion: {segments: [{until: {duration: 2.0}}]}\n"
+)
+
+
+def holds_open(pid: int, path: str) -> bool:
+    """Whether process `pid` has `path` open (from /proc)."""
+    fds = Path(f"/proc/{pid}/fd")
+    try:
+        return any(os.path.realpath(fd) == path for fd in fds.iterdir())
+    except OSError:
+        return False
+
+
+class Board:
+    """The far end of the cable: the board's LIDAR driver and lab node, in their domain.
+
+    As with a real board, its driver is (re)started once the harness holds
+    the adapter open: requests sent to a line nobody listens on are lost.
+    """
+
+    def __init__(self, cable: NullModem, domain_id: int, logs: Path) -> None:
+        self.cable, self.domain_id, self.logs = cable, domain_id, logs
+        self.processes: list[subprocess.Popen[bytes]] = []
+
+    def start_when_harness_listens(self, harness: subprocess.Popen[str]) -> None:
+        deadline = time.monotonic() + 30
+        while not holds_open(harness.pid, self.cable.harness_end):
+            assert harness.poll() is None, "the harness exited before opening the port"
+            assert time.monotonic() < deadline, "the harness never opened the port"
+            time.sleep(0.05)  # polling an observable condition, bounded
+        env = {
+            **os.environ,
+            "ROS_DOMAIN_ID": str(self.domain_id),
+            "ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST",
+        }
+        for name, argv in (
+            (
+                "driver",
+                [
+                    "harness.board_driver.rplidar_node",
+                    "--ros-args",
+                    "-p",
+                    f"port:={self.cable.board_end}",
+                    "-p",
+                    "timeout:=30.0",
+                ],
+            ),
+            ("node", ["harness.reference.lidar_node"]),
+        ):
+            with open(self.logs / f"{name}.log", "wb") as log:
+                self.processes.append(
+                    subprocess.Popen(
+                        [sys.executable, "-m", *argv],
+                        env=env,
+                        stdout=subprocess.DEVNULL,
+                        stderr=log,
+                    )
+                )
+
+    def stop(self) -> None:
+        for process in self.processes:
+            process.terminate()
+        for process in self.processes:
+            process.wait(timeout=10)
+
+
+@pytest.fixture
+def board(tmp_path: Path) -> Iterator[Board]:
+    cable = NullModem()
+    reservation = reserve_domain()
+    board = Board(cable, reservation.domain_id, tmp_path)
+    try:
+        yield board
+    finally:
+        board.stop()
+        cable.cut()
+        reservation.release()
+
+
+def start_harness(board: Board, scenario: Path) -> subprocess.Popen[str]:
+    return subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "harness.cli",
+            "run",
+            str(scenario),
+            "--link",
+            "rplidar",
+            "--port",
+            board.cable.harness_end,
+            "--domain-id",
+            str(board.domain_id),
+        ],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+
+
+def test_run_against_a_board_on_a_serial_port(board: Board, tmp_path: Path) -> None:
+    """--port with --domain-id: real-time emulation into the board, its answers judged."""
+    scenario = tmp_path / "facing_wall.yaml"
+    scenario.write_text(SHORT)
+    harness = start_harness(board, scenario)
+    board.start_when_harness_listens(harness)
+    out, err = harness.communicate(timeout=90)
+    assert harness.returncode == 0, out + err
+    assert "1 of 1 scenarios passed" in out
+
+
+def test_unplugged_adapter_fails_the_run_promptly(board: Board, tmp_path: Path) -> None:
+    """Pulling the cable mid-run ends the run with a clear message, not a hang."""
+    scenario = tmp_path / "long.yaml"
+    scenario.write_text(SHORT.replace("duration: 2.0", "duration: 30.0"))
+    harness = start_harness(board, scenario)
+    board.start_when_harness_listens(harness)
+    time.sleep(6.0)  # the run is under way by then (not synchronisation: any moment will do)
+    cut_at = time.monotonic()
+    board.cable.cut()
+    out, err = harness.communicate(timeout=30)
+    elapsed = time.monotonic() - cut_at
+    assert harness.returncode == 1, out + err
+    assert "link lost" in out, out + err
+    assert elapsed < 5.0, f"the run took {elapsed:.1f} s to notice the unplugged adapter"
