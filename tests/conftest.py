@@ -12,6 +12,7 @@ import importlib.util
 import pytest
 
 
+@pytest.hookimpl(trylast=True)  # after -m has deselected what the user left out
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
     wants_ros = [item for item in items if item.get_closest_marker("ros")]
     if wants_ros and importlib.util.find_spec("rclpy") is None:

@@ -3,14 +3,14 @@
 The driver package lives in node/fossbot_lidar_driver (an ament_python
 package, not part of the harness distribution), so its folder is put on
 sys.path here and on PYTHONPATH for the driver processes. Nothing imports
-rclpy at module level: the pure tests run without the ROS 2 wheels.
+rclpy at module level: the pure tests run without the ROS 2 wheels, and the
+tests that need it carry the `ros` mark (tests/conftest.py stops a run that
+selects them where rclpy is missing).
 """
 
 from __future__ import annotations
 
 import os
-import signal
-import subprocess
 import sys
 import time
 from collections.abc import Callable, Iterator
@@ -22,15 +22,17 @@ import pytest
 
 from harness.ros_domain import reserve_domain
 
+pytest.register_assert_rewrite("child_process", "colcon_workspace", "driver_checks")
+
 REPO = Path(__file__).resolve().parents[2]
 PACKAGE_DIR = REPO / "node" / "fossbot_lidar_driver"
 sys.path.insert(0, str(PACKAGE_DIR))
 
+from child_process import ChildProcess, ChildProcesses  # noqa: E402
 from driver_wire import Pty  # noqa: E402
 
 MATCH_TIMEOUT = 15.0  # process start (~0.4 s) + discovery (~0.2 s), with room for a slow CI
 SCAN_TIMEOUT = 10.0
-STOP_TIMEOUT = 5.0
 
 
 @pytest.fixture
@@ -57,42 +59,10 @@ def ros_domain(monkeypatch: pytest.MonkeyPatch) -> Iterator[int]:
         reservation.release()
 
 
-@dataclass
-class DriverProcess:
-    """A driver running as a real child process."""
-
-    popen: subprocess.Popen[bytes]
-    stderr_path: Path
-
-    def stderr(self) -> str:
-        """Everything the driver logged so far (rclpy logs go to stderr)."""
-        return self.stderr_path.read_text(errors="replace")
-
-    def check_alive(self) -> None:
-        """Fail at once, with the driver's stderr, if it has exited."""
-        code = self.popen.poll()
-        if code is not None:
-            pytest.fail(f"driver exited early with code {code}; stderr:\n{self.stderr()}")
-
-    def wait(self, timeout: float = STOP_TIMEOUT) -> int:
-        """Wait (bounded) for the driver to exit; return its exit code."""
-        try:
-            return self.popen.wait(timeout=timeout)
-        except subprocess.TimeoutExpired:
-            pytest.fail(f"driver still running {timeout} s later; stderr:\n{self.stderr()}")
-
-    def stop(self, sig: signal.Signals = signal.SIGTERM) -> int:
-        """Send ``sig``; return the exit code."""
-        self.popen.send_signal(sig)
-        return self.wait()
-
-
 @pytest.fixture
-def start_driver(ros_domain: int, tmp_path: Path) -> Iterator[Callable[..., DriverProcess]]:
+def start_driver(ros_domain: int, tmp_path: Path) -> Iterator[Callable[..., ChildProcess]]:
     """Start ``python -m fossbot_lidar_driver.<module> --ros-args ...`` on this test's domain."""
-    pytest.importorskip("rclpy", reason="rclpy (ROS 2 Jazzy wheels) not installed")
-    pytest.importorskip("serial", reason="pyserial not installed (pip install pyserial)")
-    started: list[DriverProcess] = []
+    children = ChildProcesses(tmp_path, role="driver")
 
     def start(
         module: str,
@@ -100,33 +70,17 @@ def start_driver(ros_domain: int, tmp_path: Path) -> Iterator[Callable[..., Driv
         command: list[str] | None = None,
         package_path: Path = PACKAGE_DIR,
         extra_env: dict[str, str] | None = None,
-    ) -> DriverProcess:
-        err = tmp_path / f"driver{len(started)}.err"
+    ) -> ChildProcess:
         argv = command or [sys.executable, "-m", f"fossbot_lidar_driver.{module}"]
         if ros_args:
             argv = [*argv, "--ros-args", *ros_args]
         pythonpath = os.pathsep.join(
             p for p in (str(package_path), os.environ.get("PYTHONPATH")) if p
         )
-        env = {
-            **os.environ,
-            "PYTHONUNBUFFERED": "1",
-            "PYTHONPATH": pythonpath,
-            **(extra_env or {}),
-        }
-        with err.open("wb") as stderr:
-            popen = subprocess.Popen(argv, env=env, stdout=subprocess.DEVNULL, stderr=stderr)
-        process = DriverProcess(popen, err)
-        started.append(process)
-        return process
+        return children.start(argv, extra_env={"PYTHONPATH": pythonpath, **(extra_env or {})})
 
-    try:
+    with children:
         yield start
-    finally:
-        for process in started:
-            if process.popen.poll() is None:
-                process.popen.kill()
-                process.popen.wait(timeout=STOP_TIMEOUT)
 
 
 @dataclass
@@ -138,7 +92,7 @@ class ScanProbe:
     subscription: Any
     scans: list[Any] = field(default_factory=list)
 
-    def wait_scans(self, count: int, process: DriverProcess, timeout: float = SCAN_TIMEOUT):
+    def wait_scans(self, count: int, process: ChildProcess, timeout: float = SCAN_TIMEOUT):
         """Spin until ``count`` scans arrived; fail (with the driver's log) after ``timeout``."""
         deadline = time.monotonic() + timeout
         while len(self.scans) < count:
@@ -155,7 +109,7 @@ class ScanProbe:
 @pytest.fixture
 def scan_probe(ros_domain: int) -> Iterator[Callable[..., ScanProbe]]:
     """A factory of /scan subscribers (reliable, keep-last 10) on this test's domain."""
-    rclpy = pytest.importorskip("rclpy", reason="rclpy (ROS 2 Jazzy wheels) not installed")
+    import rclpy
     from rclpy.executors import SingleThreadedExecutor
     from sensor_msgs.msg import LaserScan
 

@@ -4,10 +4,13 @@ from __future__ import annotations
 
 import math
 import signal
-import time
 
 import numpy as np
 import pytest
+from driver_checks import (
+    check_missing_port_exits_2_with_one_line,
+    check_port_vanishing_exits_1_promptly,
+)
 from driver_wire import BURST_PERIOD, POINTS_PER_TURN, LdStreamer, burst, point
 
 pytestmark = [pytest.mark.ros, pytest.mark.timeout(60)]
@@ -22,10 +25,6 @@ def expected_ranges() -> np.ndarray:
         distance, intensity = point((POINTS_PER_TURN - k) % POINTS_PER_TURN)
         ranges[k] = math.nan if distance == 0 and intensity == 0 else distance / 1000.0
     return ranges
-
-
-def assert_clean(stderr: str) -> None:
-    assert "Traceback" not in stderr, stderr
 
 
 def test_scans_follow_the_vendor_conventions_on_450_bins(pty, start_driver, scan_probe) -> None:
@@ -54,29 +53,18 @@ def test_sigterm_exits_0(pty, start_driver, scan_probe) -> None:
     driver = start_driver(MODULE, "-p", f"port:={pty.name}")
     scan_probe().wait_scans(1, driver)
     assert driver.stop(signal.SIGTERM) == 0
-    assert_clean(driver.stderr())
+    driver.assert_no_traceback()
 
 
 def test_port_that_cannot_be_opened_exits_2_with_one_line(start_driver) -> None:
     """No such device: exit 2 and exactly one log line, naming the port."""
-    driver = start_driver(MODULE, "-p", "port:=/dev/fossbot-hil-no-such-tty")
-    assert driver.wait() == 2
-    lines = [line for line in driver.stderr().splitlines() if line.strip()]
-    assert len(lines) == 1, lines
-    assert "cannot open /dev/fossbot-hil-no-such-tty" in lines[0]
+    check_missing_port_exits_2_with_one_line(start_driver, MODULE)
 
 
 def test_port_vanishing_mid_run_exits_1_promptly(pty, start_driver, scan_probe) -> None:
     """Closing the pty ends the driver within about a second, exit 1."""
     LdStreamer(pty, burst, BURST_PERIOD).start()
-    driver = start_driver(MODULE, "-p", f"port:={pty.name}", "-p", "timeout:=5.0")
-    scan_probe().wait_scans(1, driver)
-    pty.close()
-    started = time.monotonic()
-    assert driver.wait() == 1
-    assert time.monotonic() - started < 2.0
-    assert "[ERROR]" in driver.stderr() and pty.name in driver.stderr()
-    assert_clean(driver.stderr())
+    check_port_vanishing_exits_1_promptly(pty, start_driver, scan_probe, MODULE)
 
 
 def test_noise_without_packets_exits_1_after_the_timeout(pty, start_driver) -> None:
@@ -88,4 +76,4 @@ def test_noise_without_packets_exits_1_after_the_timeout(pty, start_driver) -> N
     stderr = driver.stderr()
     assert "no valid packet for 0.5 s" in stderr
     assert "0 CRC errors" not in stderr
-    assert_clean(stderr)
+    driver.assert_no_traceback()

@@ -21,8 +21,22 @@ pytestmark = [pytest.mark.hil, pytest.mark.ros, pytest.mark.timeout(600)]
 def test_lab_scenario_on_the_board(hil_board: HilBoard, scenario: str) -> None:
     """The board's own driver and node, fed an emulated LIDAR, must pass the lab scenario."""
     done = subprocess.run(
-        [sys.executable, "-m", "harness.cli", "run", scenario, "--link", hil_board.link,
-         "--port", hil_board.port, "--ros-network", "--domain-id", str(hil_board.domain_id)],
-        capture_output=True, text=True, timeout=540,
+        [
+            sys.executable,
+            "-m",
+            "harness.cli",
+            "run",
+            scenario,
+            "--link",
+            hil_board.link,
+            "--port",
+            hil_board.port,
+            "--ros-network",
+            "--domain-id",
+            str(hil_board.domain_id),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=540,
     )
     assert done.returncode == 0, done.stdout + done.stderr

@@ -1,16 +1,14 @@
 """Fixtures for the reference-node tests: an isolated ROS graph and node processes.
 
 Nothing here imports rclpy at module level, so the pure tests in this folder
-run where the ROS 2 wheels are missing; the fixtures that need rclpy skip.
+run where the ROS 2 wheels are missing. The tests that need rclpy carry the
+`ros` mark: tests/conftest.py stops a run that selects them where it is missing.
 """
 
 from __future__ import annotations
 
 import array
 import math
-import os
-import signal
-import subprocess
 import sys
 import time
 from collections.abc import Callable, Iterator, Sequence
@@ -22,11 +20,14 @@ import pytest
 
 from harness.ros_domain import reserve_domain
 
+pytest.register_assert_rewrite("child_process", "colcon_workspace")
+
+from child_process import ChildProcess, ChildProcesses  # noqa: E402
+
 NODE_MODULE = "harness.reference.lidar_node"
 
 MATCH_TIMEOUT = 15.0  # process start (~0.4 s) + discovery (~0.2 s), with room for a slow CI
 ANSWER_TIMEOUT = 3.0
-STOP_TIMEOUT = 5.0
 
 
 @pytest.fixture
@@ -71,8 +72,7 @@ def make_scan(
 
 @pytest.fixture
 def make_scan_fn() -> Callable[..., Any]:
-    """`make_scan` for tests, skipping where sensor_msgs is missing."""
-    pytest.importorskip("sensor_msgs.msg", reason="sensor_msgs (ROS 2 Jazzy wheels) not installed")
+    """`make_scan` for tests (it imports sensor_msgs, of the ROS 2 Jazzy wheels)."""
     return make_scan
 
 
@@ -105,7 +105,7 @@ class GraphProbe:
                 pytest.fail(f"timed out after {timeout} s waiting for {what}")
             self.executor.spin_once(timeout_sec=min(remaining, 0.05))
 
-    def wait_matched(self, process: NodeProcess | None = None) -> None:
+    def wait_matched(self, process: ChildProcess | None = None) -> None:
         """Wait until the node's subscription and both its publishers match ours."""
 
         def matched() -> bool:
@@ -119,7 +119,7 @@ class GraphProbe:
 
         self.spin_until(matched, MATCH_TIMEOUT, "the node's topics to match")
 
-    def handshake(self, process: NodeProcess | None = None) -> None:
+    def handshake(self, process: ChildProcess | None = None) -> None:
         """
         Bring both directions to lockstep before the test's own scans.
 
@@ -194,7 +194,7 @@ def ros_context(ros_domain: int) -> Iterator[RosSide]:
     A non-default Context keeps rclpy's SIGINT/SIGTERM handlers out of pytest
     (rclpy installs them only for the default context) and dies with the test.
     """
-    rclpy = pytest.importorskip("rclpy", reason="rclpy (ROS 2 Jazzy wheels) not installed")
+    import rclpy
     from rclpy.executors import SingleThreadedExecutor
 
     context = rclpy.Context()
@@ -247,69 +247,25 @@ def ros_graph(ros_context: RosSide) -> Callable[..., GraphProbe]:
     return probe
 
 
-@dataclass
-class NodeProcess:
-    """A node under test running as a real child process."""
-
-    popen: subprocess.Popen[bytes]
-    stdout_path: Path
-    stderr_path: Path
-
-    def stderr(self) -> str:
-        """Everything the node wrote to stderr so far (rclpy logs go there)."""
-        return self.stderr_path.read_text(errors="replace")
-
-    def check_alive(self) -> None:
-        """Fail at once, with the node's stderr, if the node has exited."""
-        code = self.popen.poll()
-        if code is not None:
-            pytest.fail(f"node exited early with code {code}; stderr:\n{self.stderr()}")
-
-    def wait(self, timeout: float = STOP_TIMEOUT) -> int:
-        """Wait (bounded) for the node to exit and return its exit code."""
-        try:
-            return self.popen.wait(timeout=timeout)
-        except subprocess.TimeoutExpired:
-            pytest.fail(f"node still running {timeout} s later; stderr:\n{self.stderr()}")
-
-    def stop(self, sig: signal.Signals = signal.SIGTERM, timeout: float = STOP_TIMEOUT) -> int:
-        """Send `sig` and return the exit code, failing if it takes over `timeout`."""
-        self.popen.send_signal(sig)
-        return self.wait(timeout)
-
-
 @pytest.fixture
-def start_node(ros_domain: int, tmp_path: Path) -> Iterator[Callable[..., NodeProcess]]:
+def start_node(ros_domain: int, tmp_path: Path) -> Iterator[Callable[..., ChildProcess]]:
     """
     A factory that starts the node (by default the bundled one) as a child process.
 
     The child inherits this test's ROS_DOMAIN_ID and localhost-only discovery;
     anything still running at teardown is killed.
     """
-    pytest.importorskip("rclpy", reason="rclpy (ROS 2 Jazzy wheels) not installed")
-    started: list[NodeProcess] = []
+    children = ChildProcesses(tmp_path, role="node")
 
     def start(
         *ros_args: str,
         command: Sequence[str] | None = None,
         extra_env: dict[str, str] | None = None,
-    ) -> NodeProcess:
-        index = len(started)
-        out, err = tmp_path / f"node{index}.out", tmp_path / f"node{index}.err"
+    ) -> ChildProcess:
         argv = [*(command or [sys.executable, "-m", NODE_MODULE])]
         if ros_args:
             argv += ["--ros-args", *ros_args]
-        env = {**os.environ, "PYTHONUNBUFFERED": "1", **(extra_env or {})}
-        with out.open("wb") as stdout, err.open("wb") as stderr:
-            popen = subprocess.Popen(argv, env=env, stdout=stdout, stderr=stderr)
-        process = NodeProcess(popen, out, err)
-        started.append(process)
-        return process
+        return children.start(argv, extra_env=extra_env, keep_stdout=True)
 
-    try:
+    with children:
         yield start
-    finally:
-        for process in started:
-            if process.popen.poll() is None:
-                process.popen.kill()
-                process.popen.wait(timeout=STOP_TIMEOUT)

@@ -228,7 +228,7 @@ def test_resource_marker_and_standard_tests_exist() -> None:
 
 
 def test_package_tests_pass_with_plain_pytest() -> None:
-    """The package's own test/ runs anywhere: linters skip cleanly when missing."""
+    """The package's own test/ (logic and ament linters) passes under plain pytest."""
     result = subprocess.run(
         [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", "test"],
         cwd=PACKAGE,

@@ -21,11 +21,6 @@ def expected_answer(msg, threshold: float) -> tuple[str, bool]:
     return status_text(report), report.warning
 
 
-def assert_no_traceback(stderr: str) -> None:
-    """A clean exit logs, at most; it never dumps a Python traceback."""
-    assert "Traceback" not in stderr, stderr
-
-
 def test_answers_each_scan_with_status_and_warning(start_node, ros_graph, make_scan_fn) -> None:
     """Near, far, all-invalid and mixed scans each get the right String and Bool."""
     node = start_node("-p", "threshold:=0.4", "-p", "use_sim_time:=true")
@@ -113,7 +108,7 @@ def test_signal_ends_the_node_cleanly(start_node, ros_graph, make_scan_fn, sig) 
     graph.handshake(node)
     graph.ask(make_scan_fn([1.0]))
     assert node.stop(sig, timeout=5.0) == 0
-    assert_no_traceback(node.stderr())
+    node.assert_no_traceback()
 
 
 @pytest.mark.parametrize(
@@ -131,7 +126,7 @@ def test_bad_threshold_exits_2_with_a_reason(start_node, value: str, reason: str
     node = start_node("-p", f"threshold:={value}")
     assert node.wait(timeout=10.0) == 2
     stderr = node.stderr()
-    assert_no_traceback(stderr)
+    node.assert_no_traceback()
     assert "FATAL" in stderr and "threshold" in stderr and reason in stderr
 
 
@@ -145,7 +140,7 @@ def test_bad_topic_parameters_exit_2(start_node, arg: str) -> None:
     node = start_node("-p", arg)
     assert node.wait(timeout=10.0) == 2
     assert "FATAL" in node.stderr()
-    assert_no_traceback(node.stderr())
+    node.assert_no_traceback()
 
 
 @pytest.mark.parametrize("attempt", range(3))
@@ -175,4 +170,4 @@ def test_signal_while_scans_stream_in_is_still_clean(
             signalled = True
     assert signalled
     assert node.wait(timeout=5.0) == 0, node.stderr()
-    assert_no_traceback(node.stderr())
+    node.assert_no_traceback()

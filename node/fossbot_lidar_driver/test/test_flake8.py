@@ -1,11 +1,7 @@
 """ament_flake8 over the package, as `ros2 pkg create` generates it."""
 
+from ament_flake8.main import main_with_errors
 import pytest
-
-main_with_errors = pytest.importorskip(
-    'ament_flake8.main', reason='ament_flake8 is not installed'
-).main_with_errors
-pytest.importorskip('flake8', reason='flake8 is not installed (ament_flake8 runs it)')
 
 
 @pytest.mark.flake8
