@@ -79,11 +79,12 @@ class BoardLink(Ros2Link):
         ).start()
         if self.physical:
             return  # the board runs its own driver and nodes
-        # In lockstep the line is quiet while the harness waits for the node
-        # (bounded: the deadline, then the catch-up wait); a real device never
-        # pauses, so the driver's read timeout must outlast those waits.
+        # The emulated device is quiet until the run starts and, in lockstep,
+        # while the harness waits for the node (bounded: the deadline, then
+        # the catch-up wait). A real device never pauses, so the driver's
+        # no-data timeout must outlast those waits and the start-up.
         longest_wait = opts.scan_timeout + max(CATCH_UP_S, 3 * opts.scan_timeout)
-        read_timeout = 1.0 if opts.realtime else longest_wait + 2.0
+        read_timeout = max(longest_wait, opts.ready_timeout) + 2.0
         driver_args = ros_arguments(
             (
                 f"port:={self.port.slave_path}",
