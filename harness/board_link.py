@@ -27,7 +27,6 @@ from harness.errors import ConfigError, LinkError
 from harness.links.base import LinkOptions
 from harness.links.ros2 import CATCH_UP_S, POLL_S, Ros2Link
 from harness.node_process import NodeCommand, NodeProcess, ros_arguments
-from harness.ros.observer import Observer
 from harness.scan import Scan
 
 DRIVER_READY_S = 10.0  # the driver connects to the device (info, health, scan request)
@@ -37,6 +36,7 @@ class BoardLink(Ros2Link):
     """A LIDAR device emulated on a serial line, read by the board's own driver."""
 
     profile: ClassVar[DeviceProfile]
+    publishes_scans = False  # the board's driver publishes /scan; the harness listens
 
     def __init__(self, options: LinkOptions) -> None:
         physical = options.port is not None
@@ -103,17 +103,6 @@ class BoardLink(Ros2Link):
         )
         self.driver.start()
         super()._start_processes(env)
-
-    def _make_observer(self, domain_id: int) -> Observer:
-        opts = self.options
-        return Observer(
-            domain_id,
-            scan_topic=opts.scan_topic,
-            status_topic=opts.status_topic,
-            warning_topic=opts.warning_topic,
-            network=opts.ros_network,
-            publish_scans=False,
-        )
 
     def _ready(self) -> bool:
         assert self.observer is not None and self.server is not None

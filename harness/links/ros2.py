@@ -64,6 +64,8 @@ def node_parameters(options: LinkOptions) -> tuple[str, ...]:
 class Ros2Link(Link):
     """Drive a ROS 2 node process through its scan topic; watch status and warning."""
 
+    publishes_scans = True  # the harness publishes /scan (a board link listens instead)
+
     def __init__(self, options: LinkOptions) -> None:
         super().__init__(options)
         self.command = node_command(options)  # resolve now: bad input exits 2 early
@@ -118,6 +120,7 @@ class Ros2Link(Link):
             status_topic=opts.status_topic,
             warning_topic=opts.warning_topic,
             network=opts.ros_network,
+            publish_scans=self.publishes_scans,
         )
 
     def _ready(self) -> bool:
