@@ -110,20 +110,12 @@ class BoardLink(Ros2Link):
             return False  # the driver has not asked for a scan yet
         return self.observer.ready()
 
-    def _check_processes(self, when: str) -> None:
-        if self.server is not None and self.server.error is not None:
-            raise LinkError(f"{self.profile.name} line: {self.server.error}")
-        if self.driver is not None and self.driver.returncode() is not None:
-            raise LinkError(f"the board's LIDAR driver {self.driver.exit_summary(when)}")
-        if not self.physical:
-            super()._check_processes(when)
-
-    def _node_gone(self) -> str | None:
-        if self.driver is not None and self.driver.returncode() is not None:
-            return f"the board's LIDAR driver {self.driver.exit_summary()}"
+    def _node_gone(self, when: str = "") -> str | None:
         if self.server is not None and self.server.error is not None:
             return f"{self.profile.name} line: {self.server.error}"
-        return None if self.physical else super()._node_gone()
+        if self.driver is not None and self.driver.returncode() is not None:
+            return f"the board's LIDAR driver {self.driver.exit_summary(when)}"
+        return None if self.physical else super()._node_gone(when)
 
     # -- delivery ---------------------------------------------------------
     def _deliver(self, scan: Scan, tick: int) -> int:

@@ -36,7 +36,6 @@ class RunSettings:
     faults: Sequence[str | dict[str, Any]] | None = None
     status_pattern: str | None = None
     gui: bool = False
-    stop_on_error: bool = True
 
 
 def effective_threshold(scenario: Scenario, settings: RunSettings) -> float:
@@ -117,7 +116,7 @@ def run_scenario(
                 answers.late = pending[2].take_late(answers.late, pending[0].tick)
                 judge(*pending)
             pending = (sim_tick, scan, answers)
-            if answers.problem is not None and settings.stop_on_error:
+            if answers.problem is not None:  # the node died or went silent: nothing more to judge
                 result.error = f"t={sim_tick.t:.2f} s tick {sim_tick.tick}: {answers.problem}"
                 break
         if pending is not None:

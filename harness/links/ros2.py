@@ -94,7 +94,9 @@ class Ros2Link(Link):
         self.observer = self._make_observer(self.domain.domain_id)
         deadline = time.monotonic() + opts.ready_timeout
         while not self._ready():
-            self._check_processes("before it was ready")
+            gone = self._node_gone("before it was ready")
+            if gone:
+                raise LinkError(gone)
             if time.monotonic() >= deadline:
                 raise LinkError(
                     f"node {self.command.description} never became ready within "
@@ -126,12 +128,6 @@ class Ros2Link(Link):
     def _ready(self) -> bool:
         assert self.observer is not None
         return self.observer.ready()
-
-    def _check_processes(self, when: str) -> None:
-        """Raise LinkError if a process this link started has exited."""
-        assert self.process is not None
-        if self.process.returncode() is not None:
-            raise LinkError(f"node {self.command.description} {self.process.exit_summary(when)}")
 
     def _deliver(self, scan: Scan, tick: int) -> int:
         """Put the scan in front of the node; return its send time (system-clock ns)."""
@@ -219,10 +215,11 @@ class Ros2Link(Link):
             return 0.0
         return min(max(MIN_GRACE_S, 4 * self._bool_after_gap), self.options.scan_timeout)
 
-    def _node_gone(self) -> str | None:
+    def _node_gone(self, when: str = "") -> str | None:
+        """Why a process this link started is no longer running, or None if all run."""
         assert self.process is not None
         if self.process.returncode() is not None:
-            return f"node {self.process.exit_summary()}"
+            return f"node {self.command.description} {self.process.exit_summary(when)}"
         return None
 
     def _wait_for(self, done: Callable[[], bool], seconds: float) -> str | None:

@@ -6,25 +6,15 @@ command, and talks to the harness over Fast DDS in its own domain.
 
 from __future__ import annotations
 
-import subprocess
 import sys
 from pathlib import Path
 
 import pytest
+from command_line import fossbot_hil
 
 pytestmark = [pytest.mark.ros, pytest.mark.timeout(300)]
 
 STUDENT = Path(__file__).parent / "student_node.py"
-
-
-def fossbot_hil(*args: str, timeout: float = 240) -> subprocess.CompletedProcess[str]:
-    """The real command line, as a user runs it."""
-    return subprocess.run(
-        [sys.executable, "-m", "harness.cli", *args],
-        capture_output=True,
-        text=True,
-        timeout=timeout,
-    )
 
 
 def student(variant: str) -> str:
@@ -73,7 +63,7 @@ def test_crash_when_nothing_in_range_shows_exit_code_and_stderr() -> None:
     """A node that dies mid-run: its exit code and last stderr lines are shown."""
     done = fossbot_hil("run", "drive_past_10m", "--node", student("crash_when_nothing_in_range"))
     assert done.returncode == 1
-    assert "node exited with code" in done.stdout and "ValueError" in done.stdout
+    assert "exited with code 1" in done.stdout and "ValueError" in done.stdout
 
 
 def test_slow_callbacks_are_too_late_then_stopped() -> None:
