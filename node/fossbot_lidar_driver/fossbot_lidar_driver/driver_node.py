@@ -189,8 +189,8 @@ class DriverNode(Node):
         """Declare a driver-specific read-only parameter from the defaults."""
         return self._declare(name, description)
 
-    def publish_scan(self, ranges: np.ndarray, scan_time: float) -> None:
-        """Publish ``bins`` ranges as one LaserScan stamped with the node clock now."""
+    def publish_scan(self, ranges: np.ndarray, scan_time: float, samples: int) -> None:
+        """Publish ``bins`` ranges (from ``samples`` readings) as one LaserScan, stamped now."""
         s = self.settings
         msg = LaserScan()
         msg.header.stamp = self.get_clock().now().to_msg()
@@ -207,6 +207,10 @@ class DriverNode(Node):
         msg.ranges = array.array('f', np.asarray(ranges, dtype=np.float32).tobytes())
         self._publisher.publish(msg)
         self.scans_published += 1
+        if self.scans_published == 1:
+            self.get_logger().info(
+                f'first scan on {s.scan_topic}: {samples} samples in {scan_time:.3f} s'
+            )
 
 
 class _Spinner:

@@ -222,12 +222,7 @@ def _publish(node: DriverNode, revolution: Revolution, min_returns: int) -> None
         angle_offset_deg=s.angle_offset_deg,
         mode=s.bin_mode,
     )
-    node.publish_scan(ranges, revolution.duration)
-    if node.scans_published == 1:
-        node.get_logger().info(
-            f'first scan on {s.scan_topic}: {len(revolution)} samples in '
-            f'{revolution.duration:.3f} s'
-        )
+    node.publish_scan(ranges, revolution.duration, len(revolution))
 
 
 def serve(node: DriverNode, stop: StopRequest) -> None:
