@@ -2,25 +2,14 @@
 
 from __future__ import annotations
 
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
+from command_line import fossbot_hil
 
 from harness.cli import main
 
 STUDENTS = Path(__file__).parent / "student_functions.py"
-
-
-def cli(*args: str, timeout: float = 120) -> subprocess.CompletedProcess[str]:
-    """Run the installed console script for real."""
-    return subprocess.run(
-        [sys.executable, "-m", "harness.cli", *args],
-        capture_output=True,
-        text=True,
-        timeout=timeout,
-    )
 
 
 def test_list_names_every_shipped_scenario(capsys: pytest.CaptureFixture[str]) -> None:
@@ -33,20 +22,21 @@ def test_list_names_every_shipped_scenario(capsys: pytest.CaptureFixture[str]) -
 
 def test_run_inprocess_passes() -> None:
     """A real process: the reference logic passes a lab scenario, exit 0."""
-    done = cli("run", "approach_wall", "--link", "inprocess")
+    done = fossbot_hil("run", "approach_wall", "--link", "inprocess", timeout=120)
     assert done.returncode == 0, done.stdout + done.stderr
     assert "approach_wall" in done.stdout and "PASS" in done.stdout
 
 
 def test_run_buggy_processor_exits_1_with_explanation() -> None:
     """A failing node exits 1 and the first failure is explained."""
-    done = cli(
+    done = fossbot_hil(
         "run",
         "drive_past_10m",
         "--link",
         "inprocess",
         "--processor",
         f"{STUDENTS}:min_over_raw_ranges",
+        timeout=120,
     )
     assert done.returncode == 1
     assert "drive_past_10m: t=" in done.stdout and "expected no obstacle" in done.stdout
@@ -85,7 +75,7 @@ def test_malformed_scenario_file_exits_2_naming_file_and_field(tmp_path: Path) -
     bad.write_text(
         "description: x\nmotion:\n  segments:\n    - linear: fast\n      until: {duration: 1}\n"
     )
-    done = cli("run", str(bad), "--link", "inprocess")
+    done = fossbot_hil("run", str(bad), "--link", "inprocess", timeout=120)
     assert done.returncode == 2
     assert done.stderr.strip() == (
         f"fossbot-hil: error: {bad}: motion.segments[0].linear: "

@@ -7,6 +7,7 @@ import struct
 
 import numpy as np
 import pytest
+from ld_crc_reference import ld_crc8_bitwise
 
 from harness.devices import ldlidar as ld
 from harness.devices.revolution import Sample, samples_from_scan
@@ -19,16 +20,6 @@ MANUAL_PACKET = bytes.fromhex(
 )
 
 
-def bitwise_crc8(data: bytes) -> int:
-    """CRC-8, polynomial 0x4D, MSB first, init 0: one bit at a time, no table."""
-    crc = 0
-    for byte in data:
-        crc ^= byte
-        for _ in range(8):
-            crc = ((crc << 1) ^ 0x4D) & 0xFF if crc & 0x80 else (crc << 1) & 0xFF
-    return crc
-
-
 def uniform(n: int, *, offset: float = 0.0) -> list[Sample]:
     return [Sample((offset + k * 360.0 / n) % 360.0, 100.0 + 3 * k, 200) for k in range(n)]
 
@@ -36,11 +27,11 @@ def uniform(n: int, *, offset: float = 0.0) -> list[Sample]:
 def test_crc_table_starts_as_documented_and_matches_the_polynomial() -> None:
     assert ld.CRC_TABLE[:4] == (0x00, 0x4D, 0x9A, 0xD7)
     assert len(ld.CRC_TABLE) == 256
-    assert all(ld.CRC_TABLE[i] == bitwise_crc8(bytes([i])) for i in range(256))
+    assert all(ld.CRC_TABLE[i] == ld_crc8_bitwise(bytes([i])) for i in range(256))
 
 
 def test_manual_packet_crc_and_fields() -> None:
-    assert ld.crc8(MANUAL_PACKET[:-1]) == 0x50 == bitwise_crc8(MANUAL_PACKET[:-1])
+    assert ld.crc8(MANUAL_PACKET[:-1]) == 0x50 == ld_crc8_bitwise(MANUAL_PACKET[:-1])
     packet = ld.parse_packet(MANUAL_PACKET)
     assert packet.speed_deg_s == 2152
     assert (packet.start_angle_cdeg, packet.end_angle_cdeg) == (32427, 33470)
@@ -57,7 +48,7 @@ def test_encoded_packet_golden_bytes() -> None:
     for k in range(12):
         body += (1000 + k).to_bytes(2, "little") + bytes([200])
     body += (1880).to_bytes(2, "little") + (1234).to_bytes(2, "little")
-    expected = body + bytes([bitwise_crc8(body)])
+    expected = body + bytes([ld_crc8_bitwise(body)])
     assert ld.encode_packet(samples, speed_deg_s=3600, timestamp_ms=1234) == expected
     assert len(expected) == ld.PACKET_LEN == 47
 

@@ -14,6 +14,8 @@ import threading
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
+from ld_crc_reference import ld_crc8_bitwise
+
 # Slamtec descriptors: A5 5A, then u32 LE = length (30 bits) | mode << 30, then the type.
 INFO_DESCRIPTOR = bytes.fromhex("a55a1400000004")
 HEALTH_DESCRIPTOR = bytes.fromhex("a55a0300000006")
@@ -40,16 +42,6 @@ def rp_revolution(samples: Sequence[tuple[int, float, float]]) -> bytes:
     )
 
 
-def ld_crc(data: bytes) -> int:
-    """CRC-8, polynomial 0x4D, init 0, MSB first: the slow obvious way."""
-    crc = 0
-    for byte in data:
-        crc ^= byte
-        for _ in range(8):
-            crc = ((crc << 1) ^ 0x4D) & 0xFF if crc & 0x80 else (crc << 1) & 0xFF
-    return crc
-
-
 def ld_packet(
     speed_dps: int,
     start_cdeg: int,
@@ -64,7 +56,7 @@ def ld_packet(
     body = struct.pack("<BBHH", 0x54, 0x2C, speed_dps, start_cdeg)
     body += b"".join(struct.pack("<HB", d, i) for d, i in points)
     body += struct.pack("<HH", end_cdeg, timestamp_ms)
-    return body + bytes([ld_crc(body) if crc is None else crc])
+    return body + bytes([ld_crc8_bitwise(body) if crc is None else crc])
 
 
 # From the LD06 development manual: speed 2152 deg/s, 324.27 -> 334.70 deg, CRC 0x50.
@@ -292,7 +284,7 @@ def false_header(following: bytes) -> bytes:
     for junk in range(256):
         noise = bytes([0x54, 0x2C, junk, 0x00, 0x54])
         window = (noise + following)[:47]
-        if ld_crc(window[:46]) != window[46]:
+        if ld_crc8_bitwise(window[:46]) != window[46]:
             return noise
     raise AssertionError("unreachable: some junk byte always breaks the CRC")
 

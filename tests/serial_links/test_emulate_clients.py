@@ -76,21 +76,25 @@ def emulator() -> Iterator[str]:
         process.wait(timeout=10)
 
 
+def first_scans(lidar, count: int = 5) -> list[list[tuple[float, float]]]:
+    """The first `count` scans a client yields, as (angle, distance) pairs; then stop."""
+    scans = []
+    for scan in lidar.iter_scans():
+        scans.append([(a, d) for _, a, d in scan])
+        if len(scans) == count:
+            break
+    lidar.stop()
+    return scans
+
+
 def read_with_rplidar_package(port: str) -> tuple[dict, tuple, list[list[tuple[float, float]]]]:
     from rplidar import RPLidar
 
     lidar = RPLidar(port, timeout=3)
     try:
-        info, health = lidar.get_info(), lidar.get_health()
-        scans = []
-        for scan in lidar.iter_scans():
-            scans.append([(a, d) for _, a, d in scan])
-            if len(scans) == 5:
-                break
-        lidar.stop()
+        return lidar.get_info(), lidar.get_health(), first_scans(lidar)
     finally:
         lidar.disconnect()
-    return info, health, scans
 
 
 def read_with_adafruit(port: str) -> tuple[dict, tuple, list[list[tuple[float, float]]]]:
@@ -98,16 +102,9 @@ def read_with_adafruit(port: str) -> tuple[dict, tuple, list[list[tuple[float, f
 
     lidar = RPLidar(None, port, timeout=3)
     try:
-        info, health = lidar.info, lidar.health
-        scans = []
-        for scan in lidar.iter_scans():
-            scans.append([(a, d) for _, a, d in scan])
-            if len(scans) == 5:
-                break
-        lidar.stop()
+        return lidar.info, lidar.health, first_scans(lidar)
     finally:
         lidar.disconnect()
-    return info, health, scans
 
 
 @pytest.mark.parametrize("reader", [read_with_rplidar_package, read_with_adafruit])
