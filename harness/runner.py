@@ -158,3 +158,29 @@ def run(
         )
     finally:
         link.close()
+
+
+def run_suite(
+    scenarios: Sequence[Scenario],
+    link_name: str,
+    options: LinkOptions,
+    settings: RunSettings = RunSettings(),
+    *,
+    on_result: Callable[[RunResult], None] | None = None,
+) -> list[RunResult]:
+    """Run each scenario in turn; once the software under test fails to come
+    up, the rest are marked not run instead of each waiting out its start."""
+    results: list[RunResult] = []
+    failed_start: str | None = None
+    for scenario in scenarios:
+        if failed_start is not None:
+            reason = f"not run: the node did not start in {failed_start}"
+            result = RunResult(scenario.name, link_name, 0, 0.0, "", error=reason, not_run=True)
+        else:
+            result = run(scenario, link_name, options, settings)
+            if result.not_started:
+                failed_start = scenario.name
+        results.append(result)
+        if on_result is not None:
+            on_result(result)
+    return results

@@ -1,0 +1,23 @@
+"""`fossbot-hil list`: the shipped scenarios."""
+
+from __future__ import annotations
+
+import argparse
+
+from rich.console import Console
+
+from harness.scenario import shipped_scenarios
+
+NAME = "list"
+HELP = "list the shipped scenarios"
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    pass
+
+
+def run(args: argparse.Namespace, console: Console) -> int:
+    from harness.report.terminal import scenario_table
+
+    console.print(scenario_table(shipped_scenarios()))
+    return 0

@@ -1,0 +1,99 @@
+"""`fossbot-hil run`: run scenarios through a link and judge the answers."""
+
+from __future__ import annotations
+
+import argparse
+from collections.abc import Sequence
+from pathlib import Path
+
+from rich.console import Console
+
+from harness.commands.arguments import (
+    add_judging_options,
+    add_link_option,
+    add_node_options,
+    check_link_options,
+    check_status_regex,
+    fault_list,
+    link_options,
+    seed,
+)
+from harness.errors import ConfigError
+from harness.runner import RunSettings
+from harness.scenario import Scenario, resolve_scenario, shipped_scenarios
+
+NAME = "run"
+HELP = "run scenarios and judge the node's answers"
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "scenarios",
+        nargs="*",
+        metavar="SCENARIO",
+        help="shipped scenario name or path to a scenario file (default: all shipped)",
+    )
+    add_link_option(parser)
+    parser.add_argument("--seed", type=seed, help="override the scenarios' seed")
+    parser.add_argument(
+        "--faults",
+        metavar="NAME[,NAME]",
+        help="fault profiles replacing the scenarios' own (see docs/faults.md)",
+    )
+    add_judging_options(parser)
+    parser.add_argument("--gui", action="store_true", help="open the PyBullet viewer")
+    parser.add_argument("--junit-xml", metavar="FILE", help="write a JUnit XML report")
+    add_node_options(parser)
+
+    serial = parser.add_argument_group("serial links (rplidar, ldlidar)")
+    serial.add_argument(
+        "--port",
+        metavar="DEV",
+        help="drive a physical board through this USB-UART, in real time "
+        "(default: a virtual board on a pty)",
+    )
+
+    inprocess = parser.add_argument_group("inprocess link")
+    inprocess.add_argument(
+        "--processor",
+        metavar="MODULE:FUNCTION",
+        help="fn(scan, threshold) -> (status, warning) instead of the reference",
+    )
+
+
+def selected(names: Sequence[str]) -> list[Scenario]:
+    """The named scenarios (all resolved before anything runs), or every shipped one."""
+    return [resolve_scenario(n) for n in names] if names else shipped_scenarios()
+
+
+def settings_from(args: argparse.Namespace) -> RunSettings:
+    """The per-run overrides given on the command line."""
+    return RunSettings(
+        seed=args.seed,
+        threshold=args.threshold,
+        faults=fault_list(args.faults),
+        status_pattern=args.status_regex,
+        gui=args.gui,
+    )
+
+
+def run(args: argparse.Namespace, console: Console) -> int:
+    from harness.report.terminal import print_results
+
+    check_link_options(args)
+    scenarios = selected(args.scenarios)
+    if args.junit_xml and not Path(args.junit_xml).resolve().parent.is_dir():
+        raise ConfigError(f"--junit-xml {args.junit_xml}: its folder does not exist")
+    check_status_regex(args)
+    from harness.runner import run_suite
+
+    results = run_suite(scenarios, args.link, link_options(args), settings_from(args))
+    print_results(console, results)
+    if args.junit_xml:
+        from harness.report.junit import write_junit
+
+        try:
+            write_junit(args.junit_xml, results)
+        except OSError as err:
+            raise ConfigError(f"--junit-xml {args.junit_xml}: {err.strerror or err}") from None
+    return 0 if all(r.ok for r in results) else 1
