@@ -132,6 +132,8 @@ def run(
     link_name: str,
     options: LinkOptions,
     settings: RunSettings = RunSettings(),
+    *,
+    on_tick: Callable[[TickRecord], None] | None = None,
 ) -> RunResult:
     """Open the named link, run the scenario through it, always close it.
 
@@ -143,7 +145,7 @@ def run(
     link = create_link(link_name, replace(options, threshold=threshold, scan_rate_hz=rate))
     try:
         link.open()
-        return run_scenario(scenario, link, settings)
+        return run_scenario(scenario, link, settings, on_tick=on_tick)
     except LinkError as err:
         seed = settings.seed if settings.seed is not None else scenario.seed
         return RunResult(
@@ -166,6 +168,7 @@ def run_suite(
     options: LinkOptions,
     settings: RunSettings = RunSettings(),
     *,
+    on_tick: Callable[[TickRecord], None] | None = None,
     on_result: Callable[[RunResult], None] | None = None,
 ) -> list[RunResult]:
     """Run each scenario in turn; once the software under test fails to come
@@ -177,7 +180,7 @@ def run_suite(
             reason = f"not run: the node did not start in {failed_start}"
             result = RunResult(scenario.name, link_name, 0, 0.0, "", error=reason, not_run=True)
         else:
-            result = run(scenario, link_name, options, settings)
+            result = run(scenario, link_name, options, settings, on_tick=on_tick)
             if result.not_started:
                 failed_start = scenario.name
         results.append(result)
