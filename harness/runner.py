@@ -8,9 +8,9 @@ arrived or its deadline passed.
 from __future__ import annotations
 
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, replace
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
@@ -22,9 +22,6 @@ from harness.oracle import Oracle
 from harness.scan import Scan
 from harness.scenario import Scenario
 from harness.trace import RunResult, TickRecord
-
-if TYPE_CHECKING:
-    from harness.sim.simulation import SimTick
 
 
 @dataclass(frozen=True)
@@ -53,6 +50,18 @@ def fault_profile(scenario: Scenario, settings: RunSettings) -> FaultProfile:
         raise ConfigError(f"{where}: {err}") from None
 
 
+@dataclass(frozen=True)
+class Frame:
+    """One scan to deliver, and where the robot was when it was taken."""
+
+    tick: int
+    t: float  # seconds since the start of the run (simulated or recorded)
+    x: float
+    y: float
+    yaw: float
+    scan: Scan
+
+
 def run_scenario(
     scenario: Scenario,
     link: Link,
@@ -63,6 +72,7 @@ def run_scenario(
     """Run `scenario` through an already opened `link` and judge every tick."""
     from harness.sim.simulation import Simulation  # imports pybullet
 
+    started = time.perf_counter()
     seed = settings.seed if settings.seed is not None else scenario.seed
     threshold = effective_threshold(scenario, settings)
     profile = fault_profile(scenario, settings)
@@ -76,24 +86,40 @@ def run_scenario(
         seed=seed,
         threshold=threshold,
         faults=profile.name,
+        noise_sigma=profile.noise_sigma,
     )
-    started = time.perf_counter()
-    pending: tuple[SimTick, Scan, Answers] | None = None
+    with Simulation(scenario, gui=settings.gui) as sim:
+        frames = (
+            Frame(s.tick, s.t, s.x, s.y, s.yaw, profile.emit(s.truth, sim.spec, rng, stamp=s.t))
+            for s in sim.ticks()
+        )
+        judge_frames(frames, link, oracle, result, on_tick=on_tick)
+    result.wall_s = time.perf_counter() - started
+    return result
 
-    def judge(sim_tick: SimTick, scan: Scan, answers: Answers) -> None:
+
+def judge_frames(
+    frames: Iterable[Frame],
+    link: Link,
+    oracle: Oracle,
+    result: RunResult,
+    *,
+    on_tick: Callable[[TickRecord], None] | None = None,
+) -> RunResult:
+    """Deliver each frame's scan through an opened `link`; judge and record every tick.
+
+    Simulated runs and replayed recordings share this loop, so both are
+    judged the same way.
+    """
+    pending: tuple[Frame, Answers] | None = None
+
+    def judge(frame: Frame, answers: Answers) -> None:
         # Judge against what the node saw: over a serial link that is the
         # board driver's scan, quantised and re-binned, not ours.
-        seen = answers.seen if answers.seen is not None else scan
-        verdict = oracle.judge(sim_tick.tick, sim_tick.t, seen, answers)
+        seen = answers.seen if answers.seen is not None else frame.scan
+        verdict = oracle.judge(frame.tick, frame.t, seen, answers)
         record = TickRecord(
-            sim_tick.tick,
-            sim_tick.t,
-            sim_tick.x,
-            sim_tick.y,
-            sim_tick.yaw,
-            scan,
-            answers,
-            verdict,
+            frame.tick, frame.t, frame.x, frame.y, frame.yaw, frame.scan, answers, verdict
         )
         result.records.append(record)
         if on_tick is not None:
@@ -102,29 +128,49 @@ def run_scenario(
     # Each tick is judged once the next scan's exchange is over: answers to
     # scan k that arrive after scan k+1 was sent (a Bool published after the
     # String, a second String) still count for scan k.
-    with Simulation(scenario, gui=settings.gui) as sim:
-        for sim_tick in sim.ticks():
-            scan = profile.emit(sim_tick.truth, sim.spec, rng, stamp=sim_tick.t)
-            if sim_tick.tick == 0:
-                link.warm_up(scan)
-            try:
-                answers = link.exchange(scan, sim_tick.tick)
-            except LinkError as err:  # the line or graph broke: end here, keep what we have
-                result.error = f"t={sim_tick.t:.2f} s tick {sim_tick.tick}: {err}"
-                break
-            if pending is not None:
-                answers.late = pending[2].take_late(answers.late, pending[0].tick)
-                judge(*pending)
-            pending = (sim_tick, scan, answers)
-            if answers.problem is not None:  # the node died or went silent: nothing more to judge
-                result.error = f"t={sim_tick.t:.2f} s tick {sim_tick.tick}: {answers.problem}"
-                break
+    for index, frame in enumerate(frames):
+        if index == 0:
+            link.warm_up(frame.scan)
+        try:
+            answers = link.exchange(frame.scan, frame.tick)
+        except LinkError as err:  # the line or graph broke: end here, keep what we have
+            result.error = f"t={frame.t:.2f} s tick {frame.tick}: {err}"
+            break
         if pending is not None:
-            pending[2].take_late(link.settle(), pending[0].tick)
+            answers.late = pending[1].take_late(answers.late, pending[0].tick)
             judge(*pending)
+        pending = (frame, answers)
+        if answers.problem is not None:  # the node died or went silent: nothing more to judge
+            result.error = f"t={frame.t:.2f} s tick {frame.tick}: {answers.problem}"
+            break
+    if pending is not None:
+        pending[1].take_late(link.settle(), pending[0].tick)
+        judge(*pending)
     result.diagnostics = link.diagnostics()
-    result.wall_s = time.perf_counter() - started
     return result
+
+
+def with_link(
+    link_name: str,
+    options: LinkOptions,
+    body: Callable[[Link], RunResult],
+    not_started: Callable[[str, str], RunResult],
+) -> RunResult:
+    """Open the named link, run `body` through it, always close it.
+
+    A link that cannot bring the software under test up gives
+    ``not_started(reason, diagnostics)`` instead of an exception.
+    """
+    link = create_link(link_name, options)
+    try:
+        link.open()
+        return body(link)
+    except LinkError as err:
+        result = not_started(str(err), link.diagnostics())
+        result.not_started = True
+        return result
+    finally:
+        link.close()
 
 
 def run(
@@ -142,24 +188,20 @@ def run(
     """
     threshold = effective_threshold(scenario, settings)
     rate = scenario.lidar_spec.rate_hz
-    link = create_link(link_name, replace(options, threshold=threshold, scan_rate_hz=rate))
-    try:
-        link.open()
-        return run_scenario(scenario, link, settings, on_tick=on_tick)
-    except LinkError as err:
-        seed = settings.seed if settings.seed is not None else scenario.seed
+    seed = settings.seed if settings.seed is not None else scenario.seed
+    faults = fault_profile(scenario, settings).name
+
+    def failed(reason: str, diagnostics: str) -> RunResult:
         return RunResult(
-            scenario.name,
-            link_name,
-            seed,
-            threshold,
-            fault_profile(scenario, settings).name,
-            error=str(err),
-            diagnostics=link.diagnostics(),
-            not_started=True,
+            scenario.name, link_name, seed, threshold, faults, error=reason, diagnostics=diagnostics
         )
-    finally:
-        link.close()
+
+    return with_link(
+        link_name,
+        replace(options, threshold=threshold, scan_rate_hz=rate),
+        lambda link: run_scenario(scenario, link, settings, on_tick=on_tick),
+        failed,
+    )
 
 
 def run_suite(

@@ -32,6 +32,7 @@ class RunResult:
     seed: int
     threshold: float
     faults: str
+    noise_sigma: float = 0.0  # the fault profile's noise, which widens the oracle's band
     records: list[TickRecord] = field(default_factory=list)
     error: str | None = None
     diagnostics: str = ""  # e.g. the node's last stderr lines, shown on failure
