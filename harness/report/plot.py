@@ -1,0 +1,174 @@
+"""One PNG per scenario: what the node saw, what it said, and where it went wrong.
+
+Two steps so each can be checked on its own: ``plot_series`` turns a run
+into plain arrays (pure numpy), ``render_plot`` draws them. matplotlib is
+imported only when drawing (Agg, no display), so commands that never plot
+stay quick to start.
+"""
+
+from __future__ import annotations
+
+import io
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from harness.report.files import write_atomically
+from harness.report.summary import verdict_of
+from harness.trace import RunResult
+
+__all__ = ["PlotSeries", "plot_series", "render_plot", "write_plot"]
+
+WIDTH_IN, HEIGHT_IN, DPI = 8.0, 5.0, 90  # about 720 x 450 px: a few tens of kB
+FAILED_COLOUR = "#f2b8b8"
+
+
+@dataclass(frozen=True)
+class PlotSeries:
+    """Per-tick arrays, all the same length; NaN marks "nothing to draw here"."""
+
+    title: str
+    threshold: float
+    t: np.ndarray  # simulated time of each scan, s
+    nearest: np.ndarray  # min valid range of the scan the node saw (NaN: no valid reading)
+    claimed: np.ndarray  # the node's distance (NaN: none given, or not finite)
+    claimed_nonfinite: np.ndarray  # bool: the status gave inf or nan as the distance
+    warning_expected: np.ndarray  # 1 True, 0 False, NaN either (within the band)
+    warning_got: np.ndarray  # 1 True, 0 False, NaN no Bool
+    failed: np.ndarray  # bool
+
+
+def _nearest_valid(ranges: np.ndarray, range_min: float, range_max: float) -> float:
+    """REP-117: the smallest finite reading within [range_min, range_max], else NaN."""
+    r = np.asarray(ranges, dtype=np.float32)
+    with np.errstate(invalid="ignore"):
+        valid = np.isfinite(r) & (r >= range_min) & (r <= range_max)
+    return float(r[valid].min()) if valid.any() else math.nan
+
+
+def _flag(value: bool | None) -> float:
+    return math.nan if value is None else float(value)
+
+
+def plot_series(result: RunResult) -> PlotSeries:
+    """The arrays a plot of `result` shows (the scan judged is the one the node saw)."""
+    nearest, claimed, odd = [], [], []
+    for r in result.records:
+        seen = r.answers.seen if r.answers.seen is not None else r.scan
+        nearest.append(_nearest_valid(seen.ranges, seen.range_min, seen.range_max))
+        claim = r.verdict.claim
+        d = claim.distance if claim is not None and claim.obstacle else None
+        finite = d is not None and math.isfinite(d)
+        claimed.append(d if finite else math.nan)
+        odd.append(d is not None and not finite)
+    records = result.records
+    failed = len(result.failed_ticks)
+    counted = f"{failed} of {len(records)} ticks failed" if failed else f"{len(records)} ticks"
+    title = f"{result.scenario} · {result.link} · {verdict_of(result)} ({counted})"
+    return PlotSeries(
+        title=title,
+        threshold=float(result.threshold),
+        t=np.array([r.t for r in records], dtype=float),
+        nearest=np.array(nearest, dtype=float),
+        claimed=np.array(claimed, dtype=float),
+        claimed_nonfinite=np.array(odd, dtype=bool),
+        warning_expected=np.array([_flag(r.verdict.expected.warning) for r in records]),
+        warning_got=np.array([_flag(r.verdict.warning_got) for r in records]),
+        failed=np.array([not r.verdict.ok for r in records], dtype=bool),
+    )
+
+
+def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
+    """[start, end] index pairs of the consecutive True stretches in `mask`."""
+    edges = np.diff(np.concatenate(([0], mask.astype(np.int8), [0])))
+    starts, ends = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1) - 1
+    return [(int(a), int(b)) for a, b in zip(starts, ends, strict=True)]
+
+
+def _spans(t: np.ndarray, mask: np.ndarray) -> list[tuple[float, float]]:
+    """(x, width) bars covering each stretch of ticks, half a tick either side."""
+    step = float(np.median(np.diff(t))) if t.size > 1 else 0.1
+    return [(t[a] - step / 2, t[b] - t[a] + step) for a, b in _runs(mask)]
+
+
+def render_plot(series: PlotSeries) -> bytes:
+    """The PNG bytes (deterministic: no software or date in the metadata)."""
+    from matplotlib.figure import Figure  # lazy: matplotlib takes a while to import
+
+    fig = Figure(figsize=(WIDTH_IN, HEIGHT_IN), dpi=DPI, layout="constrained")
+    top, bottom = fig.subplots(
+        2, 1, sharex=True, gridspec_kw={"height_ratios": [3, 1]}, squeeze=True
+    )
+    fig.suptitle(series.title, fontsize=10)
+    t = series.t
+    failed_spans = _spans(t, series.failed)
+    band_spans = _spans(t, np.isnan(series.warning_expected))
+    for ax in (top, bottom):
+        if failed_spans:
+            ax.broken_barh(
+                failed_spans, (0, 1), transform=ax.get_xaxis_transform(), color=FAILED_COLOUR, lw=0
+            )
+        ax.grid(True, lw=0.4, alpha=0.5)
+        ax.tick_params(labelsize=8)
+
+    # Top: distances.
+    finite = np.concatenate([series.nearest[np.isfinite(series.nearest)], [series.threshold]])
+    ceiling = 1.15 * float(finite.max())
+    top.set_ylim(0, ceiling)
+    top.plot(t, series.nearest, color="#1f5fa8", lw=1.4, label="nearest valid return (seen)")
+    top.axhline(series.threshold, color="#555555", ls="--", lw=1, label="threshold")
+    shown = np.isfinite(series.claimed) & (series.claimed <= ceiling)
+    above = (np.isfinite(series.claimed) & ~shown) | series.claimed_nonfinite
+    top.plot(t[shown], series.claimed[shown], "o", ms=2.5, color="#e07b00", label="node's distance")
+    if above.any():
+        top.plot(
+            t[above],
+            np.full(int(above.sum()), ceiling * 0.985),
+            "^",
+            ms=4,
+            color="#e07b00",
+            clip_on=False,
+            label="node's distance off the scale (or inf/nan)",
+        )
+    if series.failed.any():
+        top.plot([], [], "s", color=FAILED_COLOUR, label="failed tick")
+    top.set_ylabel("range, m", fontsize=8)
+
+    # Bottom: the warning Bool.
+    for x, width in band_spans:
+        bottom.axvspan(x, x + width, color="#dddddd", lw=0)
+    expected = series.warning_expected
+    bottom.step(t, expected, where="mid", color="#2e8b57", lw=3, alpha=0.45, label="expected")
+    bottom.plot(t, series.warning_got, "o", ms=2.5, color="#222222", label="received")
+    if band_spans:
+        bottom.plot([], [], "s", color="#dddddd", label="either accepted")
+    bottom.set_ylim(-0.3, 1.3)
+    bottom.set_yticks([0, 1], ["False", "True"])
+    bottom.set_ylabel("warning", fontsize=8)
+    bottom.set_xlabel("simulated time, s", fontsize=8)
+    handles, labels = top.get_legend_handles_labels()
+    more, more_labels = bottom.get_legend_handles_labels()
+    fig.legend(
+        handles + more,
+        labels + [f"warning {x}" for x in more_labels],
+        loc="outside lower center",
+        ncols=4,
+        fontsize=7,
+        frameon=False,
+    )
+    if t.size:
+        step = float(np.median(np.diff(t))) if t.size > 1 else 0.1
+        bottom.set_xlim(t[0] - step, t[-1] + step)
+    else:
+        top.text(0.5, 0.5, "no ticks", transform=top.transAxes, ha="center", va="center")
+
+    out = io.BytesIO()
+    fig.savefig(out, format="png", metadata={"Software": None})
+    return out.getvalue()
+
+
+def write_plot(path: Path, result: RunResult) -> Path:
+    """The report's plot writer: render, then write atomically."""
+    return write_atomically(path, render_plot(plot_series(result)))

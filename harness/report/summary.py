@@ -1,0 +1,134 @@
+"""Run results as plain JSON-ready data: one entry per scenario, one per tick (pure).
+
+The same words the terminal table shows (PASS, FAIL, ERROR, NOT RUN), so a
+CI script reading summary.json and a person reading the table agree.
+Non-finite floats (a status saying "inf") become the strings "inf", "-inf"
+and "nan": the files stay strict JSON that any parser reads.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+from harness import __version__
+from harness.trace import RunResult, TickRecord
+
+__all__ = [
+    "FORMAT",
+    "json_bytes",
+    "run_summary",
+    "scenario_details",
+    "scenario_entry",
+    "tick_entry",
+    "verdict_of",
+]
+
+FORMAT = 1  # bump when a key changes meaning or disappears (docs/reports.md)
+
+
+def verdict_of(result: RunResult) -> str:
+    """PASS, FAIL (some tick failed), ERROR (the run broke, no tick failed) or NOT RUN."""
+    if result.ok:
+        return "PASS"
+    if result.not_run:
+        return "NOT RUN"
+    return "ERROR" if result.error and not result.failed_ticks else "FAIL"
+
+
+def _number(x: float | None) -> float | str | None:
+    if x is None:
+        return None
+    x = float(x)
+    if math.isnan(x):
+        return "nan"
+    if math.isinf(x):
+        return "inf" if x > 0 else "-inf"
+    return x
+
+
+def scenario_entry(result: RunResult, files: Mapping[str, str | None]) -> dict[str, Any]:
+    """One scenario as summary.json lists it; `files` maps artifact names to paths."""
+    failed = result.failed_ticks
+    return {
+        "scenario": result.scenario,
+        "verdict": verdict_of(result),
+        "ok": result.ok,
+        "link": result.link,
+        "seed": result.seed,
+        "threshold": _number(result.threshold),
+        "faults": result.faults,
+        "ticks": len(result.records),
+        "failed": len(failed),
+        "failed_ticks": [r.tick for r in failed],
+        "first_failure": result.first_failure,
+        "error": result.error,
+        "wall_s": round(result.wall_s, 3),
+        "files": dict(files),
+    }
+
+
+def tick_entry(record: TickRecord) -> dict[str, Any]:
+    """One tick: pose, what a correct node says, what this node said, what failed."""
+    v = record.verdict
+    exp = v.expected
+    claim = v.claim
+    answers = record.answers
+    return {
+        "tick": record.tick,
+        "t": _number(record.t),
+        "pose": [_number(record.x), _number(record.y), _number(record.yaw)],
+        "ok": v.ok,
+        "expected": {
+            "obstacle": exp.obstacle,
+            "distance": _number(exp.distance),
+            "angle": _number(exp.angle),
+            "index": exp.index,
+            "warning": exp.warning,
+        },
+        "status": claim.text if claim is not None else None,
+        "claim": None
+        if claim is None
+        else {
+            "obstacle": claim.obstacle,
+            "distance": _number(claim.distance),
+            "angle": _number(claim.angle),
+        },
+        "warning": v.warning_got,
+        "waited_s": round(answers.waited, 4),
+        "timed_out": answers.timed_out,
+        "scan_seen_from_device": answers.seen is not None,
+        "failures": list(v.failures),
+    }
+
+
+def scenario_details(result: RunResult, files: Mapping[str, str | None]) -> dict[str, Any]:
+    """The per-scenario file: its summary entry, the node's output, every tick."""
+    return {
+        "format": FORMAT,
+        **scenario_entry(result, files),
+        "diagnostics": result.diagnostics,
+        "records": [tick_entry(r) for r in result.records],
+    }
+
+
+def run_summary(entries: Sequence[dict[str, Any]]) -> dict[str, Any]:
+    """summary.json: totals first (what CI checks), then every scenario."""
+    passed = sum(1 for e in entries if e["ok"])
+    return {
+        "format": FORMAT,
+        "harness": __version__,
+        "ok": passed == len(entries),
+        "total": len(entries),
+        "passed": passed,
+        "failed": len(entries) - passed,
+        "wall_s": round(sum(e["wall_s"] for e in entries), 3),
+        "scenarios": list(entries),
+    }
+
+
+def json_bytes(data: Any) -> bytes:
+    """Strict, stable JSON (no NaN literals; keys in the order built)."""
+    return (json.dumps(data, indent=2, allow_nan=False, ensure_ascii=False) + "\n").encode()
