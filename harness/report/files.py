@@ -22,3 +22,8 @@ def write_atomically(path: str | Path, data: bytes) -> Path:
         Path(temporary).unlink(missing_ok=True)
         raise
     return target
+
+
+def relative_path(path: str | Path, folder: str | Path) -> str:
+    """`path` as seen from `folder` (POSIX separators), for links inside report files."""
+    return Path(os.path.relpath(Path(path).resolve(), Path(folder).resolve())).as_posix()

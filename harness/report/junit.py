@@ -1,19 +1,43 @@
-"""JUnit XML: one test case per scenario, the oracle's explanation as the failure."""
+"""JUnit XML: one test case per scenario, the oracle's explanation as the failure.
+
+Each case carries properties: the run's settings and counts, the first
+failure's explanation (`explanation`, when the scenario did not pass) and
+the files written for it (`plot`, `recording`, `summary`, when written).
+File paths are relative to the folder holding the XML file, so a CI
+artifact with the report folder keeps its links; without a known folder
+they are absolute.
+"""
 
 from __future__ import annotations
 
 import xml.etree.ElementTree as ET
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 
-from harness.report.files import write_atomically
+from harness.report.files import relative_path, write_atomically
 from harness.trace import RunResult
 
 MAX_LISTED_FAILURES = 50
 
 
-def junit_xml(results: Sequence[RunResult], *, suite: str = "fossbot-hil") -> bytes:
-    """The report as bytes (CI systems read `failure/@message` and the properties)."""
+def _shown_path(path: Path, base: Path | None) -> str:
+    return str(path.resolve()) if base is None else relative_path(path, base)
+
+
+def junit_xml(
+    results: Sequence[RunResult],
+    *,
+    suite: str = "fossbot-hil",
+    artifacts: Sequence[Mapping[str, Path]] | None = None,
+    base: Path | None = None,
+) -> bytes:
+    """The report as bytes (CI systems read `failure/@message` and the properties).
+
+    `artifacts[i]` names the files written for `results[i]` (name -> path);
+    `base` is the folder the XML file will live in.
+    """
+    if artifacts is not None and len(artifacts) != len(results):
+        raise ValueError("junit_xml: one artifacts mapping per result")
     failures = sum(1 for r in results if r.failed_ticks)
     errors = sum(1 for r in results if r.error and not r.failed_ticks and not r.not_run)
     root = ET.Element("testsuites")
@@ -26,7 +50,7 @@ def junit_xml(results: Sequence[RunResult], *, suite: str = "fossbot-hil") -> by
         errors=str(errors),
         time=f"{sum(r.wall_s for r in results):.3f}",
     )
-    for r in results:
+    for i, r in enumerate(results):
         case = ET.SubElement(
             node, "testcase", classname=f"{suite}.{r.link}", name=r.scenario, time=f"{r.wall_s:.3f}"
         )
@@ -40,6 +64,10 @@ def junit_xml(results: Sequence[RunResult], *, suite: str = "fossbot-hil") -> by
             ("failed_ticks", len(r.failed_ticks)),
         ):
             ET.SubElement(props, "property", name=key, value=str(value))
+        if r.first_failure:
+            ET.SubElement(props, "property", name="explanation", value=r.first_failure)
+        for name, path in (artifacts[i] if artifacts is not None else {}).items():
+            ET.SubElement(props, "property", name=name, value=_shown_path(path, base))
         if r.ok:
             continue
         if r.not_run:
@@ -58,5 +86,12 @@ def junit_xml(results: Sequence[RunResult], *, suite: str = "fossbot-hil") -> by
     return ET.tostring(root, encoding="utf-8", xml_declaration=True)
 
 
-def write_junit(path: str | Path, results: Sequence[RunResult]) -> Path:
-    return write_atomically(path, junit_xml(results))
+def write_junit(
+    path: str | Path,
+    results: Sequence[RunResult],
+    *,
+    artifacts: Sequence[Mapping[str, Path]] | None = None,
+) -> Path:
+    """Write atomically; artifact paths relative to the XML file's folder."""
+    base = Path(path).resolve().parent
+    return write_atomically(path, junit_xml(results, artifacts=artifacts, base=base))

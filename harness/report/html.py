@@ -1,0 +1,110 @@
+"""index.html: the run on one page, readable offline and from a CI artifact.
+
+Built from summary.json's data (so the page and the file cannot disagree),
+plain HTML with inline CSS, no scripts. All text is escaped: scenario
+names and status strings come from users and students.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from html import escape
+from typing import Any
+from urllib.parse import quote
+
+__all__ = ["index_html"]
+
+DIAGNOSTIC_LINES = 15
+
+_STYLE = """
+body { font: 14px/1.4 system-ui, sans-serif; margin: 1.5em auto; max-width: 60em; color: #222; }
+table { border-collapse: collapse; }
+th, td { padding: 0.2em 0.7em; text-align: left; border-bottom: 1px solid #ddd; }
+td.n { text-align: right; font-variant-numeric: tabular-nums; }
+.PASS { color: #1a7f37; font-weight: bold; }
+.FAIL, .ERROR { color: #c62828; font-weight: bold; }
+.NOT_RUN { color: #9a6700; font-weight: bold; }
+p.failure { color: #c62828; font-family: monospace; white-space: pre-wrap; }
+pre { background: #f6f6f6; padding: 0.5em; overflow-x: auto; }
+img { max-width: 100%; border: 1px solid #ddd; }
+"""
+
+
+def _text(value: object) -> str:
+    return escape(str(value), quote=True)
+
+
+def _href(path: str) -> str:
+    return escape(quote(path), quote=True)
+
+
+def _verdict(verdict: str) -> str:
+    return f'<span class="{verdict.replace(" ", "_")}">{_text(verdict)}</span>'
+
+
+def _file_links(files: Mapping[str, str | None]) -> str:
+    return " ".join(f'<a href="{_href(p)}">{_text(n)}</a>' for n, p in files.items() if p)
+
+
+def _row(i: int, e: Mapping[str, Any]) -> str:
+    cells = [
+        f'<a href="#scenario-{i}">{_text(e["scenario"])}</a>',
+        _text(e["link"]),
+        f'<td class="n">{e["ticks"]}',
+        f'<td class="n">{e["failed"]}',
+        _verdict(e["verdict"]),
+        f'<td class="n">{e["wall_s"]:.2f}',
+        f'<td class="n">{_text(e["seed"])}',
+        f'<td class="n">{_text(e["threshold"])}',
+        _text(e["faults"]),
+        _file_links(e["files"]),
+    ]
+    return "<tr>" + "".join(c if c.startswith("<td") else f"<td>{c}" for c in cells) + "</tr>"
+
+
+def _section(i: int, e: Mapping[str, Any], diagnostics: str) -> list[str]:
+    out = [f'<h2 id="scenario-{i}">{_text(e["scenario"])} {_verdict(e["verdict"])}</h2>']
+    detail = f"{e['ticks']} ticks, {e['failed']} failed; link {e['link']}, seed {e['seed']}"
+    out.append(f"<p>{_text(detail)}. {_file_links(e['files'])}</p>")
+    if e["first_failure"]:
+        out.append(f'<p class="failure">{_text(e["first_failure"])}</p>')
+    error = e["error"]
+    if error and error not in (e["first_failure"] or ""):
+        out.append(f'<p class="failure">run ended: {_text(error)}</p>')
+    if diagnostics and not e["ok"]:
+        tail = "\n".join(diagnostics.rstrip().splitlines()[-DIAGNOSTIC_LINES:])
+        out.append(f"<pre>{_text(tail)}</pre>")
+    plot = e["files"].get("plot")
+    if plot:
+        alt = f"plot of {e['scenario']}: ranges, the node's answers and failed ticks over time"
+        out.append(
+            f'<p><a href="{_href(plot)}"><img src="{_href(plot)}" alt="{_text(alt)}" '
+            'loading="lazy"></a></p>'
+        )
+    return out
+
+
+def index_html(summary: Mapping[str, Any], *, diagnostics: Sequence[str] = ()) -> bytes:
+    """The page for a run summary (see harness.report.summary.run_summary)."""
+    entries = summary["scenarios"]
+    headline = f"{summary['passed']} of {summary['total']} scenarios passed"
+    head = ["scenario", "link", "ticks", "failed", "verdict", "wall s", "seed", "threshold"]
+    lines = [
+        "<!DOCTYPE html>",
+        '<html lang="en">',
+        '<head><meta charset="utf-8">',
+        f"<title>fossbot-hil: {_text(headline)}</title>",
+        f"<style>{_STYLE}</style></head>",
+        "<body>",
+        f"<h1>fossbot-hil: {_text(headline)}</h1>",
+        '<p>Machine-readable: <a href="summary.json">summary.json</a>, '
+        '<a href="junit.xml">junit.xml</a>.</p>',
+        "<table>",
+        "<tr>" + "".join(f"<th>{h}" for h in [*head, "faults", "files"]) + "</tr>",
+        *(_row(i, e) for i, e in enumerate(entries)),
+        "</table>",
+    ]
+    for i, e in enumerate(entries):
+        lines.extend(_section(i, e, diagnostics[i] if i < len(diagnostics) else ""))
+    lines += ["</body>", "</html>", ""]
+    return "\n".join(lines).encode()

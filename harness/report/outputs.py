@@ -1,0 +1,204 @@
+"""The report folder (`fossbot-hil run --out DIR`): per-scenario files, then the run's.
+
+Layout (docs/reports.md)::
+
+    DIR/summary.json  junit.xml  index.html
+    DIR/scenarios/<name>.png  <name>.mcap  <name>.json
+
+Per-scenario artifacts come from a short list of writers, each
+``(name, suffix, write(path, result) -> Path)``: adding a kind of file is
+one entry in ``artifact_writers``. Every file lands atomically: a writer
+writes a hidden temporary file beside the final name, which is renamed
+over it only once the writer returned, so an interrupted run never leaves
+half a file under its final name. Paths inside a report file are relative
+to the folder of that file, so the folder can be moved or archived whole.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import tempfile
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from harness.errors import ConfigError
+from harness.report.files import relative_path, write_atomically
+from harness.report.summary import json_bytes, run_summary, scenario_details, scenario_entry
+from harness.trace import RunResult
+
+__all__ = [
+    "ArtifactWriter",
+    "ReportFolder",
+    "ScenarioFiles",
+    "artifact_writers",
+    "prepare_folder",
+    "write_report",
+]
+
+SCENARIO_FOLDER = "scenarios"
+SUMMARY, JUNIT, INDEX = "summary.json", "junit.xml", "index.html"
+DETAILS = "summary"  # the name of each scenario's own JSON file in `files`
+
+
+@dataclass(frozen=True)
+class ArtifactWriter:
+    """One kind of per-scenario file: `write` must write `path` and return it."""
+
+    name: str  # key in summary.json's `files` and a JUnit property name
+    suffix: str  # file name = <scenario><suffix>
+    write: Callable[[Path, RunResult], Path]
+
+
+def _write_plot(path: Path, result: RunResult) -> Path:
+    from harness.report.plot import write_plot  # numpy now, matplotlib only when drawing
+
+    return write_plot(path, result)
+
+
+def artifact_writers() -> list[ArtifactWriter]:
+    """The per-scenario artifacts, in the order they are written."""
+    return [
+        ArtifactWriter("plot", ".png", _write_plot),
+        # RECORDING (issue 5): harness/record/ will provide
+        # write_recording(path: Path, result: RunResult) -> Path (one MCAP per scenario).
+        # Once it exists, this one line is all it takes to add it to every report:
+        # ArtifactWriter("recording", ".mcap", _write_recording),
+    ]
+
+
+def _write_recording(path: Path, result: RunResult) -> Path:
+    """The recording writer, imported when first used (see `artifact_writers`)."""
+    from harness.record import write_recording  # type: ignore[import-not-found]
+
+    return write_recording(path, result)
+
+
+def prepare_folder(path: str | Path) -> Path:
+    """Create the report folder (and its parents) now, before anything runs.
+
+    ConfigError, one line, when `path` is a file or cannot be created or
+    written.
+    """
+    folder = Path(path)
+    if folder.exists() and not folder.is_dir():
+        raise ConfigError(f"{path}: exists and is not a folder")
+    try:
+        (folder / SCENARIO_FOLDER).mkdir(parents=True, exist_ok=True)
+    except FileExistsError:
+        raise ConfigError(f"{path}: a part of this path is a file, not a folder") from None
+    except OSError as err:
+        raise ConfigError(f"{path}: cannot create the folder: {err.strerror or err}") from None
+    for where in (folder, folder / SCENARIO_FOLDER):
+        if not os.access(where, os.W_OK | os.X_OK):
+            raise ConfigError(f"{path}: folder is not writable")
+    return folder
+
+
+def _safe_stem(name: str) -> str:
+    """A scenario name as a portable file name (letters, digits, . _ -)."""
+    stem = re.sub(r"[^A-Za-z0-9._-]+", "_", name).strip("._")
+    return stem[:100] or "scenario"
+
+
+def _write_via_temporary(writer: ArtifactWriter, final: Path, result: RunResult) -> Path:
+    """Run `writer` on a hidden temporary file, then rename it to `final` (atomic)."""
+    handle, name = tempfile.mkstemp(
+        prefix=f".{final.name}.", suffix=writer.suffix, dir=final.parent
+    )
+    os.close(handle)
+    temporary = Path(name)
+    try:
+        written = Path(writer.write(temporary, result))
+        if written != temporary:
+            temporary.unlink(missing_ok=True)
+            return written  # the writer chose its own path; it answers for it
+        with open(temporary, "rb") as done:
+            os.fsync(done.fileno())
+        os.replace(temporary, final)
+    except BaseException:
+        temporary.unlink(missing_ok=True)
+        raise
+    return final
+
+
+@dataclass
+class ScenarioFiles:
+    """What was written for one scenario: artifact name -> absolute path."""
+
+    result: RunResult
+    paths: dict[str, Path] = field(default_factory=dict)
+
+
+class ReportFolder:
+    """Fills a report folder: `add` each result as it finishes, then `finish`.
+
+    Writing per scenario as soon as it ends keeps the plots of finished
+    scenarios when a later one hangs or the run is interrupted.
+    """
+
+    def __init__(self, root: str | Path, writers: Sequence[ArtifactWriter] | None = None) -> None:
+        self.root = prepare_folder(root)
+        self.writers = list(writers) if writers is not None else artifact_writers()
+        self.scenarios: list[ScenarioFiles] = []
+        self._stems: set[str] = set()
+
+    def _stem(self, scenario: str) -> str:
+        """A file stem no earlier scenario of this run took (names may repeat)."""
+        base = _safe_stem(scenario)
+        stem, n = base, 1
+        while stem.lower() in self._stems:
+            n += 1
+            stem = f"{base}-{n}"
+        self._stems.add(stem.lower())
+        return stem
+
+    def add(self, result: RunResult) -> ScenarioFiles:
+        """Write this scenario's artifacts (none for a scenario with no ticks) and its JSON."""
+        folder = self.root / SCENARIO_FOLDER
+        stem = self._stem(result.scenario)
+        files = ScenarioFiles(result)
+        if result.records:
+            for writer in self.writers:
+                final = folder / f"{stem}{writer.suffix}"
+                files.paths[writer.name] = _write_via_temporary(writer, final, result)
+        details = folder / f"{stem}.json"
+        files.paths[DETAILS] = details
+        names = self._names(files, relative_to=folder)
+        write_atomically(details, json_bytes(scenario_details(result, names)))
+        self.scenarios.append(files)
+        return files
+
+    def _names(self, files: ScenarioFiles, *, relative_to: Path) -> dict[str, str | None]:
+        """Every artifact name (None where not written) -> path relative to a folder."""
+        names: dict[str, str | None] = {w.name: None for w in self.writers}
+        for name, path in files.paths.items():
+            names[name] = relative_path(path, relative_to)
+        return names
+
+    def finish(self) -> Path:
+        """Write summary.json, junit.xml and index.html; return the index page."""
+        from harness.report.html import index_html
+        from harness.report.junit import junit_xml
+
+        done = self.scenarios
+        entries = [scenario_entry(s.result, self._names(s, relative_to=self.root)) for s in done]
+        summary = run_summary(entries)
+        write_atomically(self.root / SUMMARY, json_bytes(summary))
+        results = [s.result for s in done]
+        xml = junit_xml(results, artifacts=[s.paths for s in done], base=self.root)
+        write_atomically(self.root / JUNIT, xml)
+        page = index_html(summary, diagnostics=[s.result.diagnostics for s in done])
+        return write_atomically(self.root / INDEX, page)
+
+
+def write_report(
+    root: str | Path, results: Sequence[RunResult], writers: Sequence[ArtifactWriter] | None = None
+) -> ReportFolder:
+    """The whole folder for results already at hand (the CLI adds them one by one)."""
+    report = ReportFolder(root, writers)
+    for result in results:
+        report.add(result)
+    report.finish()
+    return report
