@@ -3,8 +3,9 @@
 from __future__ import annotations
 
 import argparse
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING, Any, TypeVar
 
 from rich.console import Console
 
@@ -21,6 +22,12 @@ from harness.commands.arguments import (
 from harness.errors import ConfigError
 from harness.runner import RunSettings
 from harness.scenario import Scenario, resolve_scenario, shipped_scenarios
+from harness.trace import RunResult
+
+if TYPE_CHECKING:
+    from harness.report.outputs import ReportFolder
+
+T = TypeVar("T")
 
 NAME = "run"
 HELP = "run scenarios and judge the node's answers"
@@ -43,6 +50,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     add_judging_options(parser)
     parser.add_argument("--gui", action="store_true", help="open the PyBullet viewer")
     parser.add_argument("--junit-xml", metavar="FILE", help="write a JUnit XML report")
+    parser.add_argument(
+        "--out",
+        metavar="DIR",
+        help="write a report folder: plots, summary.json, junit.xml, index.html "
+        "(see docs/reports.md)",
+    )
     add_node_options(parser)
 
     serial = parser.add_argument_group("serial links (rplidar, ldlidar)")
@@ -77,7 +90,20 @@ def settings_from(args: argparse.Namespace) -> RunSettings:
     )
 
 
+def open_report(out: str | None) -> ReportFolder | None:
+    """The `--out` folder, created now so a bad path fails before anything runs."""
+    if not out:
+        return None
+    from harness.report.outputs import ReportFolder
+
+    try:
+        return ReportFolder(out)
+    except ConfigError as err:
+        raise ConfigError(f"--out {err}") from None
+
+
 def run(args: argparse.Namespace, console: Console) -> int:
+    from harness.report.progress import RunProgress
     from harness.report.terminal import print_results
 
     check_link_options(args)
@@ -85,15 +111,45 @@ def run(args: argparse.Namespace, console: Console) -> int:
     if args.junit_xml and not Path(args.junit_xml).resolve().parent.is_dir():
         raise ConfigError(f"--junit-xml {args.junit_xml}: its folder does not exist")
     check_status_regex(args)
+    report = open_report(args.out)
     from harness.runner import run_suite
 
-    results = run_suite(scenarios, args.link, link_options(args), settings_from(args))
+    with RunProgress(console, [s.name for s in scenarios]) as progress:
+
+        def finished(result: RunResult) -> None:
+            progress.on_result(result)
+            if report is not None:
+                _write(f"--out {args.out}", report.add, result)
+
+        results = run_suite(
+            scenarios,
+            args.link,
+            link_options(args),
+            settings_from(args),
+            on_tick=progress.on_tick,
+            on_result=finished,
+        )
     print_results(console, results)
+    if report is not None:
+        index = _write(f"--out {args.out}", report.finish)
+        console.print(f"report: {index}", highlight=False, markup=False, soft_wrap=True)
     if args.junit_xml:
         from harness.report.junit import write_junit
 
-        try:
-            write_junit(args.junit_xml, results)
-        except OSError as err:
-            raise ConfigError(f"--junit-xml {args.junit_xml}: {err.strerror or err}") from None
+        artifacts = [s.paths for s in report.scenarios] if report is not None else None
+        _write(
+            f"--junit-xml {args.junit_xml}",
+            write_junit,
+            args.junit_xml,
+            results,
+            artifacts=artifacts,
+        )
     return 0 if all(r.ok for r in results) else 1
+
+
+def _write(option: str, writer: Callable[..., T], *args: Any, **kwargs: Any) -> T:
+    """Run a report writer; a file system error is the user's to fix, in one line."""
+    try:
+        return writer(*args, **kwargs)
+    except OSError as err:
+        raise ConfigError(f"{option}: {err.strerror or err}") from None

@@ -7,10 +7,12 @@ from collections.abc import Sequence
 from rich.console import Console
 from rich.table import Table
 
+from harness.report.summary import verdict_of
 from harness.scenario import Scenario
 from harness.trace import RunResult
 
 DIAGNOSTIC_LINES = 15
+VERDICT_STYLES = {"PASS": "green", "FAIL": "red", "ERROR": "red", "NOT RUN": "yellow"}
 
 
 def scenario_table(scenarios: Sequence[Scenario]) -> Table:
@@ -32,12 +34,8 @@ def results_table(results: Sequence[RunResult]) -> Table:
             column, justify="right" if column in ("ticks", "failed", "wall s") else "left"
         )
     for r in results:
-        if r.ok:
-            verdict = "[green]PASS[/]"
-        elif r.not_run:
-            verdict = "[yellow]NOT RUN[/]"
-        else:
-            verdict = "[red]ERROR[/]" if r.error and not r.failed_ticks else "[red]FAIL[/]"
+        word = verdict_of(r)
+        verdict = f"[{VERDICT_STYLES[word]}]{word}[/]"
         table.add_row(
             r.scenario,
             r.link,
@@ -75,8 +73,9 @@ def print_results(console: Console, results: Sequence[RunResult]) -> None:
     not_run = [r for r in failed if r.not_run]
     if not_run:
         console.print()
+        reason = (not_run[0].error or "").removeprefix("not run: ")
         console.print(
-            f"{len(not_run)} not run: {not_run[0].error.removeprefix('not run: ')}",
+            f"{len(not_run)} not run: {reason}",
             highlight=False,
             markup=False,
         )
