@@ -1,0 +1,241 @@
+"""`fossbot-hil grade DIR...`: build and test each student's node; write the class table.
+
+Exit 0 once every student is graded (their failures are the output, not
+an error), 2 for bad input. The rules for what counts as a student, and the
+output folder's layout, are in docs/grading.md.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib.util
+import shutil
+import time
+from pathlib import Path
+
+from rich.console import Console
+
+from harness.commands.arguments import (
+    add_judging_options,
+    add_link_option,
+    add_node_options,
+    check_status_regex,
+    fault_list,
+    link_options,
+    positive,
+    seed,
+)
+from harness.errors import ConfigError
+from harness.grading import LAB_EXECUTABLE, LAB_PACKAGE
+from harness.grading.discover import GRADES_MARKER, Student
+from harness.scenario import Scenario, resolve_scenario, shipped_scenarios
+
+NAME = "grade"
+HELP = "build and test every student's node in DIR; write the class table (CSV, HTML)"
+
+NODE_LINKS = ("ros2", "rplidar", "ldlidar")  # the links that start a node
+NOT_FOR_GRADING = {
+    "node": "each student's node comes from their folder",
+    "workspace": "each student's folder is built into --out",
+    "domain_id": "each student's run reserves a free ROS domain id",
+    "ros_network": "students are graded on this machine only",
+}
+
+
+def jobs(text: str) -> int:
+    """--jobs: a whole number of students graded at once."""
+    try:
+        value = int(text)
+    except ValueError:
+        value = 0
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"jobs must be a whole number >= 1, got {text!r}")
+    return value
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "dirs",
+        nargs="+",
+        metavar="DIR",
+        help="folder with one folder per student (or one student's workspace or package)",
+    )
+    parser.add_argument(
+        "--out",
+        default="grades",
+        metavar="DIR",
+        help="where the class table and each student's logs go (default: grades)",
+    )
+    parser.add_argument(
+        "--jobs",
+        type=jobs,
+        default=1,
+        metavar="N",
+        help="students graded at once (default 1)",
+    )
+    parser.add_argument(
+        "--scenario",
+        action="append",
+        default=[],
+        metavar="NAME[,NAME]",
+        help="scenario name or file (repeatable; default: all shipped)",
+    )
+    add_link_option(parser)
+    parser.add_argument("--seed", type=seed, help="override the scenarios' seed")
+    parser.add_argument(
+        "--faults",
+        metavar="NAME[,NAME]",
+        help="fault profiles replacing the scenarios' own (see docs/faults.md)",
+    )
+    add_judging_options(parser)
+    parser.add_argument(
+        "--build-timeout",
+        type=positive("build timeout"),
+        default=300.0,
+        metavar="S",
+        help="longest one student's colcon build may take (default 300)",
+    )
+    parser.add_argument(
+        "--student-timeout",
+        type=positive("student timeout"),
+        default=900.0,
+        metavar="S",
+        help="longest one student's scenario suite may take (default 900)",
+    )
+    add_node_options(parser)
+    parser.set_defaults(package=LAB_PACKAGE, executable=LAB_EXECUTABLE)
+
+
+def check_grading_options(args: argparse.Namespace) -> None:
+    """Options `run` takes that make no sense for a class are mistakes, not ignored."""
+    for name, why in NOT_FOR_GRADING.items():
+        if getattr(args, name):
+            raise ConfigError(f"--{name.replace('_', '-')} does not apply to grade: {why}")
+    if args.link not in NODE_LINKS:
+        known = ", ".join(NODE_LINKS)
+        raise ConfigError(f"--link {args.link}: grade runs students' nodes (use {known})")
+    if not args.package or not args.executable:
+        raise ConfigError("--package and --executable must name the lab's node")
+    if importlib.util.find_spec("rclpy") is None:
+        raise ConfigError(
+            "grading needs rclpy: pip install 'fossbot-hil[ros]' (or source ROS 2 Jazzy)"
+        )
+
+
+def selected_scenarios(items: list[str]) -> list[Scenario]:
+    """`--scenario` items (comma lists allowed), all resolved now; default every shipped one."""
+    names = [n.strip() for item in items for n in item.split(",") if n.strip()]
+    scenarios = [resolve_scenario(n) for n in names] if names else shipped_scenarios()
+    seen: set[str] = set()
+    for s in scenarios:
+        if s.name in seen:
+            raise ConfigError(f"--scenario {s.name}: given twice")
+        seen.add(s.name)
+    return scenarios
+
+
+def prepare_out(out: Path) -> Path:
+    """The output folder, new or one of ours; never someone's folder of other files."""
+    if out.exists() and not out.is_dir():
+        raise ConfigError(f"--out {out}: not a folder")
+    if out.is_dir() and not (out / GRADES_MARKER).exists() and any(out.iterdir()):
+        raise ConfigError(
+            f"--out {out}: not empty and not written by 'fossbot-hil grade' "
+            "(choose a new or empty folder)"
+        )
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+        (out / GRADES_MARKER).write_text("written by fossbot-hil grade\n", encoding="utf-8")
+    except OSError as err:
+        raise ConfigError(f"--out {out}: {err.strerror or err}") from None
+    shutil.rmtree(out / "students", ignore_errors=True)  # last time's students
+    return out
+
+
+def _progress(console: Console, student: Student, grade: object) -> None:
+    from harness.grading.class_table import StudentGrade
+
+    assert isinstance(grade, StudentGrade)
+    parts = [student.kind]
+    if grade.build_s is not None:
+        built = not grade.first_failure.startswith("did not build")
+        parts.append(f"{'built' if built else 'build failed'} in {grade.build_s:.1f} s")
+    if grade.run_s is not None:
+        parts.append(f"{grade.score} passed in {grade.run_s:.1f} s")
+    else:
+        parts.append("not run")
+    console.print(f"  {student.name}: {', '.join(parts)}", markup=False, highlight=False)
+
+
+def run(args: argparse.Namespace, console: Console) -> int:
+    from harness.grading.build import colcon_executable
+    from harness.grading.class_table import class_csv, class_html, class_rich_table
+    from harness.grading.discover import discover
+    from harness.grading.grade import GradeConfig, grade_class
+    from harness.report.files import write_atomically
+    from harness.runner import RunSettings, fault_profile
+
+    check_grading_options(args)
+    scenarios = selected_scenarios(args.scenario)
+    settings = RunSettings(
+        seed=args.seed,
+        threshold=args.threshold,
+        faults=fault_list(args.faults),
+        status_pattern=args.status_regex,
+    )
+    for scenario in scenarios:
+        fault_profile(scenario, settings)  # a bad --faults is a usage error now
+    check_status_regex(args)
+    out = Path(args.out)
+    found = discover(args.dirs, exclude=out)  # before prepare_out: no folder for a typo
+    if any(s.kind in ("package", "workspace") for s in found.students):
+        colcon_executable()
+    prepare_out(out)
+
+    names = tuple(s.name for s in scenarios)
+    config = GradeConfig(
+        scenarios=names,
+        scenario_refs=tuple(s.source or s.name for s in scenarios),
+        link=args.link,
+        options=link_options(args),
+        settings=settings,
+        students_dir=out / "students",
+        build_timeout=args.build_timeout,
+        student_timeout=args.student_timeout,
+    )
+    for note in found.skipped:
+        console.print(f"skipped {note}", markup=False, highlight=False)
+    count = len(found.students)
+    console.print(
+        f"grading {count} student{'s' if count != 1 else ''} on {len(names)} scenario"
+        f"{'s' if len(names) != 1 else ''} over {args.link}, {args.jobs} at a time, into {out}",
+        markup=False,
+        highlight=False,
+    )
+    started = time.monotonic()
+    grades = grade_class(
+        found.students,
+        config,
+        jobs=args.jobs,
+        on_graded=lambda student, grade: _progress(console, student, grade),
+    )
+    wall_s = time.monotonic() - started
+    meta = [
+        ("scenarios", ", ".join(names)),
+        ("link", args.link),
+        ("node", f"{args.package}/{args.executable}"),
+        ("seed", "per scenario" if args.seed is None else str(args.seed)),
+        ("threshold", "per scenario" if args.threshold is None else f"{args.threshold:g} m"),
+        ("graded", time.strftime("%Y-%m-%d %H:%M")),
+    ]
+    csv_path = write_atomically(out / "grades.csv", class_csv(grades, names))
+    html_path = write_atomically(out / "grades.html", class_html(grades, names, meta=meta))
+    console.print()
+    console.print(class_rich_table(grades, names))
+    console.print()
+    console.print(
+        f"graded {count} in {wall_s:.1f} s; wrote {csv_path} and {html_path}",
+        markup=False,
+        highlight=False,
+    )
+    return 0

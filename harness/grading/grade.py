@@ -1,0 +1,253 @@
+"""Grade a class: per student, build, run the suite in a worker process, read the verdicts.
+
+Every step of a student is bounded (build and suite time limits, log size
+limits) and runs in a child process, and any failure of one student,
+including a bug of ours while grading them, becomes that student's row:
+it never stops the others. Students are graded ``jobs`` at a time; each
+suite reserves its own ROS domain, so parallel runs never hear each other.
+"""
+
+from __future__ import annotations
+
+import json
+import shlex
+import shutil
+import sys
+import threading
+import traceback
+from collections.abc import Callable, Sequence
+from concurrent.futures import FIRST_COMPLETED, Future, ThreadPoolExecutor, wait
+from dataclasses import dataclass, replace
+from pathlib import Path
+from typing import Any
+
+from harness.grading.build import build_student
+from harness.grading.class_table import ERROR, NOT_RUN, PASS, StudentGrade
+from harness.grading.discover import Student
+from harness.grading.process import Finished, run_bounded
+from harness.grading.worker import write_job
+from harness.links.base import LinkOptions
+from harness.report.files import write_atomically
+from harness.runner import RunSettings
+from harness.trace import RunResult
+
+__all__ = ["GradeConfig", "grade_class", "grade_student"]
+
+MAX_RUN_LOG_BYTES = 20 * 1024 * 1024
+ARTIFACTS = (("build log", "build.log"), ("run log", "run.log"), ("JUnit", "junit.xml"))
+
+
+@dataclass(frozen=True)
+class GradeConfig:
+    """What every student is graded with."""
+
+    scenarios: tuple[str, ...]  # scenario names, in table order
+    scenario_refs: tuple[str, ...]  # what the worker resolves (file paths)
+    link: str
+    options: LinkOptions  # package and executable set; node and workspace per student
+    settings: RunSettings
+    students_dir: Path  # <out>/students: one artifact folder per student
+    build_timeout: float
+    student_timeout: float
+
+
+def _shorten(text: str, folder: Path, command: str | None = None) -> str:
+    """Messages name paths relative to the student's artifact folder, a script by its name."""
+    if command:
+        text = text.replace(command, command.rsplit("/", 1)[-1].strip("'"))
+    return text.replace(f"{folder.resolve()}/", "").replace(f"{folder}/", "")
+
+
+def _placeholder_junit(config: GradeConfig, folder: Path, reason: str) -> None:
+    """A JUnit report for a student whose suite never ran: the reason, then NOT RUN."""
+    from harness.report.junit import write_junit
+
+    results = [
+        RunResult(name, config.link, 0, 0.0, "", error=reason if i == 0 else f"not run: {reason}")
+        for i, name in enumerate(config.scenarios)
+    ]
+    for result in results[1:]:
+        result.not_run = True
+    write_junit(folder / "junit.xml", results)
+
+
+def _read_results(path: Path) -> dict[str, Any]:
+    try:
+        data = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return {}
+    return data if isinstance(data, dict) else {}
+
+
+def _unfinished_reason(finished: Finished, config: GradeConfig) -> str:
+    if finished.timed_out:
+        return f"stopped: the suite took longer than {config.student_timeout:g} s"
+    if finished.flooded:
+        return f"stopped: the run wrote more than {MAX_RUN_LOG_BYTES // 2**20} MB"
+    if finished.cancelled:
+        return "interrupted"
+    if finished.start_error:
+        return finished.start_error
+    return f"the test run crashed (exit code {finished.returncode}; see run.log)"
+
+
+def verdicts_from(
+    data: dict[str, Any],
+    finished: Finished,
+    config: GradeConfig,
+    folder: Path,
+    command: str | None = None,
+) -> tuple[dict[str, str], str]:
+    """Each scenario's verdict and the first failure in words, from the worker's results."""
+    entries = {e.get("scenario"): e for e in data.get("results", []) if isinstance(e, dict)}
+    error = data.get("error")
+    start_error = str(error) if error and error != "stopped" else None  # "stopped": SIGTERM
+    unfinished = not data.get("finished") and start_error is None
+    first = f"node did not start: {_shorten(start_error, folder, command)}" if start_error else ""
+    verdicts: dict[str, str] = {}
+    for name in config.scenarios:
+        entry = entries.get(name)
+        if entry is None:
+            verdicts[name] = NOT_RUN
+            if unfinished:  # the worker was on this scenario when it ended
+                unfinished = False
+                if not finished.cancelled:
+                    verdicts[name] = ERROR
+                first = first or f"{name}: {_unfinished_reason(finished, config)}"
+            continue
+        verdicts[name] = str(entry.get("verdict", ERROR))
+        if first or verdicts[name] in (PASS, NOT_RUN):
+            continue
+        if entry.get("not_started"):
+            first = f"node did not start: {_shorten(str(entry.get('error')), folder, command)}"
+        else:
+            first = _shorten(str(entry.get("first_failure") or f"{name}: failed"), folder, command)
+    return verdicts, first
+
+
+def _artifacts(folder: Path) -> tuple[tuple[str, str], ...]:
+    """(label, path relative to the class table) of the student's files that exist."""
+    return tuple(
+        (label, f"{folder.parent.name}/{folder.name}/{name}")
+        for label, name in ARTIFACTS
+        if (folder / name).is_file()
+    )
+
+
+def _run_options(student: Student, config: GradeConfig, folder: Path) -> LinkOptions:
+    if student.kind == "script":
+        assert student.script is not None
+        command = f"{shlex.quote(sys.executable)} {shlex.quote(str(student.script.resolve()))}"
+        return replace(config.options, node=command, package=None, executable=None)
+    return replace(config.options, node=None, workspace=str(folder / "colcon"))
+
+
+def _grade(student: Student, config: GradeConfig, cancel: threading.Event) -> StudentGrade:
+    folder = config.students_dir / student.slug
+    shutil.rmtree(folder, ignore_errors=True)
+    folder.mkdir(parents=True)
+    not_run = dict.fromkeys(config.scenarios, NOT_RUN)
+    artifacts = tuple(
+        (label, f"students/{student.slug}/{name}")
+        for label, name in ARTIFACTS
+        if name != "build.log" or student.kind in ("package", "workspace")
+    )
+
+    def without_run(reason: str, build_s: float | None = None) -> StudentGrade:
+        _placeholder_junit(config, folder, reason)
+        return StudentGrade(student.name, student.kind, not_run, reason, artifacts, build_s=build_s)
+
+    if student.problem is not None:
+        return without_run(student.problem)
+    build_s = None
+    if student.kind in ("package", "workspace"):
+        built = build_student(
+            student,
+            folder / "colcon",
+            package=config.options.package or "",
+            executable=config.options.executable or "",
+            log=folder / "build.log",
+            timeout=config.build_timeout,
+            cancel=cancel,
+        )
+        build_s = built.wall_s
+        if not built.ok:
+            return without_run(f"did not build: {built.error}", build_s)
+    if cancel.is_set():
+        return without_run("interrupted", build_s)
+    options = _run_options(student, config, folder)
+    job = write_job(
+        folder / "job.json",
+        scenarios=list(config.scenario_refs),
+        link=config.link,
+        options=options,
+        settings=config.settings,
+        results=folder / "results.json",
+        junit=folder / "junit.xml",
+    )
+    finished = run_bounded(
+        [sys.executable, "-m", "harness.grading.worker", str(job)],
+        log=folder / "run.log",
+        timeout=config.student_timeout,
+        max_log_bytes=MAX_RUN_LOG_BYTES,
+        cwd=folder,
+        cancel=cancel,
+    )
+    data = _read_results(folder / "results.json")
+    verdicts, first = verdicts_from(data, finished, config, folder, options.node)
+    if not (folder / "junit.xml").exists():
+        _placeholder_junit(config, folder, first or "no results")
+    return StudentGrade(
+        student.name, student.kind, verdicts, first, _artifacts(folder), build_s, finished.wall_s
+    )
+
+
+def grade_student(
+    student: Student, config: GradeConfig, cancel: threading.Event | None = None
+) -> StudentGrade:
+    """One student's row; a bug of ours while grading them is their row too, not a crash."""
+    cancel = cancel or threading.Event()
+    try:
+        return _grade(student, config, cancel)
+    except Exception as err:  # one student must never stop the class
+        folder = config.students_dir / student.slug
+        folder.mkdir(parents=True, exist_ok=True)
+        write_atomically(folder / "grader-error.log", traceback.format_exc().encode())
+        reason = f"could not grade: {type(err).__name__}: {err} (see grader-error.log)"
+        return StudentGrade(
+            student.name, student.kind, dict.fromkeys(config.scenarios, NOT_RUN), reason
+        )
+
+
+def grade_class(
+    students: Sequence[Student],
+    config: GradeConfig,
+    *,
+    jobs: int = 1,
+    on_graded: Callable[[Student, StudentGrade], None] | None = None,
+) -> list[StudentGrade]:
+    """Every student's row, in the order given; `jobs` students at a time.
+
+    On Ctrl-C (or SIGTERM) the running builds and suites are stopped, each
+    within its bounded grace, before KeyboardInterrupt goes on up.
+    """
+    cancel = threading.Event()
+    grades: dict[int, StudentGrade] = {}
+    with ThreadPoolExecutor(max_workers=jobs, thread_name_prefix="grade") as pool:
+        pending: dict[Future[StudentGrade], int] = {
+            pool.submit(grade_student, s, config, cancel): i for i, s in enumerate(students)
+        }
+        try:
+            while pending:
+                done, _ = wait(pending, timeout=1.0, return_when=FIRST_COMPLETED)
+                for future in done:
+                    index = pending.pop(future)
+                    grades[index] = future.result()
+                    if on_graded is not None:
+                        on_graded(students[index], grades[index])
+        except BaseException:
+            cancel.set()
+            for future in pending:
+                future.cancel()
+            raise
+    return [grades[i] for i in range(len(students))]

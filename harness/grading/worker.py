@@ -1,0 +1,158 @@
+"""One student's scenario suite, in a process of its own: ``python -m harness.grading.worker JOB``.
+
+A student's node can crash, hang or flood its output; running their suite
+here means that can only ever end this process, never the grader. JOB is a
+JSON file (written by ``grade``) naming the scenarios, the link, the
+LinkOptions and RunSettings fields, and where to write ``results.json`` and
+the JUnit XML. ``results.json`` is rewritten (atomically) after every
+scenario, so a run stopped at its time limit still tells what it judged.
+The human-readable report goes to stdout, as ``fossbot-hil run`` prints it.
+"""
+
+from __future__ import annotations
+
+import json
+import signal
+import sys
+from dataclasses import asdict, fields
+from pathlib import Path
+from typing import Any
+
+from harness.errors import ConfigError
+from harness.report.files import write_atomically
+from harness.trace import RunResult
+
+__all__ = ["result_entry", "verdict_of", "write_job"]
+
+PASS, FAIL, ERROR, NOT_RUN = "PASS", "FAIL", "ERROR", "NOT RUN"
+
+
+def verdict_of(result: RunResult) -> str:
+    """PASS, FAIL (an expectation failed), ERROR (the run broke) or NOT RUN."""
+    if result.ok:
+        return PASS
+    if result.not_run:
+        return NOT_RUN
+    return FAIL if result.failed_ticks else ERROR
+
+
+def result_entry(result: RunResult) -> dict[str, Any]:
+    """What the grader needs of one scenario's run, as JSON-ready data."""
+    return {
+        "scenario": result.scenario,
+        "verdict": verdict_of(result),
+        "first_failure": result.first_failure,
+        "error": result.error,
+        "not_started": result.not_started,
+        "not_run": result.not_run,
+        "ticks": len(result.records),
+        "failed_ticks": len(result.failed_ticks),
+        "wall_s": round(result.wall_s, 3),
+        "diagnostics": result.diagnostics,
+    }
+
+
+def write_job(
+    path: Path,
+    *,
+    scenarios: list[str],
+    link: str,
+    options: Any,
+    settings: Any,
+    results: Path,
+    junit: Path,
+) -> Path:
+    """Write a job file for this worker: LinkOptions and RunSettings as their fields."""
+    job = {
+        "scenarios": scenarios,
+        "link": link,
+        "options": asdict(options),
+        "settings": asdict(settings),
+        "results": str(results),
+        "junit": str(junit),
+    }
+    return write_atomically(path, json.dumps(job, indent=2).encode())
+
+
+def _write_results(path: Path, entries: list[dict[str, Any]], **state: Any) -> None:
+    data = {"results": entries, **state}
+    write_atomically(path, json.dumps(data, indent=2).encode())
+
+
+def _options(data: dict[str, Any]) -> Any:
+    from harness.links.base import LinkOptions
+
+    known = {f.name for f in fields(LinkOptions)}
+    values = {k: v for k, v in data.items() if k in known}
+    values["params"] = tuple(values.get("params", ()))
+    return LinkOptions(**values)
+
+
+def _settings(data: dict[str, Any]) -> Any:
+    from harness.runner import RunSettings
+
+    known = {f.name for f in fields(RunSettings)}
+    return RunSettings(**{k: v for k, v in data.items() if k in known})
+
+
+def run_job(job: dict[str, Any]) -> int:
+    """Run the job's suite; results.json tells the outcome, the exit code only if it broke."""
+    from rich.console import Console
+
+    from harness.report.junit import write_junit
+    from harness.report.terminal import print_results
+    from harness.runner import run_suite
+    from harness.scenario import resolve_scenario
+
+    results_path = Path(job["results"])
+    entries: list[dict[str, Any]] = []
+    results: list[RunResult] = []
+
+    def keep(result: RunResult) -> None:
+        results.append(result)
+        entries.append(result_entry(result))
+        _write_results(results_path, entries, finished=False, error=None)
+        write_junit(job["junit"], results)  # so a run stopped later still has a report
+        print(f"{result.scenario}: {verdict_of(result)}", flush=True)
+
+    try:
+        scenarios = [resolve_scenario(ref) for ref in job["scenarios"]]
+        run_suite(
+            scenarios,
+            job["link"],
+            _options(job["options"]),
+            _settings(job["settings"]),
+            on_result=keep,
+        )
+    except ConfigError as err:  # e.g. the node command cannot be resolved
+        _write_results(results_path, entries, finished=False, error=str(err))
+        print(f"error: {err}", flush=True)
+        return 0
+    except KeyboardInterrupt:  # SIGTERM from the grader: links are closed, nodes stopped
+        _write_results(results_path, entries, finished=False, error="stopped")
+        return 1
+    _write_results(results_path, entries, finished=True, error=None)
+    print(flush=True)
+    console = Console(highlight=False, width=160, force_terminal=False)
+    print_results(console, results)
+    return 0
+
+
+def _interrupt_on_sigterm() -> None:
+    def handler(signum: int, frame: object) -> None:
+        raise KeyboardInterrupt
+
+    signal.signal(signal.SIGTERM, handler)
+
+
+def main(argv: list[str]) -> int:
+    if len(argv) != 1:
+        print("usage: python -m harness.grading.worker JOB.json", file=sys.stderr)
+        return 2
+    _interrupt_on_sigterm()
+    job = json.loads(Path(argv[0]).read_text(encoding="utf-8"))
+    return run_job(job)
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
