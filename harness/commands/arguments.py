@@ -139,6 +139,23 @@ def add_link_option(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--link", default=DEFAULT_LINK, help=f"one of {', '.join(known_links())}")
 
 
+def add_device_options(parser: argparse.ArgumentParser) -> None:
+    """Where the scans go besides ROS 2: a physical port, or a Python function."""
+    serial = parser.add_argument_group("serial links (rplidar, ldlidar)")
+    serial.add_argument(
+        "--port",
+        metavar="DEV",
+        help="drive a physical board through this USB-UART, in real time "
+        "(default: a virtual board on a pty)",
+    )
+    inprocess = parser.add_argument_group("inprocess link")
+    inprocess.add_argument(
+        "--processor",
+        metavar="MODULE:FUNCTION",
+        help="fn(scan, threshold) -> (status, warning) instead of the reference",
+    )
+
+
 def link_options(args: argparse.Namespace) -> LinkOptions:
     """Link settings from the command line (the runner fills in the threshold)."""
     return LinkOptions(

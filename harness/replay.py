@@ -1,0 +1,92 @@
+"""Re-inject a recorded scan stream into the software under test and judge it.
+
+A fossbot-hil recording carries its threshold and fault noise, so a replay
+is judged exactly as the original run was; a robot's rosbag2 needs the
+threshold given. Poses come along when the recording has them.
+"""
+
+from __future__ import annotations
+
+import math
+import statistics
+import time
+from collections.abc import Callable, Iterator
+from dataclasses import replace
+
+from harness.errors import ConfigError
+from harness.links.base import LinkOptions
+from harness.oracle import Oracle
+from harness.record import RecordedScans
+from harness.runner import Frame, judge_frames, with_link
+from harness.trace import RunResult, TickRecord
+
+
+def _recorded_float(recording: RecordedScans, key: str) -> float | None:
+    text = recording.run.get(key)
+    try:
+        value = float(text) if text is not None else None
+    except ValueError:
+        return None
+    return value if value is not None and math.isfinite(value) else None
+
+
+def replay_threshold(recording: RecordedScans, threshold: float | None) -> float:
+    """The given threshold, else the recorded run's; a robot's bag needs one given."""
+    if threshold is not None:
+        return threshold
+    recorded = _recorded_float(recording, "threshold")
+    if recorded is None or recorded <= 0:
+        raise ConfigError(
+            f"{recording.source}: the recording does not say its threshold; give --threshold M"
+        )
+    return recorded
+
+
+def scan_rate_hz(recording: RecordedScans) -> float:
+    """The recorded scan rate (median period), for links that pace or emulate a device."""
+    periods = [b - a for a, b in zip(recording.times, recording.times[1:], strict=False) if b > a]
+    if periods:
+        return 1.0 / statistics.median(periods)
+    scan_time = recording.scans[0].scan_time
+    return 1.0 / scan_time if scan_time > 0 else 10.0
+
+
+def frames(recording: RecordedScans) -> Iterator[Frame]:
+    poses = recording.poses or [(0.0, 0.0, 0.0)] * len(recording.scans)
+    rows = zip(recording.times, recording.scans, poses, strict=True)
+    for tick, (t, scan, (x, y, yaw)) in enumerate(rows):
+        yield Frame(tick, t, x, y, yaw, scan)
+
+
+def replay(
+    recording: RecordedScans,
+    link_name: str,
+    options: LinkOptions,
+    *,
+    threshold: float | None = None,
+    status_pattern: str | None = None,
+    on_tick: Callable[[TickRecord], None] | None = None,
+) -> RunResult:
+    """Send every recorded scan through the named link, in lockstep, and judge each."""
+    threshold = replay_threshold(recording, threshold)
+    noise_sigma = _recorded_float(recording, "noise_sigma") or 0.0
+    name = recording.run.get("scenario") or f"replay of {recording.source}"
+    seed = int(recording.run.get("seed", "0") or 0)
+    faults = recording.run.get("faults", "recorded")
+
+    def result(**extra: object) -> RunResult:
+        return RunResult(name, link_name, seed, threshold, faults, noise_sigma, **extra)  # type: ignore[arg-type]
+
+    def body(link) -> RunResult:  # type: ignore[no-untyped-def]
+        started = time.perf_counter()
+        oracle = Oracle(threshold, noise_sigma=noise_sigma, status_pattern=status_pattern)
+        replayed = judge_frames(frames(recording), link, oracle, result(), on_tick=on_tick)
+        replayed.wall_s = time.perf_counter() - started
+        return replayed
+
+    return with_link(
+        link_name,
+        replace(options, threshold=threshold, scan_rate_hz=scan_rate_hz(recording)),
+        body,
+        lambda reason, diagnostics: result(error=reason, diagnostics=diagnostics),
+    )
