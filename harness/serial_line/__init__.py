@@ -1,13 +1,14 @@
 """The serial line to the board: ports, real-time pacing, and the device server.
 
 ``ports`` gives a pty pair (the virtual board) or a named USB-UART (real
-HIL); ``pacing`` paces bytes at the line rate that ptys ignore; ``server``
+HIL), which ``port_lock`` lets one run use at a time; ``pacing`` paces bytes at the line rate that ptys ignore; ``server``
 runs an emulated LIDAR from ``harness.devices`` on a port in one thread.
 """
 
 from __future__ import annotations
 
 from harness.serial_line.pacing import LinePacer, PacingReport
+from harness.serial_line.port_lock import PortLock, hold_port
 from harness.serial_line.ports import DevicePort, PortInfo, PtyPort, SerialPort, list_serial_ports
 from harness.serial_line.server import Delivery, DeviceServer, ServerStats
 
@@ -17,9 +18,11 @@ __all__ = [
     "DeviceServer",
     "LinePacer",
     "PacingReport",
+    "PortLock",
     "PortInfo",
     "PtyPort",
     "SerialPort",
     "ServerStats",
+    "hold_port",
     "list_serial_ports",
 ]

@@ -19,6 +19,7 @@ from dataclasses import dataclass
 from typing import Literal
 
 from harness.errors import ConfigError, LinkError
+from harness.serial_line.port_lock import DEFAULT_WAIT_S, PortLock, hold_port
 
 _NO_PEER_STEP_S = 0.01  # how often a pty without a reader is re-checked
 
@@ -199,6 +200,11 @@ class SerialPort(DevicePort):
     our inputs. The adapter itself transmits at the baud rate, so its bytes
     are paced by hardware; a vanished adapter (read or write fails) becomes
     ``LinkError`` at the next operation, which the server runs every few ms.
+
+    One run at a time: the port's lock (``port_lock``) is taken first,
+    waiting at most `lock_wait` s for a run that holds it, and the device is
+    opened exclusively, so a program outside the harness that holds it
+    (with an exclusive open) is refused too.
     """
 
     paced_by_hardware = True
@@ -211,6 +217,7 @@ class SerialPort(DevicePort):
         dtr_input: Literal["dsr", "cts"] = "dsr",
         write_timeout: float = 0.5,
         option: str = "--port",
+        lock_wait: float = DEFAULT_WAIT_S,
     ) -> None:
         import serial  # the optional part: only a named port needs pyserial
 
@@ -221,12 +228,18 @@ class SerialPort(DevicePort):
         if dtr_input not in ("dsr", "cts"):
             raise ConfigError(f"{self._label}: dtr input must be dsr or cts, not {dtr_input!r}")
         self.dtr_input = dtr_input
+        self._lock: PortLock | None = hold_port(path, lock_wait, label=self._label)
         try:
             # timeout=0: reads never block inside pyserial; we wait with select.
             self._ser: serial.Serial | None = serial.Serial(
-                path, baudrate, timeout=0, write_timeout=write_timeout
+                path, baudrate, timeout=0, write_timeout=write_timeout, exclusive=True
             )
         except (serial.SerialException, OSError, ValueError) as err:
+            self._lock.release()
+            if "exclusively lock" in str(err):
+                raise ConfigError(
+                    f"{self._label}: already open elsewhere, with an exclusive lock"
+                ) from None
             raise ConfigError(f"{self._label}: cannot open: {_one_line(err)}") from None
 
     def _port(self):  # noqa: ANN202 - serial.Serial, imported lazily
@@ -282,6 +295,9 @@ class SerialPort(DevicePort):
                 ser.close()
             except Exception:  # noqa: BLE001 - a vanished port may fail to close; it is gone anyway
                 pass
+        lock, self._lock = self._lock, None
+        if lock is not None:
+            lock.release()  # after closing: the next run never finds the device still open
 
 
 @dataclass(frozen=True)
