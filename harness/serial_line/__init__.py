@@ -1,8 +1,9 @@
 """The serial line to the board: ports, real-time pacing, and the device server.
 
 ``ports`` gives a pty pair (the virtual board) or a named USB-UART (real
-HIL), which ``port_lock`` lets one run use at a time; ``pacing`` paces bytes at the line rate that ptys ignore; ``server``
-runs an emulated LIDAR from ``harness.devices`` on a port in one thread.
+HIL), which ``port_lock`` lets one run use at a time; ``pacing`` paces
+bytes at the line rate that ptys ignore; ``server`` runs an emulated LIDAR
+from ``harness.devices`` on a port in one thread.
 """
 
 from __future__ import annotations
@@ -18,8 +19,8 @@ __all__ = [
     "DeviceServer",
     "LinePacer",
     "PacingReport",
-    "PortLock",
     "PortInfo",
+    "PortLock",
     "PtyPort",
     "SerialPort",
     "ServerStats",
