@@ -1,0 +1,177 @@
+"""`fossbot-hil grade` on a real class: colcon builds, real nodes over DDS, two at a time.
+
+One grading run (module scope) of four students over the three lab
+scenarios: a good workspace, a package with a bug, a package that does not
+build, and a single-file node. The tests read its outputs.
+"""
+
+from __future__ import annotations
+
+import csv
+import subprocess
+import time
+import xml.etree.ElementTree as ET
+from dataclasses import dataclass
+from html.parser import HTMLParser
+from pathlib import Path
+
+import pytest
+from command_line import fossbot_hil
+from grading_class import (
+    LAB_SCENARIOS,
+    broken_setup_package,
+    good_workspace,
+    range_min_bug_package,
+    script_student,
+    snapshot,
+)
+
+pytestmark = [pytest.mark.ros, pytest.mark.slow, pytest.mark.timeout(240)]
+
+
+@dataclass
+class Graded:
+    done: subprocess.CompletedProcess[str]
+    out: Path
+    rows: dict[str, dict[str, str]]
+    before: dict[str, dict[str, tuple[int, int]]]
+    classroom: Path
+    wall_s: float
+
+
+@pytest.fixture(scope="module")
+def graded(tmp_path_factory: pytest.TempPathFactory) -> Graded:
+    """Grade alice (good), bob (range_min bug), carol (broken setup.py), dave (script)."""
+    classroom = tmp_path_factory.mktemp("class")
+    good_workspace(classroom / "alice")
+    range_min_bug_package(classroom / "bob")
+    broken_setup_package(classroom / "carol")
+    script_student(classroom / "dave")
+    before = {p.name: snapshot(p) for p in classroom.iterdir()}
+    out = tmp_path_factory.mktemp("grades") / "grades"
+    started = time.monotonic()
+    done = fossbot_hil(
+        "grade",
+        str(classroom),
+        "--out",
+        str(out),
+        "--jobs",
+        "2",
+        "--scenario",
+        ",".join(LAB_SCENARIOS),
+        timeout=200,
+    )
+    wall_s = time.monotonic() - started
+    rows: dict[str, dict[str, str]] = {}
+    if (out / "grades.csv").is_file():
+        with open(out / "grades.csv", newline="", encoding="utf-8") as handle:
+            rows = {row["student"]: row for row in csv.DictReader(handle)}
+    return Graded(done, out, rows, before, classroom, wall_s)
+
+
+def test_grading_completes_with_exit_0(graded: Graded) -> None:
+    """Students failing is the output, not an error: exit 0, a row for each, no traceback."""
+    assert graded.done.returncode == 0, graded.done.stdout + graded.done.stderr
+    assert "Traceback" not in graded.done.stdout + graded.done.stderr
+    assert sorted(graded.rows) == ["alice", "bob", "carol", "dave"]
+    print(f"graded 4 students in {graded.wall_s:.1f} s")  # shown with -s, for timing notes
+
+
+def test_good_student_passes_every_scenario(graded: Graded) -> None:
+    """The reference package as a workspace: PASS everywhere, nothing to explain."""
+    alice = graded.rows["alice"]
+    assert [alice[s] for s in LAB_SCENARIOS] == ["PASS"] * 3, alice
+    assert alice["passed"] == "3/3" and alice["first_failure"] == ""
+
+
+def test_buggy_student_fails_with_the_oracles_explanation(graded: Graded) -> None:
+    """The range_min bug passes two scenarios and fails out_of_range, explained in words."""
+    bob = graded.rows["bob"]
+    assert [bob[s] for s in LAB_SCENARIOS] == ["PASS", "PASS", "FAIL"], bob
+    assert bob["first_failure"].startswith("out_of_range: t=0.00 s tick 0: expected no obstacle")
+    assert "below range_min" in bob["first_failure"]
+
+
+def test_non_building_student_says_why_and_stops_no_one(graded: Graded) -> None:
+    """carol's SyntaxError is named with its line; the others were still graded."""
+    carol = graded.rows["carol"]
+    assert [carol[s] for s in LAB_SCENARIOS] == ["NOT RUN"] * 3
+    assert carol["first_failure"] == (
+        "did not build: setup.py line 18: SyntaxError: invalid syntax. Perhaps you forgot a comma?"
+    )
+    assert "SyntaxError" in (graded.out / "students" / "carol" / "build.log").read_text()
+    assert graded.rows["alice"]["passed"] == "3/3"  # graded despite carol
+
+
+def test_script_student_runs_as_a_node_command(graded: Graded) -> None:
+    """A folder with one .py file is run with this Python, no build."""
+    dave = graded.rows["dave"]
+    assert [dave[s] for s in LAB_SCENARIOS] == ["PASS"] * 3, dave
+    assert not (graded.out / "students" / "dave" / "build.log").exists()
+
+
+class _Table(HTMLParser):
+    """The rows of the page's table, as text per cell."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.rows: list[list[str]] = []
+        self._cell: list[str] | None = None
+
+    def handle_starttag(self, tag: str, attrs: list[tuple[str, str | None]]) -> None:
+        if tag == "tr":
+            self.rows.append([])
+        elif tag in ("td", "th"):
+            self._cell = []
+
+    def handle_endtag(self, tag: str) -> None:
+        if tag in ("td", "th") and self._cell is not None:
+            self.rows[-1].append(" ".join(t.strip() for t in self._cell if t.strip()))
+            self._cell = None
+
+    def handle_data(self, data: str) -> None:
+        if self._cell is not None:
+            self._cell.append(data)
+
+
+def test_html_page_has_the_same_rows(graded: Graded) -> None:
+    """One table: a header, then each student with verdicts and the first failure."""
+    parser = _Table()
+    parser.feed((graded.out / "grades.html").read_text(encoding="utf-8"))
+    header, *rows = parser.rows
+    assert header == ["student", *LAB_SCENARIOS, "passed", "first failure"]
+    by_name = {row[0].split()[0]: row for row in rows}
+    assert sorted(by_name) == ["alice", "bob", "carol", "dave"]
+    print(graded.done.stdout)  # shown with -s, for timing notes
+    for name, csv_row in graded.rows.items():
+        assert by_name[name][1:] == [
+            *(csv_row[s] for s in LAB_SCENARIOS),
+            csv_row["passed"],
+            csv_row["first_failure"],
+        ]
+
+
+def test_each_student_has_a_junit_report(graded: Graded) -> None:
+    """Per student: JUnit XML with one case per scenario, failures where the table says."""
+    for name in ("alice", "bob", "carol", "dave"):
+        root = ET.parse(graded.out / "students" / name / "junit.xml").getroot()
+        cases = root.findall(".//testcase")
+        assert [c.get("name") for c in cases] == list(LAB_SCENARIOS), name
+    bob = ET.parse(graded.out / "students" / "bob" / "junit.xml").getroot()
+    failure = bob.find(".//testcase[@name='out_of_range']/failure")
+    assert failure is not None and "expected no obstacle" in (failure.get("message") or "")
+
+
+def test_student_folders_are_left_as_they_were(graded: Graded) -> None:
+    """colcon built into --out: no build/, install/, log/ or egg-info in the students' folders."""
+    after = {p.name: snapshot(p) for p in graded.classroom.iterdir()}
+    assert after == graded.before
+    assert (graded.out / "students" / "alice" / "colcon" / "install").is_dir()
+
+
+def test_terminal_shows_the_class_table(graded: Graded) -> None:
+    """The run prints a line per student as it is graded, then the table."""
+    out = graded.done.stdout
+    assert "grading 4 students on 3 scenarios" in out
+    assert "carol: package, build failed" in out
+    assert "first failure" in out and "did not build: setup.py line 18" in out

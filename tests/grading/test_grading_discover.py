@@ -1,0 +1,112 @@
+"""Which folders are students, and what each handed in (files only, milliseconds)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from harness.errors import ConfigError
+from harness.grading.discover import GRADES_MARKER, discover, student_in
+
+NODE = "import rclpy\n"
+
+
+def touch(path: Path, text: str = "") -> Path:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(text)
+    return path
+
+
+def test_each_layout_is_recognised(tmp_path: Path) -> None:
+    """Workspace (src/), package, nested package, script; junk is a student with a reason."""
+    touch(tmp_path / "ws" / "src" / "repo" / "pkg" / "package.xml")
+    touch(tmp_path / "pkg" / "package.xml")
+    touch(tmp_path / "nested" / "fossbot_lidar_processing" / "package.xml")
+    touch(tmp_path / "script" / "my_node.py", NODE)
+    touch(tmp_path / "notes" / "readme.txt")
+    found = {s.name: s for s in discover([tmp_path]).students}
+    assert {name: s.kind for name, s in found.items()} == {
+        "ws": "workspace",
+        "pkg": "package",
+        "nested": "workspace",
+        "script": "script",
+        "notes": "none",
+    }
+    assert found["ws"].base_paths == (tmp_path / "ws" / "src" / "repo" / "pkg",)
+    assert found["pkg"].base_paths == (tmp_path / "pkg",)
+    assert found["script"].script == tmp_path / "script" / "my_node.py"
+    assert found["notes"].problem == "no node found: no package.xml and no .py file"
+
+
+def test_build_output_and_ignored_folders_are_not_searched(tmp_path: Path) -> None:
+    """A student's own build/install/log and COLCON_IGNOREd folders hold no packages."""
+    ws = tmp_path / "ws"
+    touch(ws / "src" / "pkg" / "package.xml")
+    touch(ws / "src" / "old" / "COLCON_IGNORE")
+    touch(ws / "src" / "old" / "package.xml")
+    touch(ws / "install" / "pkg" / "share" / "pkg" / "package.xml")
+    assert student_in(ws).base_paths == (ws / "src" / "pkg",)
+
+
+def test_the_node_script_is_the_one_importing_rclpy(tmp_path: Path) -> None:
+    """Helpers beside the node are fine; two candidate nodes are ambiguous."""
+    touch(tmp_path / "a" / "helpers.py", "import math\n")
+    touch(tmp_path / "a" / "node.py", "from rclpy.node import Node\n")
+    touch(tmp_path / "a" / "setup.py", NODE)
+    assert student_in(tmp_path / "a").script == tmp_path / "a" / "node.py"
+    touch(tmp_path / "b" / "one.py", NODE)
+    touch(tmp_path / "b" / "two.py", NODE)
+    ambiguous = student_in(tmp_path / "b")
+    assert ambiguous.kind == "none"
+    assert ambiguous.problem is not None and "one.py, two.py" in ambiguous.problem
+
+
+def test_a_workspace_given_directly_is_one_student(tmp_path: Path) -> None:
+    """DIR with src/ (or a package.xml) is one hand-in, named after the folder."""
+    ws = tmp_path / "maria_ws"
+    touch(ws / "src" / "pkg" / "package.xml")
+    touch(ws / "src" / "pkg" / "pkg" / "node.py", NODE)
+    [student] = discover([ws]).students
+    assert (student.name, student.kind) == ("maria_ws", "workspace")
+
+
+def test_same_name_in_two_folders_is_told_apart(tmp_path: Path) -> None:
+    """Two sections each with an 'alex': names get the section, slugs stay file-safe."""
+    for section in ("mon", "tue"):
+        touch(tmp_path / section / "alex" / "package.xml")
+    students = discover([tmp_path / "mon", tmp_path / "tue"]).students
+    assert [(s.name, s.slug) for s in students] == [
+        ("mon/alex", "mon_alex"),
+        ("tue/alex", "tue_alex"),
+    ]
+
+
+def test_output_folder_hidden_folders_and_files_are_skipped(tmp_path: Path) -> None:
+    """--out inside the class folder, a .git folder and a zip are never students."""
+    touch(tmp_path / "ana" / "package.xml")
+    touch(tmp_path / "grades" / GRADES_MARKER)
+    touch(tmp_path / "old_grades" / GRADES_MARKER)
+    touch(tmp_path / ".git" / "config")
+    touch(tmp_path / "ben.zip")
+    found = discover([tmp_path], exclude=tmp_path / "grades")
+    assert [s.name for s in found.students] == ["ana"]
+    assert [note.split(":")[1] for note in found.skipped] == [
+        " not a folder",
+        " an output folder of `fossbot-hil grade`",
+    ]
+
+
+@pytest.mark.parametrize(
+    ("make", "match"),
+    [
+        (lambda root: root / "missing", "no such folder"),
+        (lambda root: touch(root / "file.txt"), "not a folder"),
+        (lambda root: root, "no students found"),
+        (lambda root: touch(root / "x" / "notes.txt").parents[1], "no students found"),
+    ],
+)
+def test_nothing_to_grade_is_a_usage_error(tmp_path: Path, make, match: str) -> None:
+    """Missing folder, a file, an empty folder, folders without any node: ConfigError."""
+    with pytest.raises(ConfigError, match=match):
+        discover([make(tmp_path)])
