@@ -61,16 +61,12 @@ def artifact_writers() -> list[ArtifactWriter]:
     """The per-scenario artifacts, in the order they are written."""
     return [
         ArtifactWriter("plot", ".png", _write_plot),
-        # RECORDING (issue 5): harness/record/ will provide
-        # write_recording(path: Path, result: RunResult) -> Path (one MCAP per scenario).
-        # Once it exists, this one line is all it takes to add it to every report:
-        # ArtifactWriter("recording", ".mcap", _write_recording),
+        ArtifactWriter("recording", ".mcap", _write_recording),
     ]
 
 
 def _write_recording(path: Path, result: RunResult) -> Path:
-    """The recording writer, imported when first used (see `artifact_writers`)."""
-    from harness.record import write_recording  # type: ignore[import-not-found]
+    from harness.record import write_recording  # mcap and rosbags only when recording
 
     return write_recording(path, result)
 

@@ -45,6 +45,7 @@ def test_out_writes_the_report_of_the_run(
         row = next(line for line in captured.out.splitlines() if line.startswith(entry["scenario"]))
         assert row.split()[2:5] == [str(entry["ticks"]), str(entry["failed"]), entry["verdict"]]
         assert (out / entry["files"]["plot"]).read_bytes()[:4] == b"\x89PNG"
+        assert (out / entry["files"]["recording"]).read_bytes()[:5] == b"\x89MCAP"
     assert summary["scenarios"][1]["first_failure"] in captured.out
     # --junit-xml outside the folder still points at the plots, relative to itself.
     for xml in (out / "junit.xml", junit):

@@ -11,6 +11,7 @@ from pathlib import Path
 import pytest
 
 from harness.errors import ConfigError
+from harness.record import read_scans
 from harness.report.junit import write_junit
 from harness.report.outputs import ArtifactWriter, ReportFolder, artifact_writers, write_report
 from harness.trace import RunResult
@@ -54,8 +55,10 @@ def test_layout_and_summary_match_the_run(
         "junit.xml",
         "scenarios",
         "scenarios/approach_wall.json",
+        "scenarios/approach_wall.mcap",
         "scenarios/approach_wall.png",
         "scenarios/drive_past_10m.json",
+        "scenarios/drive_past_10m.mcap",
         "scenarios/drive_past_10m.png",
         "summary.json",
     ]
@@ -78,10 +81,17 @@ def test_layout_and_summary_match_the_run(
         name = result.scenario
         assert entry["files"] == {
             "plot": f"scenarios/{name}.png",
+            "recording": f"scenarios/{name}.mcap",
             "summary": f"scenarios/{name}.json",
         }
+        recording = read_scans(tmp_path / entry["files"]["recording"])
+        assert len(recording.scans) == entry["ticks"]
         details = json.loads((tmp_path / entry["files"]["summary"]).read_text())
-        assert details["files"] == {"plot": f"{name}.png", "summary": f"{name}.json"}
+        assert details["files"] == {
+            "plot": f"{name}.png",
+            "recording": f"{name}.mcap",
+            "summary": f"{name}.json",
+        }
         assert len(details["records"]) == entry["ticks"]
         assert [r["tick"] for r in details["records"] if not r["ok"]] == entry["failed_ticks"]
     last = details["records"][-1]
@@ -123,7 +133,7 @@ def test_junit_properties_name_the_explanation_and_files(
         assert props[1]["explanation"] == failing.first_failure
         assert cases[1].find("failure") is not None
         for p in props:
-            for name in ("plot", "summary"):
+            for name in ("plot", "recording", "summary"):
                 assert (xml.parent / p[name]).resolve().is_file(), p[name]
     assert props[0]["plot"] == "../report/scenarios/approach_wall.png"
 
@@ -143,7 +153,7 @@ def test_a_run_without_ticks_has_no_artifacts(tmp_path: Path) -> None:
     write_report(tmp_path, [skipped])
     [entry] = json.loads((tmp_path / "summary.json").read_text())["scenarios"]
     assert entry["verdict"] == "NOT RUN"
-    assert entry["files"] == {"plot": None, "summary": "scenarios/later.json"}
+    assert entry["files"] == {"plot": None, "recording": None, "summary": "scenarios/later.json"}
 
 
 def _broken_writer(path: Path, result: RunResult) -> Path:
@@ -154,11 +164,15 @@ def _broken_writer(path: Path, result: RunResult) -> Path:
 
 def test_writes_are_atomic(tmp_path: Path, passing: RunResult) -> None:
     """A writer failing halfway leaves nothing under its name and no temporary file."""
-    writers = [*artifact_writers(), ArtifactWriter("recording", ".mcap", _broken_writer)]
+    writers = [*artifact_writers(), ArtifactWriter("broken", ".bin", _broken_writer)]
     report = ReportFolder(tmp_path, writers)
     with pytest.raises(OSError, match="No space left"):
         report.add(passing)
-    assert _files_in(tmp_path) == ["scenarios", "scenarios/approach_wall.png"]
+    assert _files_in(tmp_path) == [
+        "scenarios",
+        "scenarios/approach_wall.mcap",
+        "scenarios/approach_wall.png",
+    ]
     write_report(tmp_path / "whole", [passing])
     assert not [p for p in (tmp_path / "whole").rglob(".*")]
 

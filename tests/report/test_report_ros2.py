@@ -23,6 +23,7 @@ def test_out_over_ros2(tmp_path: Path) -> None:
     assert (summary["ok"], entry["verdict"], entry["link"]) == (True, "PASS", "ros2")
     assert entry["ticks"] > 50 and entry["failed_ticks"] == []
     assert (out / entry["files"]["plot"]).read_bytes()[:4] == b"\x89PNG"
+    assert (out / entry["files"]["recording"]).read_bytes()[:5] == b"\x89MCAP"
     details = json.loads((out / entry["files"]["summary"]).read_text())
     assert all(r["status"] for r in details["records"])  # every tick answered over DDS
     assert entry["files"]["plot"] in (out / "index.html").read_text()
