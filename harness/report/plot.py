@@ -161,8 +161,11 @@ def render_plot(series: PlotSeries) -> bytes:
     if t.size:
         step = float(np.median(np.diff(t))) if t.size > 1 else 0.1
         bottom.set_xlim(t[0] - step, t[-1] + step)
-    else:
-        top.text(0.5, 0.5, "no ticks", transform=top.transAxes, ha="center", va="center")
+    note = "no ticks" if not t.size else ""
+    if t.size and np.isnan(series.nearest).all():
+        note = "no valid return in any scan: nothing in range"
+    if note:
+        top.text(0.5, 0.5, note, transform=top.transAxes, ha="center", va="center", fontsize=9)
 
     out = io.BytesIO()
     fig.savefig(out, format="png", metadata={"Software": None})
