@@ -10,6 +10,7 @@ from typing import TYPE_CHECKING, Any, TypeVar
 from rich.console import Console
 
 from harness.commands.arguments import (
+    add_device_options,
     add_judging_options,
     add_link_option,
     add_node_options,
@@ -57,21 +58,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "(see docs/reports.md)",
     )
     add_node_options(parser)
-
-    serial = parser.add_argument_group("serial links (rplidar, ldlidar)")
-    serial.add_argument(
-        "--port",
-        metavar="DEV",
-        help="drive a physical board through this USB-UART, in real time "
-        "(default: a virtual board on a pty)",
-    )
-
-    inprocess = parser.add_argument_group("inprocess link")
-    inprocess.add_argument(
-        "--processor",
-        metavar="MODULE:FUNCTION",
-        help="fn(scan, threshold) -> (status, warning) instead of the reference",
-    )
+    add_device_options(parser)
 
 
 def selected(names: Sequence[str]) -> list[Scenario]:
