@@ -91,9 +91,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--build-timeout",
         type=positive("build timeout"),
-        default=300.0,
+        default=180.0,
         metavar="S",
-        help="longest one student's colcon build may take (default 300)",
+        help="longest one student's colcon build may take (default 180)",
     )
     parser.add_argument(
         "--student-timeout",
@@ -199,7 +199,7 @@ def run(args: argparse.Namespace, console: Console) -> int:
         link=args.link,
         options=link_options(args),
         settings=settings,
-        students_dir=out / "students",
+        students_dir=out.resolve() / "students",  # workers run in their student's folder
         build_timeout=args.build_timeout,
         student_timeout=args.student_timeout,
     )

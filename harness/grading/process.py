@@ -5,10 +5,12 @@ their node), so none of it may hang the grader, fill the disk, or outlive
 it. Each child gets its own process group, so stopping it stops whatever it
 started; it writes to a file, never a pipe, so it can never block on us.
 
-Run as ``python -m harness.grading.process CMD ARGS...``, this module asks
-Linux to SIGTERM it when the grader's thread that started it dies, then
-execs CMD: even a SIGKILLed grader leaves no build or run behind. (Setting
-that in the parent with ``preexec_fn`` is unsafe with threads.)
+Run as ``python -m harness.grading.process MAX_FILE_BYTES CMD ARGS...``,
+this module asks Linux to SIGTERM it when the grader's thread that started
+it dies, caps the size of any one file it and its children write (a node
+printing forever into its log gets EFBIG, not the whole disk), then execs
+CMD: even a SIGKILLed grader leaves no build or run behind. (Doing this in
+the parent with ``preexec_fn`` is unsafe with threads.)
 """
 
 from __future__ import annotations
@@ -25,6 +27,7 @@ from pathlib import Path
 
 __all__ = ["Finished", "run_bounded"]
 
+MAX_FILE_BYTES = 128 * 1024 * 1024  # any one file a student's build or node writes
 POLL_S = 0.2  # how often a running child's log size and the cancel flag are looked at
 TERM_GRACE_S = 15.0  # after SIGTERM: a worker stops its node (up to 9 s) and writes results
 KILL_WAIT_S = 5.0
@@ -80,9 +83,10 @@ def run_bounded(
     cwd: Path | None = None,
     env: dict[str, str] | None = None,
     cancel: threading.Event | None = None,
+    max_file_bytes: int = MAX_FILE_BYTES,
 ) -> Finished:
     """Run `argv` with stdout and stderr in `log`; stop it on timeout, flood or cancel."""
-    guarded = [sys.executable, "-m", "harness.grading.process", *argv]
+    guarded = [sys.executable, "-m", "harness.grading.process", str(max_file_bytes), *argv]
     started = time.monotonic()
     log.parent.mkdir(parents=True, exist_ok=True)
     with open(log, "ab") as out:
@@ -128,11 +132,15 @@ def run_bounded(
     )
 
 
-def _exec_guarded(argv: list[str]) -> None:
-    """Die with the parent (SIGTERM), then become `argv`."""
+def _exec_guarded(max_file_bytes: int, argv: list[str]) -> None:
+    """Die with the parent (SIGTERM), cap file sizes, then become `argv`."""
     import ctypes
+    import resource
 
     parent = os.getppid()
+    hard = resource.getrlimit(resource.RLIMIT_FSIZE)[1]
+    cap = max_file_bytes if hard == resource.RLIM_INFINITY else min(hard, max_file_bytes)
+    resource.setrlimit(resource.RLIMIT_FSIZE, (cap, cap))
     try:
         ctypes.CDLL("libc.so.6", use_errno=True).prctl(PR_SET_PDEATHSIG, signal.SIGTERM)
     except (OSError, AttributeError):
@@ -147,6 +155,6 @@ def _exec_guarded(argv: list[str]) -> None:
 
 
 if __name__ == "__main__":
-    if len(sys.argv) < 2:
-        sys.exit("usage: python -m harness.grading.process CMD [ARGS...]")
-    _exec_guarded(sys.argv[1:])
+    if len(sys.argv) < 3 or not sys.argv[1].isdigit():
+        sys.exit("usage: python -m harness.grading.process MAX_FILE_BYTES CMD [ARGS...]")
+    _exec_guarded(int(sys.argv[1]), sys.argv[2:])

@@ -16,7 +16,7 @@ from html.parser import HTMLParser
 from pathlib import Path
 
 import pytest
-from command_line import fossbot_hil
+from command_line import COMMAND
 from grading_class import (
     LAB_SCENARIOS,
     broken_setup_package,
@@ -48,17 +48,24 @@ def graded(tmp_path_factory: pytest.TempPathFactory) -> Graded:
     broken_setup_package(classroom / "carol")
     script_student(classroom / "dave")
     before = {p.name: snapshot(p) for p in classroom.iterdir()}
-    out = tmp_path_factory.mktemp("grades") / "grades"
+    here = tmp_path_factory.mktemp("grader")
+    out = here / "grades"
     started = time.monotonic()
-    done = fossbot_hil(
-        "grade",
-        str(classroom),
-        "--out",
-        str(out),
-        "--jobs",
-        "2",
-        "--scenario",
-        ",".join(LAB_SCENARIOS),
+    done = subprocess.run(
+        [
+            *COMMAND,
+            "grade",
+            str(classroom),
+            "--out",
+            "grades",  # relative to the grader's folder, not the students'
+            "--jobs",
+            "2",
+            "--scenario",
+            ",".join(LAB_SCENARIOS),
+        ],
+        cwd=here,
+        capture_output=True,
+        text=True,
         timeout=200,
     )
     wall_s = time.monotonic() - started

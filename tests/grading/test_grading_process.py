@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import errno
 import sys
 import threading
 from pathlib import Path
@@ -55,6 +56,27 @@ def test_endless_output_is_stopped_at_the_log_limit(tmp_path: Path) -> None:
     done = run_bounded([sys.executable, "-c", code], log=log, timeout=30, max_log_bytes=200_000)
     assert done.flooded and not done.timed_out
     assert log.stat().st_size < 50_000_000
+
+
+def test_no_file_a_child_writes_can_outgrow_the_cap(tmp_path: Path) -> None:
+    """A node printing forever into a file of its own gets EFBIG at the cap, not the disk."""
+    code = (
+        "import sys\n"
+        f"with open({str(tmp_path / 'big')!r}, 'wb') as f:\n"
+        "    try:\n"
+        "        f.write(b'x' * 3_000_000)\n"
+        "    except OSError as err:\n"
+        "        sys.exit(err.errno)\n"
+    )
+    done = run_bounded(
+        [sys.executable, "-c", code],
+        log=tmp_path / "log",
+        timeout=30,
+        max_log_bytes=10_000,
+        max_file_bytes=1_000_000,
+    )
+    assert done.returncode == errno.EFBIG
+    assert (tmp_path / "big").stat().st_size <= 1_000_000
 
 
 def test_cancel_stops_a_running_child(tmp_path: Path) -> None:
