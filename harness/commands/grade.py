@@ -103,7 +103,22 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="longest one student's scenario suite may take (default 900)",
     )
     add_node_options(parser)
+    _adapt_node_options(parser)
+
+
+def _adapt_node_options(parser: argparse.ArgumentParser) -> None:
+    """`run`'s link and node options: the lab's names as defaults, the refused ones hidden."""
     parser.set_defaults(package=LAB_PACKAGE, executable=LAB_EXECUTABLE)
+    for action in parser._actions:  # argparse has no public way to edit an added option
+        if action.dest in NOT_FOR_GRADING:
+            action.help = argparse.SUPPRESS
+        elif action.dest == "link":
+            action.help = "ros2 (default), or a virtual board: rplidar, ldlidar"
+        elif action.dest in ("package", "executable"):
+            action.help = f"{action.help} (default: {action.default})"
+    for group in parser._action_groups:
+        if group.title and group.title.startswith("node under test"):
+            group.title = "each student's node"
 
 
 def check_grading_options(args: argparse.Namespace) -> None:
