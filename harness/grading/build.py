@@ -30,7 +30,7 @@ _PY_WHERE = re.compile(r'^\s*File "([^"]+)", line (\d+)')
 _WRAPPERS = {"CalledProcessError"}  # colcon's own report that a setup.py step failed
 _OTHER_ERRORS = (
     re.compile(r"^CMake Error.*?:\s*(.+)$"),
-    re.compile(r"^ERROR:colcon[\w.]*:(.+)$"),
+    re.compile(r"^(?:\[[\d.]+s\]\s*)?ERROR:colcon[\w.]*:(.+)$"),
     re.compile(r"^error: (.+)$"),
     re.compile(r"^(.*\berror\b.*)$", re.IGNORECASE),
 )
@@ -99,13 +99,26 @@ def _python_error(lines: list[str]) -> str | None:
     return None
 
 
+def _first_match(pattern: re.Pattern[str], lines: list[str]) -> str | None:
+    """The pattern's group in the first line it matches, with a list that follows a colon."""
+    for i, line in enumerate(lines):
+        match = pattern.match(line)
+        if match:
+            found = match.group(1).strip()
+            if found.endswith(":"):  # e.g. colcon's "Duplicate package names ...:" then "- ..."
+                items = [x.strip() for x in lines[i + 1 : i + 7] if x.lstrip().startswith("- ")]
+                found = " ".join([found, *items])
+            return found
+    return None
+
+
 def build_error(log_text: str, *, hide: tuple[Path, ...] = ()) -> str:
     """The line of a failed colcon log that says what is wrong, paths made short."""
     lines = [line.rstrip() for line in log_text.splitlines()]
     found = _python_error(lines)
     if found is None:
         for pattern in _OTHER_ERRORS:
-            found = next((m.group(1).strip() for m in map(pattern.match, lines) if m), None)
+            found = _first_match(pattern, lines)
             if found:
                 break
     if found is None:

@@ -38,6 +38,11 @@ Failed   <<< fossbot_lidar_processing [0.23s, exited with code 1]
             "setup.py line 3: ModuleNotFoundError: No module named 'foo'",
         ),
         (
+            "[0.628s] ERROR:colcon:colcon build: Duplicate package names not supported:\n"
+            "- pkg:\n  - /class/ana/src/pkg\n  - /class/ana/src/old/pkg\n",
+            "colcon build: Duplicate package names not supported: - pkg: - src/pkg - src/old/pkg",
+        ),
+        (
             "running install_data\nerror: can't copy 'resource/pkg': doesn't exist or not a "
             "regular file\nFailed   <<< pkg [0.9s, exited with code 1]\n",
             "can't copy 'resource/pkg': doesn't exist or not a regular file",
