@@ -126,8 +126,9 @@ def build_error(log_text: str, *, hide: tuple[Path, ...] = ()) -> str:
         found = f"colcon: {failed.group(1)} failed ({failed.group(2)})" if failed else None
     if found is None:
         found = next((line for line in reversed(lines) if line.strip()), "colcon failed")
-    for folder in hide:
-        found = found.replace(f"{folder.resolve()}/", "").replace(f"{folder}/", "")
+    for folder in hide:  # paths inside the student's folder, relative; the folder, by name
+        for path in dict.fromkeys((str(folder.resolve()), str(folder))):
+            found = found.replace(f"{path}/", "").replace(path, folder.name)
     if "CMakeLists.txt" in found:  # colcon took it for ament_cmake, the default build type
         found += " (does package.xml say <build_type>ament_python</build_type>?)"
     return found

@@ -48,9 +48,9 @@ Failed   <<< fossbot_lidar_processing [0.23s, exited with code 1]
             "can't copy 'resource/pkg': doesn't exist or not a regular file",
         ),
         (
-            'CMake Error: The source directory "/class/ana/pkg" does not appear to contain '
+            'CMake Error: The source directory "/class/ana" does not appear to contain '
             "CMakeLists.txt.\n",
-            'The source directory "pkg" does not appear to contain CMakeLists.txt. '
+            'The source directory "ana" does not appear to contain CMakeLists.txt. '
             "(does package.xml say <build_type>ament_python</build_type>?)",
         ),
         (
