@@ -1,20 +1,56 @@
 """The fossbot-hil pytest plugin (registered by entry point; no conftest needed).
 
-For now it selects a physical board for hardware-in-the-loop tests: tests
-marked ``hil`` run against the board named with ``--hil-port`` and skip,
-saying why, where none is given. Never opens a port that was not named.
+A test asks for ``hil`` and runs scenarios against the node under test::
+
+    def test_wall(hil):
+        result = hil.run("approach_wall", threshold=0.4, faults="noisy")
+        assert result.ok, result.explanation
+
+The node and the link come from ``--hil-*`` options (or ``hil_*`` ini
+keys), mirrored by fixtures a conftest may override: ``hil_node``,
+``hil_link``, ``hil_link_options``. ``@pytest.mark.hil_scenarios(...)``
+parametrises ``hil_case``. Tests marked ``hil`` need a physical board
+(``--hil-port``) and skip, saying why, without one. Under pytest-xdist each
+run reserves its own ROS domain and runs on one port take turns.
+
+This module imports neither rclpy nor pybullet (nor numpy): it is loaded
+into every pytest session of whoever installed the package.
 """
 
 from __future__ import annotations
 
+import os
+from collections.abc import Iterator
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
 
 import pytest
+
+from harness.pytest_cases import MARKER, MARKER_HELP, HilCase
+from harness.pytest_options import HilConfig, add_options, check_config, read_config
+
+if TYPE_CHECKING:
+    from harness.links.base import LinkOptions
+    from harness.pytest_run import Hil
+
+__all__ = ["HilBoard", "HilCase", "NodeUnderTest"]
 
 NO_BOARD = (
     "no physical board named: give --hil-port /dev/ttyUSB0 (the USB-UART wired to the "
     "board's LIDAR input) and --hil-domain-id N (the board's ROS_DOMAIN_ID)"
 )
+_CONFIG = pytest.StashKey[HilConfig]()
+
+
+@dataclass(frozen=True)
+class NodeUnderTest:
+    """The node to start: a shell command, or a package's executable; none: the reference."""
+
+    command: str | None = None
+    package: str | None = None
+    executable: str | None = None
+    workspace: str | None = None
+    params: tuple[str, ...] = ()  # NAME:=VALUE, passed verbatim
 
 
 @dataclass(frozen=True)
@@ -25,36 +61,36 @@ class HilBoard:
     domain_id: int
     link: str  # the device the board expects: rplidar or ldlidar
 
+    def run_options(self) -> dict[str, Any]:
+        """Keyword arguments for ``hil.run`` that send the scenario to this board."""
+        return {
+            "link": self.link,
+            "port": self.port,
+            "domain_id": self.domain_id,
+            "ros_network": True,
+        }
 
+
+# -- hooks --------------------------------------------------------------------
 def pytest_addoption(parser: pytest.Parser) -> None:
-    group = parser.getgroup("fossbot-hil", "FOSSBot hardware-in-the-loop")
-    group.addoption(
-        "--hil-port",
-        metavar="DEV",
-        default=None,
-        help="USB-UART wired to the board's LIDAR input (enables hil tests)",
-    )
-    group.addoption(
-        "--hil-domain-id",
-        metavar="N",
-        type=int,
-        default=None,
-        help="the board's ROS_DOMAIN_ID (default 0)",
-    )
-    group.addoption(
-        "--hil-link",
-        default="rplidar",
-        choices=["rplidar", "ldlidar"],
-        help="which LIDAR the board expects (default rplidar)",
-    )
+    add_options(parser)
 
 
 def pytest_configure(config: pytest.Config) -> None:
     config.addinivalue_line("markers", "hil: needs a physical FOSSBot board (--hil-port)")
+    config.addinivalue_line("markers", MARKER_HELP)
+    # ROS 2's message code imports lark, which imports modules Python 3.11
+    # deprecates: noise in every test that runs a node, and not the user's to fix.
+    config.addinivalue_line(
+        "filterwarnings", "ignore:module 'sre_(parse|constants)' is deprecated:DeprecationWarning"
+    )
+    cfg = read_config(config)
+    check_config(cfg, config)
+    config.stash[_CONFIG] = cfg
 
 
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
-    if config.getoption("--hil-port") is not None:
+    if config.stash[_CONFIG].port is not None:
         return
     skip = pytest.mark.skip(reason=NO_BOARD)
     for item in items:
@@ -62,12 +98,125 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
             item.add_marker(skip)
 
 
+def pytest_generate_tests(metafunc: pytest.Metafunc) -> None:
+    marker = metafunc.definition.get_closest_marker(MARKER)
+    if marker is None:
+        return
+    from harness.errors import ConfigError
+    from harness.pytest_cases import cases_from_marker
+
+    if "hil_case" not in metafunc.fixturenames:
+        pytest.fail(
+            f"@pytest.mark.{MARKER} on {metafunc.function.__name__}: "
+            "the test needs a hil_case argument",
+            pytrace=False,
+        )
+    try:
+        cases = cases_from_marker(marker.args, dict(marker.kwargs))
+    except ConfigError as err:
+        problem = str(err)  # failed outside the handler: no chained traceback
+    else:
+        metafunc.parametrize("hil_case", cases, ids=[c.id for c in cases])
+        return
+    pytest.fail(f"@pytest.mark.{MARKER}: {problem}", pytrace=False)
+
+
+# -- fixtures -------------------------------------------------------------------
+@pytest.fixture(scope="session")
+def hil_config(pytestconfig: pytest.Config) -> HilConfig:
+    """The session's ``--hil-*`` settings (command line, then ini, then defaults)."""
+    return pytestconfig.stash[_CONFIG]
+
+
 @pytest.fixture
-def hil_board(request: pytest.FixtureRequest) -> HilBoard:
-    """The board selected on the command line (hil tests only run when there is one)."""
-    config = request.config
-    port = config.getoption("--hil-port")
-    if port is None:
+def hil_node(hil_config: HilConfig) -> NodeUnderTest:
+    """The node under test; override in a conftest to fix it for a project."""
+    return NodeUnderTest(
+        command=hil_config.node,
+        package=hil_config.package,
+        executable=hil_config.executable,
+        workspace=hil_config.workspace,
+        params=hil_config.param,
+    )
+
+
+@pytest.fixture
+def hil_link(hil_config: HilConfig) -> str:
+    """The link ``hil.run`` uses: --hil-link, else ros2."""
+    return hil_config.run_link
+
+
+@pytest.fixture
+def hil_link_options(hil_config: HilConfig, hil_node: NodeUnderTest, hil_link: str) -> LinkOptions:
+    """Link settings for every run of the test (the runner fills in threshold and rate)."""
+    from harness.links.base import LinkOptions
+
+    physical = hil_link in ("rplidar", "ldlidar") and hil_config.port is not None
+    return LinkOptions(
+        scan_timeout=hil_config.timeout,
+        ready_timeout=hil_config.ready_timeout,
+        node=hil_node.command,
+        package=hil_node.package,
+        executable=hil_node.executable,
+        workspace=hil_node.workspace,
+        params=tuple(hil_node.params),
+        domain_id=hil_config.domain_id,
+        ros_network=physical,  # a board is another machine: discover beyond localhost
+        port=hil_config.port if physical else None,
+    )
+
+
+@pytest.fixture
+def hil(
+    request: pytest.FixtureRequest,
+    hil_config: HilConfig,
+    hil_link: str,
+    hil_link_options: LinkOptions,
+) -> Hil:
+    """Runs scenarios: ``hil.run("approach_wall", threshold=0.4, faults="noisy")``."""
+    from harness.pytest_run import Hil
+
+    return Hil(
+        hil_link,
+        hil_link_options,
+        seed=hil_config.seed,
+        port_wait=hil_config.port_wait,
+        base_dir=request.path.parent,
+        record=lambda name, value: request.node.user_properties.append((name, value)),
+    )
+
+
+@pytest.fixture
+def hil_case() -> HilCase:
+    """Given by ``@pytest.mark.hil_scenarios(...)``; without the marker there is none."""
+    pytest.fail(
+        f"hil_case comes from @pytest.mark.{MARKER}(...) on the test, which it lacks",
+        pytrace=False,
+    )
+
+
+@pytest.fixture
+def hil_board(hil_config: HilConfig) -> Iterator[HilBoard]:
+    """The board named on the command line, held for this test (other workers wait).
+
+    hil tests only run when there is one; the wait for a port another run
+    holds is bounded by --hil-port-wait.
+    """
+    if hil_config.port is None:
         pytest.skip(NO_BOARD)
-    domain = config.getoption("--hil-domain-id")
-    return HilBoard(port, 0 if domain is None else domain, config.getoption("--hil-link"))
+    from harness.errors import ConfigError
+    from harness.serial_line.port_lock import hold_port
+
+    env_id = os.environ.get("ROS_DOMAIN_ID", "0")
+    default_id = int(env_id) if env_id.isdigit() else 0
+    domain = hil_config.domain_id if hil_config.domain_id is not None else default_id
+    label = f"--hil-port {hil_config.port}"
+    try:
+        lock = hold_port(hil_config.port, hil_config.port_wait, label=label)
+    except ConfigError as err:
+        problem = str(err)  # failed outside the handler: no chained traceback
+    else:
+        with lock:
+            yield HilBoard(hil_config.port, domain, hil_config.board_link)
+        return
+    pytest.fail(problem, pytrace=False)

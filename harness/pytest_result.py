@@ -1,0 +1,109 @@
+"""What ``hil.run`` returns: a RunResult with the reading a failing test needs.
+
+``assert result.ok, result.explanation`` prints the oracle's explanation of
+the first failed tick, how many more failed, why the run ended early, and
+the node's last stderr lines when it crashed or went quiet. The short
+``repr`` is what a bare ``assert result.ok`` shows. Pure: no rclpy here.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from harness.trace import RunResult, TickRecord
+
+__all__ = ["HilResult"]
+
+REPR_CHARS = 160  # of the first failure, in repr
+LISTED_TICKS = 10  # further failed ticks named by number
+
+
+@dataclass(frozen=True)
+class HilResult:
+    """One scenario run through one link, judged tick by tick."""
+
+    raw: RunResult
+    domain_id: int | None = None  # the ROS domain the run used (None: no ROS graph)
+
+    @property
+    def ok(self) -> bool:
+        """Every tick passed and nothing ended the run early."""
+        return self.raw.ok
+
+    @property
+    def records(self) -> list[TickRecord]:
+        return self.raw.records
+
+    @property
+    def failed_ticks(self) -> list[TickRecord]:
+        return self.raw.failed_ticks
+
+    @property
+    def scenario(self) -> str:
+        return self.raw.scenario
+
+    def _title(self) -> str:
+        r = self.raw
+        return (
+            f"{r.scenario} over {r.link} (seed {r.seed}, faults {r.faults or 'clean'}, "
+            f"threshold {r.threshold:g} m)"
+        )
+
+    def _node_output_matters(self) -> bool:
+        """The node's stderr explains a crash, a start-up failure or silence, not a wrong value."""
+        if self.raw.error is not None:
+            return True
+        return any(r.verdict.claim is None for r in self.failed_ticks)
+
+    @property
+    def explanation(self) -> str:
+        """Readable text: the first failure, how many more, the run error, the node's stderr."""
+        r = self.raw
+        failed = self.failed_ticks
+        if self.ok:
+            return f"{self._title()}: all {len(r.records)} ticks passed"
+        if r.not_started:
+            lines = [f"{self._title()}: did not start: {r.error}"]
+        else:
+            lines = [f"{self._title()}: {len(failed)} of {len(r.records)} ticks failed"]
+        if failed:
+            lines.append(f"first failure: {failed[0].verdict.explanation}")
+            more = [str(t.tick) for t in failed[1 : 1 + LISTED_TICKS]]
+            if len(failed) > 1:
+                etc = ", ..." if len(failed) > 1 + LISTED_TICKS else ""
+                lines.append(f"{len(failed) - 1} more failed ticks: {', '.join(more)}{etc}")
+        if r.error is not None and not r.not_started:
+            problem = r.error.partition(": ")[2] or r.error  # without its "t=... tick N: "
+            if not failed or problem not in failed[0].verdict.explanation:
+                lines.append(f"the run ended early: {r.error}")
+        if r.diagnostics and self._node_output_matters():
+            lines.append(r.diagnostics.rstrip())
+        return "\n".join(lines)
+
+    def check(self) -> HilResult:
+        """Raise AssertionError with the explanation unless ok; returns self to chain."""
+        if not self.ok:
+            raise AssertionError(self.explanation)
+        return self
+
+    def __repr__(self) -> str:
+        r = self.raw
+        where = f"{r.scenario} over {r.link}"
+        if self.ok:
+            return f"<HilResult {where}: PASS, {len(r.records)} ticks>"
+        failed = self.failed_ticks
+        if failed:
+            first = failed[0].verdict.explanation
+        else:
+            first = r.error or "failed"
+        if len(first) > REPR_CHARS:
+            first = first[: REPR_CHARS - 3] + "..."
+        count = f"{len(failed)} of {len(r.records)} ticks failed"
+        if r.not_started:
+            count = "did not start"
+        return f"<HilResult {where}: FAIL, {count}: {first}>"
+
+    def __str__(self) -> str:
+        return self.explanation

@@ -1,0 +1,214 @@
+"""The ``hil`` fixture's object: run one scenario through a link and judge it.
+
+Everything heavy (the runner, PyBullet, rclpy) is imported when a test
+first calls ``hil.run``, never when pytest loads the plugin. A mistake in
+the test's arguments (unknown scenario or fault profile, nonsense
+threshold) fails that test with one line instead of a traceback into the
+harness. Each run that starts a ROS graph holds its own domain id, reserved
+here so the result can name it, and a run on a physical port holds that
+port, so parallel pytest workers and sessions never meet.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from collections.abc import Callable, Sequence
+from contextlib import ExitStack
+from dataclasses import fields, replace
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, NoReturn
+
+import pytest
+
+from harness.errors import ConfigError, HarnessError
+from harness.pytest_cases import HilCase, split_faults
+from harness.pytest_options import DEFAULT_PORT_WAIT_S, SERIAL_LINKS
+from harness.pytest_result import HilResult
+
+if TYPE_CHECKING:
+    from harness.links.base import LinkOptions
+    from harness.scenario import Scenario
+
+    ScenarioRef = str | os.PathLike[str] | HilCase | Scenario
+    Faults = str | Sequence[str | dict[str, Any]] | None
+
+__all__ = ["Hil"]
+#: LinkOptions fields the runner fills in itself, per scenario.
+RUNNER_FIELDS = ("threshold", "scan_rate_hz")
+
+
+def _fail(message: str) -> NoReturn:
+    pytest.fail(f"hil.run: {message}", pytrace=False)
+
+
+def _fault_list(faults: Faults) -> list[str | dict[str, Any]] | None:
+    """A name, "a,b", or a list of names and inline fault mappings; checked now."""
+    from harness.faults import build_profile
+
+    if faults is None:
+        return None
+    items: list[str | dict[str, Any]]
+    if isinstance(faults, str):
+        items = list(split_faults(faults))
+    elif isinstance(faults, Sequence):
+        items = list(faults)
+    else:
+        raise ConfigError(f"faults must be a name, 'a,b' or a list, got {faults!r}")
+    build_profile(items, field_name="faults")
+    return items
+
+
+class Hil:
+    """Run scenarios against the node under test; see docs/pytest.md."""
+
+    def __init__(
+        self,
+        link: str,
+        options: LinkOptions,
+        *,
+        seed: int | None = None,
+        port_wait: float = DEFAULT_PORT_WAIT_S,
+        base_dir: Path | None = None,
+        record: Callable[[str, object], None] | None = None,
+    ) -> None:
+        self.link = link
+        self.options = options
+        self.seed = seed
+        self.port_wait = port_wait
+        self.base_dir = base_dir  # relative scenario paths may be relative to the test file
+        self.results: list[HilResult] = []
+        self._record = record
+
+    def __repr__(self) -> str:
+        o = self.options
+        node = o.node or (f"{o.package} {o.executable}" if o.package else None)
+        what = f"node {node!r}" if node else "the reference node"
+        if self.link == "inprocess":
+            what = f"processor {o.processor!r}" if o.processor else "the reference processing"
+        return f"<hil: {self.link} link, {what}>"
+
+    # -- arguments ----------------------------------------------------------
+    def _scenario(self, ref: ScenarioRef) -> Scenario:
+        from harness.scenario import Scenario, resolve_scenario
+
+        if isinstance(ref, Scenario):
+            return ref
+        text = os.fspath(ref) if not isinstance(ref, HilCase) else ref.scenario
+        if not isinstance(text, str):
+            raise ConfigError(f"scenario must be a name or a path, got {ref!r}")
+        candidate = Path(text)
+        if (
+            self.base_dir is not None
+            and not candidate.is_absolute()
+            and not candidate.exists()
+            and (self.base_dir / candidate).is_file()
+        ):
+            text = str(self.base_dir / candidate)
+        return resolve_scenario(text)
+
+    def _options(self, link: str, overrides: dict[str, Any]) -> LinkOptions:
+        names = [f.name for f in fields(self.options) if f.name not in RUNNER_FIELDS]
+        for key in overrides:
+            if key not in names:
+                raise ConfigError(f"unknown option {key!r} (known: link, {', '.join(names)})")
+        if "params" in overrides:
+            overrides = {**overrides, "params": tuple(overrides["params"])}
+        options = replace(self.options, **overrides)
+        if link not in SERIAL_LINKS and "port" not in overrides:
+            options = replace(options, port=None)  # the board's port concerns board links only
+        return options
+
+    def _checked(
+        self,
+        scenario: ScenarioRef,
+        threshold: float | None,
+        faults: Faults,
+        seed: int | None,
+        link: str,
+        status_regex: str | None,
+        overrides: dict[str, Any],
+    ) -> tuple[Scenario, list[str | dict[str, Any]] | None, LinkOptions]:
+        """The run's arguments, checked; ConfigError names the first bad one."""
+        chosen = self._scenario(scenario)
+        fault_items = _fault_list(faults)
+        if threshold is not None and not (
+            isinstance(threshold, (int, float)) and math.isfinite(threshold) and threshold > 0
+        ):
+            raise ConfigError(f"threshold must be a positive number of metres, got {threshold!r}")
+        if seed is not None and not (isinstance(seed, int) and 0 <= seed < 2**32):
+            raise ConfigError(f"seed must be a whole number in 0..2**32-1, got {seed!r}")
+        if status_regex is not None:
+            from harness.status import compile_status_pattern
+
+            compile_status_pattern(status_regex)
+        return chosen, fault_items, self._options(link, overrides)
+
+    # -- running ------------------------------------------------------------
+    def run(
+        self,
+        scenario: ScenarioRef,
+        threshold: float | None = None,
+        faults: Faults = None,
+        seed: int | None = None,
+        *,
+        link: str | None = None,
+        status_regex: str | None = None,
+        **overrides: Any,
+    ) -> HilResult:
+        """Run one scenario (a shipped name, a file, or a ``hil_case``) and judge every tick.
+
+        `threshold`, `faults` and `seed` override the scenario file's;
+        `overrides` are LinkOptions fields (``node=``, ``params=``,
+        ``scan_timeout=`` ...). Returns the result; it does not assert.
+        """
+        from harness.runner import RunSettings
+
+        link = link if link is not None else self.link
+        if isinstance(scenario, HilCase) and faults is None:
+            faults = scenario.faults
+        seed = seed if seed is not None else self.seed
+        try:
+            chosen, fault_items, options = self._checked(
+                scenario, threshold, faults, seed, link, status_regex, overrides
+            )
+        except ConfigError as err:
+            problem = str(err)  # failed outside the handler: no chained traceback
+        else:
+            problem = None
+        if problem is not None:
+            _fail(problem)
+        settings = RunSettings(
+            seed=seed, threshold=threshold, faults=fault_items, status_pattern=status_regex
+        )
+        result = self._run(chosen, link, options, settings)
+        self.results.append(result)
+        if self._record is not None:
+            verdict = "PASS" if result.ok else f"FAIL ({len(result.failed_ticks)} ticks)"
+            self._record("hil", f"{result.scenario} over {link}: {verdict}")
+        return result
+
+    def _run(self, scenario: Scenario, link: str, options: LinkOptions, settings: Any) -> HilResult:
+        from harness.runner import run
+
+        physical = link in SERIAL_LINKS and options.port is not None
+        domain_id = options.domain_id
+        try:
+            with ExitStack() as held:
+                if physical:
+                    from harness.serial_line.port_lock import hold_port
+
+                    assert options.port is not None
+                    label = f"--hil-port {options.port}"
+                    held.enter_context(hold_port(options.port, self.port_wait, label=label))
+                elif link != "inprocess" and domain_id is None:
+                    from harness.ros_domain import reserve_domain
+
+                    domain_id = held.enter_context(reserve_domain()).domain_id
+                    options = replace(options, domain_id=domain_id)
+                raw = run(scenario, link, options, settings)
+        except HarnessError as err:  # ConfigError (node, link, port) or no free domain
+            problem = str(err)
+        else:
+            return HilResult(raw, domain_id=None if link == "inprocess" else domain_id)
+        _fail(problem)
