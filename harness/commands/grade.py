@@ -131,10 +131,6 @@ def check_grading_options(args: argparse.Namespace) -> None:
         raise ConfigError(f"--link {args.link}: grade runs students' nodes (use {known})")
     if not args.package or not args.executable:
         raise ConfigError("--package and --executable must name the lab's node")
-    if importlib.util.find_spec("rclpy") is None:
-        raise ConfigError(
-            "grading needs rclpy: pip install 'fossbot-hil[ros]' (or source ROS 2 Jazzy)"
-        )
 
 
 def selected_scenarios(items: list[str]) -> list[Scenario]:
@@ -149,8 +145,8 @@ def selected_scenarios(items: list[str]) -> list[Scenario]:
     return scenarios
 
 
-def prepare_out(out: Path) -> Path:
-    """The output folder, new or one of ours; never someone's folder of other files."""
+def check_out(out: Path) -> None:
+    """The output folder must be new, empty or one of ours: never someone's folder of files."""
     if out.exists() and not out.is_dir():
         raise ConfigError(f"--out {out}: not a folder")
     if out.is_dir() and not (out / GRADES_MARKER).exists() and any(out.iterdir()):
@@ -158,6 +154,11 @@ def prepare_out(out: Path) -> Path:
             f"--out {out}: not empty and not written by 'fossbot-hil grade' "
             "(choose a new or empty folder)"
         )
+
+
+def prepare_out(out: Path) -> Path:
+    """Create (or reuse) the output folder, marked as ours, without last time's students."""
+    check_out(out)
     try:
         out.mkdir(parents=True, exist_ok=True)
         (out / GRADES_MARKER).write_text("written by fossbot-hil grade\n", encoding="utf-8")
@@ -203,8 +204,13 @@ def run(args: argparse.Namespace, console: Console) -> int:
     check_status_regex(args)
     out = Path(args.out)
     found = discover(args.dirs, exclude=out)  # before prepare_out: no folder for a typo
+    check_out(out)
     if any(s.kind in ("package", "workspace") for s in found.students):
         colcon_executable()
+    if importlib.util.find_spec("rclpy") is None:  # checked last: the input was fine
+        raise ConfigError(
+            "grading needs rclpy: pip install 'fossbot-hil[ros]' (or source ROS 2 Jazzy)"
+        )
     prepare_out(out)
 
     names = tuple(s.name for s in scenarios)
