@@ -36,7 +36,7 @@ if TYPE_CHECKING:
 __all__ = ["HilBoard", "HilCase", "NodeUnderTest"]
 
 NO_BOARD = (
-    "no physical board named: give --hil-port /dev/ttyUSB0 (the USB-UART wired to the "
+    "no physical board named: give --hil-port=/dev/ttyUSB0 (the USB-UART wired to the "
     "board's LIDAR input) and --hil-domain-id N (the board's ROS_DOMAIN_ID)"
 )
 _CONFIG = pytest.StashKey[HilConfig]()
