@@ -12,6 +12,7 @@ import contextlib
 import ctypes
 import os
 import sys
+import tempfile
 from collections.abc import Iterator
 
 _LIBC = ctypes.CDLL(None)
@@ -38,6 +39,45 @@ def _stdout_silenced() -> Iterator[None]:
             os.close(copy)
 
 
+@contextlib.contextmanager
+def captured_output() -> Iterator[list[str]]:
+    """Send fds 1 and 2 to a temporary file; afterwards the list holds what was written.
+
+    PyBullet's loaders print their warnings and errors there instead of
+    raising them: kept off our stdout, they can still explain a failure.
+    """
+    lines: list[str] = []
+    sys.stdout.flush()
+    sys.stderr.flush()
+    _LIBC.fflush(None)
+    saved = {fd: os.dup(fd) for fd in (1, 2)}
+    try:
+        with tempfile.TemporaryFile() as capture:  # unlinked at once: nothing is left behind
+            for fd in saved:
+                os.dup2(capture.fileno(), fd)
+            try:
+                yield lines
+            finally:
+                _LIBC.fflush(None)
+                for fd, copy in saved.items():
+                    os.dup2(copy, fd)
+                capture.seek(0)
+                text = capture.read(1 << 20).decode("utf-8", "replace")
+                lines.extend(line.strip() for line in text.splitlines() if line.strip())
+    finally:
+        for copy in saved.values():
+            os.close(copy)
+
+
+def last_complaint(lines: list[str]) -> str:
+    """PyBullet's last error or warning among captured lines, without its source location."""
+    for line in reversed(lines):
+        text = line.split("]:", 1)[1].strip() if line.startswith("b3") and "]:" in line else line
+        if text:
+            return text[:200]
+    return ""
+
+
 with _stdout_silenced():
     import pybullet as pb
 
@@ -48,4 +88,4 @@ def connect(gui: bool = False) -> int:
         return pb.connect(pb.GUI if gui else pb.DIRECT)
 
 
-__all__ = ["connect", "pb"]
+__all__ = ["captured_output", "connect", "last_complaint", "pb"]

@@ -13,19 +13,22 @@ robot pitches in wheels mode. Obstacles keep PyBullet's default groups.
 
 from __future__ import annotations
 
+import contextlib
 import math
 import os
 import sys
-from importlib import resources
+from collections.abc import Iterator
 from pathlib import Path
 from types import TracebackType
 
 import numpy as np
 
 from harness.errors import ConfigError
+from harness.model_files import check_model_file, find_model_file, robot_models_dir
 from harness.scenario import Box, Cylinder, Model, Scenario, Wall
 from harness.sim import bullet
 from harness.sim.bullet import pb
+from harness.sim.geometry import cylinder_segments
 from harness.sim.motion import WheelGeometry
 
 TIME_STEP = 1.0 / 240.0  # s; the only physics step the harness uses
@@ -37,18 +40,8 @@ FLOOR_GROUP = 1 << 7  # collision filter group of the floor
 _STATIC_GROUP = 2  # Bullet's StaticFilter
 RAY_MASK = -1 & ~(ROBOT_GROUP | FLOOR_GROUP)  # what the LIDAR may hit
 
-# Scenario cylinders become triangle-mesh prisms: Bullet's ray test against
-# an implicit cylinder is off by up to ~1 mm, a fine prism by far less.
-CYLINDER_SAGITTA = 2e-5  # m, largest gap between the prism and the true circle
-_CYLINDER_SEGMENTS = (64, 2048)
-
 _OBSTACLE_RGBA = (0.8, 0.55, 0.3, 1.0)
 _FLOOR_RGBA = (0.85, 0.85, 0.85, 1.0)
-
-
-def robot_models_dir() -> Path:
-    """Folder of the shipped robot and world models (``robot_models/``)."""
-    return Path(str(resources.files("harness.robot_models")))
 
 
 def yaw_quaternion(yaw: float) -> tuple[float, float, float, float]:
@@ -178,7 +171,7 @@ class World:
         field = f"obstacles[{index}].path"
         path = self.resolve(model.path, field)
         position, orientation = model.position, yaw_quaternion(model.yaw)
-        try:
+        with self._loading(field, model.path):
             if path.suffix == ".urdf":
                 body = pb.loadURDF(
                     str(path),
@@ -190,10 +183,10 @@ class World:
                 )
                 return (body,)
             bodies = tuple(pb.loadSDF(str(path), physicsClientId=c))
-        except pb.error as err:
+        if not bodies:
             raise ConfigError(
-                f"{self.where}: {field}: cannot load {model.path!r}: PyBullet: {err}"
-            ) from None
+                f"{self.where}: {field}: cannot load {model.path!r}: PyBullet found no model in it"
+            )
         for body in bodies:  # place the SDF's world at (position, yaw); obstacles stay put
             pos, orn = pb.getBasePositionAndOrientation(body, physicsClientId=c)
             pos, orn = pb.multiplyTransforms(position, orientation, pos, orn)
@@ -201,10 +194,28 @@ class World:
             pb.changeDynamics(body, -1, mass=0.0, physicsClientId=c)
         return bodies
 
+    @contextlib.contextmanager
+    def _loading(self, field: str, ref: str) -> Iterator[None]:
+        """Run a PyBullet loader with its chatter captured; its failures become ConfigErrors.
+
+        The file was checked (``harness.model_files``) before, so this only
+        catches what PyBullet still refuses: a mesh it cannot read, say.
+        """
+        prefix = f"{self.where}: {field}: cannot load {ref!r}: PyBullet"
+        with bullet.captured_output() as lines:
+            try:
+                yield
+            except pb.error as err:
+                complaint = bullet.last_complaint(lines)
+                raise ConfigError(f"{prefix}: {complaint or err}") from None
+        unreadable = next((line for line in lines if "cannot extract mesh" in line), None)
+        if unreadable is not None:
+            raise ConfigError(f"{prefix}: {unreadable.split(': ', 1)[-1][:200]}")
+
     def _load_robot(self) -> int:
         c = self.client
         start = self.scenario.robot.start
-        try:
+        with self._loading("robot.urdf", self.scenario.robot.urdf):
             robot = pb.loadURDF(
                 str(self.robot_path),
                 basePosition=(start.x, start.y, 0.0),
@@ -212,11 +223,6 @@ class World:
                 flags=pb.URDF_USE_IMPLICIT_CYLINDER | pb.URDF_USE_INERTIA_FROM_FILE,
                 physicsClientId=c,
             )
-        except pb.error as err:
-            raise ConfigError(
-                f"{self.where}: robot.urdf: cannot load {self.scenario.robot.urdf!r}: "
-                f"PyBullet: {err}"
-            ) from None
         for link in range(-1, pb.getNumJoints(robot, physicsClientId=c)):
             pb.setCollisionFilterGroupMask(robot, link, ROBOT_GROUP, -1, physicsClientId=c)
         self.robot = robot
@@ -226,20 +232,16 @@ class World:
     # -- lookups ----------------------------------------------------------
 
     def resolve(self, ref: str, field: str) -> Path:
-        """A model file: absolute, else next to the scenario file, else in robot_models/."""
-        given = Path(ref).expanduser()
-        if given.is_absolute():
-            candidates = [given]
-        else:
-            folders = [self.scenario.base_dir, robot_models_dir()]
-            candidates = [folder / given for folder in folders if folder is not None]
-        for candidate in candidates:
-            if candidate.is_file():
-                return candidate
-        looked = ", ".join(str(c.parent) for c in candidates)
-        raise ConfigError(
-            f"{self.where}: {field}: cannot load {ref!r}: no such file (looked in {looked})"
-        )
+        """A model file, checked: next to the scenario file, else in robot_models/.
+
+        The rules (relative paths that stay inside the folder they are found
+        in; files PyBullet can load without crashing) are
+        ``harness.model_files``'s.
+        """
+        what = f"{self.where}: {field}: cannot load {ref!r}"
+        model = find_model_file(ref, [self.scenario.base_dir, robot_models_dir()], what=what)
+        check_model_file(model, what=what)
+        return model.path
 
     def link_names(self) -> list[str]:
         """The robot's link names; index i + 1 holds link i (index 0 is the root, -1)."""
@@ -385,9 +387,7 @@ def link_frame_pose(
 
 def cylinder_prism(radius: float, height: float) -> tuple[list[list[float]], list[int]]:
     """A closed triangle-mesh prism around an upright cylinder centred at the origin."""
-    step = math.acos(max(-1.0, 1.0 - CYLINDER_SAGITTA / radius))
-    lo, hi = _CYLINDER_SEGMENTS
-    n = min(hi, max(lo, math.ceil(math.pi / step)))
+    n = cylinder_segments(radius)
     ring = [
         (radius * math.cos(2 * math.pi * k / n), radius * math.sin(2 * math.pi * k / n))
         for k in range(n)

@@ -181,7 +181,7 @@ def test_unloadable_model_file_names_the_obstacle(tmp_path, name):
         obstacles=[{"type": "model", "path": name}], source=str(tmp_path / "s.yaml")
     )
     with pytest.raises(
-        ConfigError, match=rf"s\.yaml: obstacles\[0\]\.path: cannot load '{name}': PyBullet"
+        ConfigError, match=rf"s\.yaml: obstacles\[0\]\.path: cannot load '{name}': not well-formed"
     ):
         World(scenario)
 
@@ -190,7 +190,7 @@ def test_unloadable_robot_file(tmp_path):
     """A robot URDF PyBullet cannot parse names robot.urdf."""
     (tmp_path / "bad.urdf").write_text("<robot><link></robot>")
     with pytest.raises(
-        ConfigError, match=r"s\.yaml: robot\.urdf: cannot load 'bad\.urdf': PyBullet"
+        ConfigError, match=r"s\.yaml: robot\.urdf: cannot load 'bad\.urdf': not well-formed"
     ):
         World(make_scenario(robot={"urdf": "bad.urdf"}, source=str(tmp_path / "s.yaml")))
 

@@ -1,0 +1,499 @@
+"""Model files a scenario names: where they may live, and whether PyBullet can take them.
+
+Pure (xml.etree, no pybullet), so a scenario file is checked when it is
+loaded, before any node or board is started, and so it unit-tests fast.
+
+Where: a scenario names its robot (``robot.urdf``) and model obstacles
+(``obstacles[i].path``) by paths relative to its own folder, else to the
+shipped ``robot_models/``. Whatever the path says, the file it resolves to
+(symlinks followed) must lie inside the folder it was found in, and so must
+every mesh the model uses: a scenario file from elsewhere cannot make the
+harness read ``/etc/passwd`` or a file beside the project.
+
+What: PyBullet's URDF/SDF parsers print their complaints on stdout and
+crash the whole process on some broken files (a URDF with two root links
+segfaults; a mesh path naming a folder aborts with ``std::bad_alloc``; an
+SDF model of two links without a joint segfaults). So each file is read
+here first, bounded in size, and checked for what PyBullet needs: well-formed
+XML without DTDs, the right root element, links with unique names joined
+into one tree by known joint types, one shape per geometry with finite,
+positive sizes, and mesh files that exist, are regular files of a kind
+PyBullet reads and look like that kind.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import stat
+import struct
+import xml.etree.ElementTree as ET
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
+from importlib import resources
+from pathlib import Path, PurePosixPath
+
+from harness.errors import ConfigError
+
+__all__ = [
+    "MAX_MESH_BYTES",
+    "MAX_MODEL_BYTES",
+    "MESH_SUFFIXES",
+    "ModelFile",
+    "check_model_file",
+    "find_model_file",
+    "robot_models_dir",
+]
+
+MAX_MODEL_BYTES = 5 << 20  # a URDF/SDF file; the FOSSBot's is 7 kB
+MAX_MESH_BYTES = 50 << 20  # one mesh file
+MESH_SUFFIXES = (".stl", ".obj", ".dae")  # what PyBullet's mesh loader reads
+SNIFF_BYTES = 64 << 10  # how much of a mesh is read to see what it is
+JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar", "spherical")
+URDF_SHAPES = ("box", "cylinder", "sphere", "capsule", "mesh", "plane")
+SDF_SHAPES = ("box", "cylinder", "sphere", "capsule", "mesh", "plane")
+
+
+def robot_models_dir() -> Path:
+    """Folder of the shipped robot and world models (``robot_models/``)."""
+    return Path(str(resources.files("harness.robot_models")))
+
+
+@dataclass(frozen=True)
+class ModelFile:
+    """A model file found for a scenario, and the folder it must stay inside."""
+
+    path: Path  # resolved (symlinks followed)
+    root: Path  # resolved folder it was found in: the scenario's folder or robot_models/
+
+
+def _inside(path: Path, root: Path) -> bool:
+    return path == root or root in path.parents
+
+
+def _plain_relative(ref: str, what: str) -> PurePosixPath:
+    """`ref` as a relative path that does not climb out of its folder, or ConfigError."""
+    if not ref.strip() or "\0" in ref:
+        raise ConfigError(f"{what}: empty or not a path")
+    given = PurePosixPath(ref)
+    if given.is_absolute() or ref.startswith("~"):
+        raise ConfigError(
+            f"{what}: absolute paths are not allowed (give it relative to the folder)"
+        )
+    normal = PurePosixPath(os.path.normpath(ref))
+    if normal.parts and normal.parts[0] == "..":
+        raise ConfigError(f"{what}: climbs out of its folder with '..'")
+    return normal
+
+
+def _exists(path: Path) -> bool:
+    """Whether anything is there; a name the OS refuses (too long) is nothing."""
+    try:
+        os.lstat(path)
+    except (OSError, ValueError):
+        return False
+    return True
+
+
+def _resolved_inside(candidate: Path, root: Path, what: str) -> Path:
+    """The real path of `candidate`; ConfigError if it leaves `root` or is not a file."""
+    try:
+        real = candidate.resolve(strict=True)
+    except (OSError, RuntimeError) as err:  # RuntimeError: a symlink loop (Python < 3.13)
+        raise ConfigError(f"{what}: cannot resolve {candidate}: {_reason(err)}") from None
+    if not _inside(real, root):
+        raise ConfigError(
+            f"{what}: resolves to {real}, outside {root} "
+            "(model files must stay inside the scenario's folder or robot_models/)"
+        )
+    try:
+        mode = os.stat(real).st_mode
+    except OSError as err:
+        raise ConfigError(f"{what}: cannot read {real}: {_reason(err)}") from None
+    if not stat.S_ISREG(mode):
+        kind = "a folder" if stat.S_ISDIR(mode) else "not a regular file"
+        raise ConfigError(f"{what}: {real} is {kind}")
+    return real
+
+
+def _reason(err: BaseException) -> str:
+    return getattr(err, "strerror", None) or str(err) or type(err).__name__
+
+
+def find_model_file(ref: str, folders: Sequence[Path | None], *, what: str = "") -> ModelFile:
+    """The model file `ref` names: in the first of `folders` that has it, inside that folder.
+
+    `what` prefixes the messages (e.g. ``cannot load 'x.urdf'``); None
+    folders (a scenario built in code) are skipped.
+    """
+    label = what or repr(ref)
+    relative = _plain_relative(ref, label)
+    tried: list[str] = []
+    for folder in folders:
+        if folder is None:
+            continue
+        tried.append(str(folder))
+        candidate = folder / relative
+        if _exists(candidate):
+            root = folder.resolve()
+            return ModelFile(_resolved_inside(candidate, root, label), root)
+    raise ConfigError(f"{label}: no such file (looked in {', '.join(tried)})")
+
+
+# -- reading ---------------------------------------------------------------
+
+
+def _read_bounded(path: Path, limit: int, what: str) -> bytes:
+    """At most `limit` bytes of a regular file; ConfigError beyond that."""
+    try:
+        with open(path, "rb") as handle:
+            data = handle.read(limit + 1)
+    except OSError as err:
+        raise ConfigError(f"{what}: cannot read: {_reason(err)}") from None
+    if len(data) > limit:
+        raise ConfigError(f"{what}: larger than {limit >> 20} MiB")
+    return data
+
+
+def _parse_xml(path: Path, what: str) -> ET.Element:
+    data = _read_bounded(path, MAX_MODEL_BYTES, what)
+    if b"<!DOCTYPE" in data or b"<!ENTITY" in data:
+        raise ConfigError(f"{what}: DOCTYPE and ENTITY declarations are not allowed")
+    try:
+        return ET.fromstring(data)
+    except ET.ParseError as err:
+        raise ConfigError(f"{what}: not well-formed XML: {err}") from None
+
+
+# -- numbers ---------------------------------------------------------------
+
+
+def _numbers(text: str | None, count: int, what: str, *, positive: bool = False) -> list[float]:
+    """`count` finite numbers separated by spaces (all > 0 if `positive`), or ConfigError."""
+    parts = (text or "").split()
+    try:
+        values = [float(p) for p in parts]
+    except ValueError:
+        values = []
+    ok = len(values) == count and all(math.isfinite(v) for v in values)
+    if ok and positive:
+        ok = all(v > 0 for v in values)
+    if not ok:
+        kind = "positive" if positive else "finite"
+        wanted = f"a {kind} number" if count == 1 else f"{count} {kind} numbers"
+        raise ConfigError(f"{what}: expected {wanted}, got {(text or '')[:40]!r}")
+    return values
+
+
+def _attr_numbers(
+    element: ET.Element, name: str, count: int, what: str, *, positive: bool = False
+) -> None:
+    if name in element.attrib:
+        _numbers(element.attrib[name], count, f"{what} {name}", positive=positive)
+
+
+# -- the link tree -----------------------------------------------------------
+
+
+def _check_tree(links: list[str], joints: list[tuple[str, str, str]], what: str) -> None:
+    """Links joined into exactly one tree: one root, one parent each, all reachable."""
+    known = set(links)
+    parent_of: dict[str, str] = {}
+    children: dict[str, list[str]] = {name: [] for name in links}
+    for joint, parent, child in joints:
+        for role, link in (("parent", parent), ("child", child)):
+            if link not in known:
+                raise ConfigError(f"{what}: joint {joint!r}: {role} link {link!r} does not exist")
+        if child in parent_of:
+            raise ConfigError(f"{what}: link {child!r} is the child of two joints")
+        parent_of[child] = parent
+        children[parent].append(child)
+    roots = [name for name in links if name not in parent_of]
+    if not roots:
+        raise ConfigError(f"{what}: no root link: the joints form a loop")
+    if len(roots) != 1:
+        shown = ", ".join(repr(r) for r in roots[:5]) or "none"
+        raise ConfigError(
+            f"{what}: {len(roots)} root links ({shown}); the links must form one tree "
+            "joined by joints"
+        )
+    seen, todo = {roots[0]}, [roots[0]]
+    while todo:
+        for child in children[todo.pop()]:
+            if child not in seen:
+                seen.add(child)
+                todo.append(child)
+    if len(seen) != len(links):
+        loop = sorted(known - seen)[:5]
+        raise ConfigError(f"{what}: joints form a loop through {', '.join(map(repr, loop))}")
+
+
+def _unique_names(elements: Iterable[ET.Element], kind: str, what: str) -> list[str]:
+    names: list[str] = []
+    for element in elements:
+        name = element.get("name", "")
+        if not name.strip():
+            raise ConfigError(f"{what}: a <{kind}> without a name")
+        if name in names:
+            raise ConfigError(f"{what}: two {kind}s named {name!r}")
+        names.append(name)
+    return names
+
+
+# -- meshes ----------------------------------------------------------------
+
+
+def _sniff_mesh(path: Path, what: str) -> None:
+    """Refuse files that are plainly not the mesh their suffix says."""
+    size = path.stat().st_size
+    if size == 0:
+        raise ConfigError(f"{what}: the mesh file is empty")
+    if size > MAX_MESH_BYTES:
+        raise ConfigError(f"{what}: the mesh file is larger than {MAX_MESH_BYTES >> 20} MiB")
+    try:
+        with open(path, "rb") as handle:
+            head = handle.read(SNIFF_BYTES)
+    except OSError as err:
+        raise ConfigError(f"{what}: cannot read: {_reason(err)}") from None
+    suffix = path.suffix.lower()
+    if suffix == ".stl":
+        triangles = struct.unpack_from("<I", head, 80)[0] if len(head) >= 84 else 0
+        if triangles and size >= 84 + 50 * triangles:
+            return
+        if head.lstrip().startswith(b"solid") and b"facet" in head:
+            return
+        raise ConfigError(f"{what}: not an STL mesh (neither binary nor ASCII STL)")
+    if suffix == ".obj":
+        lines = head.splitlines()
+        if any(line.startswith(b"v ") for line in lines):
+            return
+        raise ConfigError(f"{what}: not an OBJ mesh (no 'v' vertex lines)")
+    if b"<COLLADA" not in head:
+        raise ConfigError(f"{what}: not a COLLADA mesh (no <COLLADA> element)")
+
+
+def _check_mesh(filename: str, model: ModelFile, schemes: tuple[str, ...], what: str) -> None:
+    """A mesh named in a model: found as PyBullet would find it, and inside the model's root."""
+    label = f"{what}: mesh {filename[:200]!r}"
+    name = filename.strip()
+    for scheme in schemes:
+        if name.startswith(scheme):
+            name = name[len(scheme) :]
+            break
+    else:
+        if "://" in name:
+            raise ConfigError(f"{label}: unsupported URI (use a path relative to the model file)")
+    relative = _plain_relative(name, label)
+    if not name.lower().endswith(MESH_SUFFIXES):
+        raise ConfigError(f"{label}: PyBullet reads only {', '.join(MESH_SUFFIXES)} meshes")
+    # PyBullet looks next to the model file first, then in each folder above it.
+    folder = model.path.parent
+    while _inside(folder, model.root):
+        candidate = folder / relative
+        if _exists(candidate):
+            _sniff_mesh(_resolved_inside(candidate, model.root, label), label)
+            return
+        if folder.parent == folder:
+            break
+        folder = folder.parent
+    above = (
+        f" and the folders above it up to {model.root}" if model.path.parent != model.root else ""
+    )
+    raise ConfigError(f"{label}: no such file (looked in {model.path.parent}{above})")
+
+
+# -- URDF ------------------------------------------------------------------
+
+
+def _check_origin(element: ET.Element, what: str) -> None:
+    for origin in element.findall("origin"):
+        _attr_numbers(origin, "xyz", 3, f"{what} origin")
+        _attr_numbers(origin, "rpy", 3, f"{what} origin")
+
+
+def _urdf_geometry(holder: ET.Element, what: str) -> str | None:
+    """Check one <visual>/<collision>; the mesh file name it uses, if any."""
+    _check_origin(holder, what)
+    geometries = holder.findall("geometry")
+    if len(geometries) != 1:
+        raise ConfigError(f"{what}: needs one <geometry>, got {len(geometries)}")
+    shapes = list(geometries[0])
+    if len(shapes) != 1:
+        raise ConfigError(f"{what}: <geometry> needs exactly one shape, got {len(shapes)}")
+    shape = shapes[0]
+    where = f"{what} <{shape.tag}>"
+    if shape.tag == "box":
+        _numbers(shape.get("size"), 3, f"{where} size", positive=True)
+    elif shape.tag in ("cylinder", "capsule"):
+        _numbers(shape.get("radius"), 1, f"{where} radius", positive=True)
+        _numbers(shape.get("length"), 1, f"{where} length", positive=True)
+    elif shape.tag == "sphere":
+        _numbers(shape.get("radius"), 1, f"{where} radius", positive=True)
+    elif shape.tag == "plane":
+        _attr_numbers(shape, "normal", 3, where)
+    elif shape.tag == "mesh":
+        _attr_numbers(shape, "scale", 3, where)
+        filename = shape.get("filename", "")
+        if not filename.strip():
+            raise ConfigError(f"{where}: no filename")
+        return filename
+    else:
+        raise ConfigError(f"{what}: unknown shape <{shape.tag}> (known: {', '.join(URDF_SHAPES)})")
+    return None
+
+
+def _check_urdf(root: ET.Element, model: ModelFile, what: str) -> None:
+    if root.tag != "robot":
+        raise ConfigError(f"{what}: not a URDF: the root element is <{root.tag}>, not <robot>")
+    links = root.findall("link")
+    if not links:
+        raise ConfigError(f"{what}: the robot has no <link>")
+    names = _unique_names(links, "link", what)
+    meshes: list[tuple[str, str]] = []
+    for link, name in zip(links, names, strict=True):
+        where = f"{what}: link {name!r}"
+        for inertial in link.findall("inertial"):
+            _check_origin(inertial, where)
+            for mass in inertial.findall("mass"):
+                _numbers(mass.get("value"), 1, f"{where} mass")
+            for inertia in inertial.findall("inertia"):
+                for key in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz"):
+                    _attr_numbers(inertia, key, 1, f"{where} inertia")
+        for kind in ("visual", "collision"):
+            for holder in link.findall(kind):
+                mesh = _urdf_geometry(holder, f"{where} {kind}")
+                if mesh is not None:
+                    meshes.append((mesh, where))
+    joints = root.findall("joint")
+    joint_names = _unique_names(joints, "joint", what)
+    tree: list[tuple[str, str, str]] = []
+    for joint, name in zip(joints, joint_names, strict=True):
+        where = f"{what}: joint {name!r}"
+        kind = joint.get("type", "")
+        if kind not in JOINT_TYPES:
+            raise ConfigError(f"{where}: unknown type {kind!r} (known: {', '.join(JOINT_TYPES)})")
+        ends = []
+        for role in ("parent", "child"):
+            element = joint.find(role)
+            link = element.get("link", "") if element is not None else ""
+            if not link:
+                raise ConfigError(f"{where}: no <{role} link=...>")
+            ends.append(link)
+        tree.append((name, ends[0], ends[1]))
+        _check_origin(joint, where)
+        for axis in joint.findall("axis"):
+            if "xyz" in axis.attrib:
+                xyz = _numbers(axis.get("xyz"), 3, f"{where} axis xyz")
+                if not any(xyz):
+                    raise ConfigError(f"{where}: axis xyz is the zero vector")
+        for limit in joint.findall("limit"):
+            for key in ("lower", "upper", "effort", "velocity"):
+                _attr_numbers(limit, key, 1, f"{where} limit")
+    _check_tree(names, tree, what)
+    for filename, where in meshes:
+        _check_mesh(filename, model, ("package://",), where)
+
+
+# -- SDF -------------------------------------------------------------------
+
+
+def _text_numbers(parent: ET.Element, tag: str, count: int, what: str, positive: bool) -> None:
+    element = parent.find(tag)
+    if element is None:
+        raise ConfigError(f"{what}: no <{tag}>")
+    _numbers(element.text, count, f"{what} <{tag}>", positive=positive)
+
+
+def _sdf_poses(element: ET.Element, what: str) -> None:
+    for pose in element.iter("pose"):
+        if (pose.text or "").strip():
+            _numbers(pose.text, 6, f"{what} <pose>")
+
+
+def _sdf_geometry(holder: ET.Element, what: str) -> str | None:
+    geometry = holder.find("geometry")
+    if geometry is None:
+        raise ConfigError(f"{what}: no <geometry>")
+    shapes = list(geometry)
+    if len(shapes) != 1:
+        raise ConfigError(f"{what}: <geometry> needs exactly one shape, got {len(shapes)}")
+    shape = shapes[0]
+    where = f"{what} <{shape.tag}>"
+    if shape.tag == "box":
+        _text_numbers(shape, "size", 3, where, True)
+    elif shape.tag in ("cylinder", "capsule"):
+        _text_numbers(shape, "radius", 1, where, True)
+        _text_numbers(shape, "length", 1, where, True)
+    elif shape.tag == "sphere":
+        _text_numbers(shape, "radius", 1, where, True)
+    elif shape.tag == "plane":
+        for tag, count in (("normal", 3), ("size", 2)):
+            if shape.find(tag) is not None:
+                _text_numbers(shape, tag, count, where, tag == "size")
+    elif shape.tag == "mesh":
+        if shape.find("scale") is not None:
+            _text_numbers(shape, "scale", 3, where, False)
+        uri = shape.findtext("uri", "").strip()
+        if not uri:
+            raise ConfigError(f"{where}: no <uri>")
+        return uri
+    else:
+        raise ConfigError(f"{what}: unknown shape <{shape.tag}> (known: {', '.join(SDF_SHAPES)})")
+    return None
+
+
+def _check_sdf(root: ET.Element, model: ModelFile, what: str) -> None:
+    if root.tag != "sdf":
+        raise ConfigError(f"{what}: not an SDF file: the root element is <{root.tag}>, not <sdf>")
+    if root.find(".//include") is not None:
+        raise ConfigError(f"{what}: <include> is not supported by PyBullet; put the model inline")
+    models = root.findall("model") + root.findall("world/model")
+    if not models:
+        raise ConfigError(f"{what}: no <model> (directly or in a <world>)")
+    _sdf_poses(root, what)
+    meshes: list[tuple[str, str]] = []
+    for element in models:
+        where = f"{what}: model {element.get('name', '')!r}"
+        if element.find("model") is not None:
+            raise ConfigError(f"{where}: nested models are not supported by PyBullet")
+        links = element.findall("link")
+        if not links:
+            raise ConfigError(f"{where}: has no <link>")
+        names = _unique_names(links, "link", where)
+        for link, name in zip(links, names, strict=True):
+            for kind in ("visual", "collision"):
+                for holder in link.findall(kind):
+                    mesh = _sdf_geometry(holder, f"{where} link {name!r} {kind}")
+                    if mesh is not None:
+                        meshes.append((mesh, f"{where} link {name!r}"))
+        joints = element.findall("joint")
+        joint_names = _unique_names(joints, "joint", where)
+        tree = [
+            (name, joint.findtext("parent", "").strip(), joint.findtext("child", "").strip())
+            for joint, name in zip(joints, joint_names, strict=True)
+        ]
+        for name, parent, child in tree:
+            kind = next(j for j in joints if j.get("name") == name).get("type", "")
+            if kind not in JOINT_TYPES:
+                raise ConfigError(
+                    f"{where}: joint {name!r}: unknown type {kind!r} "
+                    f"(known: {', '.join(JOINT_TYPES)})"
+                )
+            if not parent or not child:
+                raise ConfigError(f"{where}: joint {name!r} needs <parent> and <child>")
+        _check_tree(names, tree, where)
+    for uri, where in meshes:
+        _check_mesh(uri, model, ("model://", "package://"), where)
+
+
+def check_model_file(model: ModelFile, *, what: str = "") -> None:
+    """Refuse a URDF/SDF file PyBullet would choke, crash or print garbage on.
+
+    `what` prefixes the messages (e.g. ``cannot load 'table.urdf'``).
+    """
+    label = what or str(model.path)
+    root = _parse_xml(model.path, label)
+    if model.path.suffix == ".sdf":
+        _check_sdf(root, model, label)
+    else:
+        _check_urdf(root, model, label)
