@@ -375,10 +375,10 @@ def _check_urdf(root: ET.Element, model: ModelFile, what: str) -> None:
         ends = []
         for role in ("parent", "child"):
             element = joint.find(role)
-            link = element.get("link", "") if element is not None else ""
-            if not link:
+            link_name = element.get("link", "") if element is not None else ""
+            if not link_name:
                 raise ConfigError(f"{where}: no <{role} link=...>")
-            ends.append(link)
+            ends.append(link_name)
         tree.append((name, ends[0], ends[1]))
         _check_origin(joint, where)
         for axis in joint.findall("axis"):

@@ -10,20 +10,52 @@ duration, distance, turn, obstacle_ahead_below, obstacle_ahead_above``.
 from __future__ import annotations
 
 import math
+import os
+import re
+import stat
+import unicodedata
 from collections.abc import Sequence
 from importlib import resources
 from pathlib import Path
 from typing import Annotated, Any, Literal
 
 import yaml
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
+from pydantic import (
+    AfterValidator,
+    BaseModel,
+    BeforeValidator,
+    ConfigDict,
+    Field,
+    ValidationError,
+    field_validator,
+    model_validator,
+)
 
 from harness.errors import ConfigError
 from harness.faults import build_profile
 from harness.lidar_spec import PRESETS, LidarSpec, preset
+from harness.model_files import check_model_file, find_model_file, robot_models_dir
+from harness.sim.geometry import cylinder_segments
 
 SCENARIO_SUFFIXES = (".yaml", ".yml")
-MAX_SEGMENT_SECONDS = 600.0
+
+# What one scenario may ask for. Each bound keeps a hostile or mistaken file
+# from hanging or exhausting the machine; the lab's scenarios use a small
+# fraction of each (docs/scenarios.md, "Limits").
+MAX_FILE_BYTES = 1 << 20  # a scenario file
+MAX_YAML_DEPTH = 20  # nesting of YAML mappings and lists (aliases expanded)
+MAX_YAML_NODES = 100_000  # values in the file, each alias counted at its full size
+MAX_YAML_SCALAR = 4096  # characters of one YAML value
+MAX_SEGMENT_SECONDS = 600.0  # one segment's duration or timeout
+MAX_RUN_SECONDS = 600.0  # simulated time of a whole run, conditional segments at their timeout
+MAX_SCANS = 10_000  # LIDAR revolutions of a whole run
+MAX_RAYS = 10_000_000  # beams cast in a whole run (scans x samples)
+MAX_CYLINDER_SIDES = 100_000  # sides of all cylinder meshes together (big radii need more)
+MAX_MODELS = 100  # model (URDF/SDF) obstacles
+MAX_COORDINATE = 1000.0  # m, |x| and |y| of anything placed in the world
+MIN_SIZE, MAX_SIZE = 0.001, 100.0  # m, sizes of walls, boxes and cylinders
+MAX_RANGE = 100.0  # m, LIDAR range_max, the threshold and obstacle conditions
+MAX_PATH = 1024  # characters of a model path
 
 
 class _Strict(BaseModel):
@@ -32,38 +64,75 @@ class _Strict(BaseModel):
     model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
 
 
-Finite = Annotated[float, Field(allow_inf_nan=False)]
-Positive = Annotated[float, Field(gt=0, allow_inf_nan=False)]
-NonNegative = Annotated[float, Field(ge=0, allow_inf_nan=False)]
-Point2 = tuple[Finite, Finite]
+def _printable(value: str) -> str:
+    """Text shown on terminals and in reports: no control or invisible formatting characters."""
+    for char in value:
+        if unicodedata.category(char) in ("Cc", "Cf"):
+            raise ValueError(f"must be printable text, found character U+{ord(char):04X}")
+    return value
+
+
+def _not_bool(value: Any) -> Any:
+    """YAML's true/false are not numbers, though Python's bool is an int."""
+    if isinstance(value, bool):
+        raise ValueError(f"must be a number, got {str(value).lower()}")
+    return value
+
+
+_NotBool = BeforeValidator(_not_bool)
+Finite = Annotated[float, _NotBool, Field(allow_inf_nan=False)]
+Positive = Annotated[float, _NotBool, Field(gt=0, allow_inf_nan=False)]
+Coordinate = Annotated[
+    float, _NotBool, Field(ge=-MAX_COORDINATE, le=MAX_COORDINATE, allow_inf_nan=False)
+]
+Size = Annotated[float, _NotBool, Field(ge=MIN_SIZE, le=MAX_SIZE, allow_inf_nan=False)]
+Range = Annotated[float, _NotBool, Field(gt=0, le=MAX_RANGE, allow_inf_nan=False)]
+Angle = Annotated[float, _NotBool, Field(ge=-2 * math.pi, le=2 * math.pi, allow_inf_nan=False)]
+Increment = Annotated[float, _NotBool, Field(gt=0, le=2 * math.pi, allow_inf_nan=False)]
+Rate = Annotated[float, _NotBool, Field(ge=1, le=100, allow_inf_nan=False)]
+Timeout = Annotated[float, _NotBool, Field(gt=0, le=MAX_SEGMENT_SECONDS, allow_inf_nan=False)]
+Linear = Annotated[float, _NotBool, Field(ge=-2.0, le=2.0, allow_inf_nan=False)]
+Angular = Annotated[float, _NotBool, Field(ge=-10.0, le=10.0, allow_inf_nan=False)]
+Samples = Annotated[int, _NotBool, Field(ge=1, le=16383)]
+Seed = Annotated[int, _NotBool, Field(ge=0, le=2**32 - 1)]
+Point2 = tuple[Coordinate, Coordinate]
+Text = Annotated[str, AfterValidator(_printable)]
+ModelPath = Annotated[str, Field(min_length=1, max_length=MAX_PATH), AfterValidator(_printable)]
 
 
 class Pose2D(_Strict):
     """A planar pose: metres and radians (yaw CCW from +x)."""
 
-    x: Finite = 0.0
-    y: Finite = 0.0
+    x: Coordinate = 0.0
+    y: Coordinate = 0.0
     yaw: Finite = 0.0
 
 
 class RobotConfig(_Strict):
     """Which URDF to load, its LIDAR link and where it starts."""
 
-    urdf: str = "fossbot_v2.urdf"
-    lidar_link: str = "lidar_scan_frame"
+    urdf: ModelPath = "fossbot_v2.urdf"
+    lidar_link: Annotated[Text, Field(min_length=1, max_length=255)] = "lidar_scan_frame"
     start: Pose2D = Pose2D()
+
+    @field_validator("urdf")
+    @classmethod
+    def _is_urdf(cls, value: str) -> str:
+        if not value.endswith(".urdf"):
+            raise ValueError(f"the robot must be a .urdf file, got {value[:100]!r}")
+        return value
 
 
 class LidarConfig(_Strict):
     """A preset plus optional overrides of its fields."""
 
     preset: str = "gazebo"
-    samples: Annotated[int, Field(ge=1, le=16383)] | None = None
-    angle_min: Finite | None = None
-    angle_increment: Positive | None = None
-    range_min: Positive | None = None
-    range_max: Positive | None = None
-    rate_hz: Annotated[float, Field(gt=0, le=100, allow_inf_nan=False)] | None = None
+    samples: Samples | None = None
+    angle_min: Angle | None = None
+    angle_increment: Increment | None = None
+    range_min: Range | None = None
+    range_max: Range | None = None
+    rate_hz: Rate | None = None
 
     @field_validator("preset")
     @classmethod
@@ -90,8 +159,8 @@ class Wall(_Strict):
     type: Literal["wall"]
     start: Point2
     end: Point2
-    thickness: Positive = 0.05
-    height: Positive = 0.5
+    thickness: Size = 0.05
+    height: Size = 0.5
 
     @model_validator(mode="after")
     def _has_length(self) -> Wall:
@@ -105,7 +174,7 @@ class Box(_Strict):
 
     type: Literal["box"]
     position: Point2
-    size: tuple[Positive, Positive, Positive]
+    size: tuple[Size, Size, Size]
     yaw: Finite = 0.0
 
 
@@ -114,23 +183,23 @@ class Cylinder(_Strict):
 
     type: Literal["cylinder"]
     position: Point2
-    radius: Positive
-    height: Positive = 0.5
+    radius: Size
+    height: Size = 0.5
 
 
 class Model(_Strict):
     """A URDF or SDF file, relative to the scenario file or robot_models/."""
 
     type: Literal["model"]
-    path: str
-    position: tuple[Finite, Finite, Finite] = (0.0, 0.0, 0.0)
+    path: ModelPath
+    position: tuple[Coordinate, Coordinate, Coordinate] = (0.0, 0.0, 0.0)
     yaw: Finite = 0.0
 
     @field_validator("path")
     @classmethod
     def _known_format(cls, value: str) -> str:
         if not value.endswith((".urdf", ".sdf")):
-            raise ValueError(f"model path must end in .urdf or .sdf, got {value!r}")
+            raise ValueError(f"model path must end in .urdf or .sdf, got {value[:100]!r}")
         return value
 
 
@@ -143,9 +212,9 @@ class Until(_Strict):
     duration: Positive | None = None
     distance: Positive | None = None
     turn: Positive | None = None  # absolute radians turned
-    obstacle_ahead_below: Positive | None = None
-    obstacle_ahead_above: Positive | None = None
-    timeout: Annotated[float, Field(gt=0, le=MAX_SEGMENT_SECONDS, allow_inf_nan=False)] = 60.0
+    obstacle_ahead_below: Range | None = None
+    obstacle_ahead_above: Range | None = None
+    timeout: Timeout = 60.0
 
     @model_validator(mode="after")
     def _exactly_one(self) -> Until:
@@ -161,9 +230,19 @@ class Until(_Strict):
 class Segment(_Strict):
     """Constant body velocity (m/s, rad/s) until a condition holds."""
 
-    linear: Annotated[float, Field(ge=-2.0, le=2.0, allow_inf_nan=False)] = 0.0
-    angular: Annotated[float, Field(ge=-10.0, le=10.0, allow_inf_nan=False)] = 0.0
+    linear: Linear = 0.0
+    angular: Angular = 0.0
     until: Until
+
+    def worst_case_seconds(self) -> float:
+        """Longest this segment can run: its duration, its exact time, or its timeout."""
+        until = self.until
+        if until.duration is not None:
+            return until.duration
+        for value, speed in ((until.distance, self.linear), (until.turn, self.angular)):
+            if value is not None and speed != 0:
+                return min(value / abs(speed), until.timeout)
+        return until.timeout  # obstacle conditions; unreachable ones fail before they run
 
 
 class Motion(_Strict):
@@ -176,23 +255,34 @@ class Motion(_Strict):
 class Scenario(_Strict):
     """One scripted run of the robot through a world."""
 
-    name: str = ""
-    description: str = Field(min_length=1, max_length=200)
+    name: Annotated[Text, Field(max_length=100)] = ""
+    description: Annotated[str, Field(min_length=1, max_length=200)]
     robot: RobotConfig = RobotConfig()
     lidar: LidarConfig = LidarConfig()
     obstacles: list[Obstacle] = Field(default_factory=list, max_length=1000)
     motion: Motion
-    faults: list[str | dict[str, Any]] = Field(default_factory=list, max_length=50)
-    threshold: Positive = 0.5
-    seed: Annotated[int, Field(ge=0, le=2**32 - 1)] = 0
+    faults: list[Annotated[str, Field(max_length=100)] | dict[str, Any]] = Field(
+        default_factory=list, max_length=50
+    )
+    threshold: Range = 0.5
+    seed: Seed = 0
     source: str = Field(default="", exclude=True)  # file the scenario came from
 
     @field_validator("description")
     @classmethod
     def _one_line(cls, value: str) -> str:
+        if not value.strip():
+            raise ValueError("must not be blank")
         if "\n" in value.strip():
             raise ValueError("must be one line")
-        return value.strip()
+        return _printable(value.strip())
+
+    @field_validator("name")
+    @classmethod
+    def _name_one_line(cls, value: str) -> str:
+        if value != value.strip():
+            raise ValueError("must not start or end with spaces")
+        return value
 
     @property
     def lidar_spec(self) -> LidarSpec:
@@ -203,13 +293,16 @@ class Scenario(_Strict):
         return Path(self.source).parent if self.source else None
 
 
+_UNION_TAGS = ("wall", "box", "cylinder", "model", "str", "constrained-str", "dict[str,any]")
+
+
 def _field_path(loc: Sequence[Any]) -> str:
     """pydantic's error location as `motion.segments[1].until`."""
     out = ""
     for part in loc:
         if isinstance(part, int):
             out += f"[{part}]"
-        elif part in ("wall", "box", "cylinder", "model", "str", "dict[str,any]"):
+        elif part in _UNION_TAGS or str(part).startswith("function-"):
             continue  # union branch tags add nothing for the reader
         else:
             out += f".{part}" if out else str(part)
@@ -226,8 +319,42 @@ def _first_error(err: ValidationError) -> str:
     return f"{_field_path(first['loc'])}: {msg}"
 
 
+def _check_run_length(scenario: Scenario) -> None:
+    """Refuse runs too long or too costly to simulate (see MAX_* above); pure arithmetic."""
+    segments = scenario.motion.segments
+    seconds = sum(segment.worst_case_seconds() for segment in segments)
+    spec = scenario.lidar_spec
+    scans = math.ceil(seconds * spec.rate_hz - 1e-9) + 1
+    if seconds > MAX_RUN_SECONDS or scans > MAX_SCANS:
+        waits = any(s.until.obstacle_ahead_below or s.until.obstacle_ahead_above for s in segments)
+        raise ConfigError(
+            f"motion: the run could last {seconds:g} s of simulated time ({scans} scans at "
+            f"{spec.rate_hz:g} Hz); at most {MAX_RUN_SECONDS:g} s and {MAX_SCANS} scans"
+            + (" (segments waiting for an obstacle count at their until.timeout)" if waits else "")
+        )
+    if scans * spec.samples > MAX_RAYS:
+        raise ConfigError(
+            f"lidar: {spec.samples} samples x {scans} scans = {scans * spec.samples} beams to "
+            f"cast; at most {MAX_RAYS} per run (fewer samples or a shorter run)"
+        )
+    sides = sum(cylinder_segments(o.radius) for o in scenario.obstacles if isinstance(o, Cylinder))
+    if sides > MAX_CYLINDER_SIDES:
+        raise ConfigError(
+            f"obstacles: the cylinders need {sides} mesh sides in all (a bigger radius needs "
+            f"more); at most {MAX_CYLINDER_SIDES} (fewer or smaller cylinders)"
+        )
+    models = sum(isinstance(o, Model) for o in scenario.obstacles)
+    if models > MAX_MODELS:
+        raise ConfigError(f"obstacles: {models} model obstacles; at most {MAX_MODELS}")
+
+
 def parse_scenario(data: Any, *, source: str = "<scenario>") -> Scenario:
-    """Validate already-loaded YAML data; ConfigError names the source and field."""
+    """Validate already-loaded YAML data; ConfigError names the source and field.
+
+    Checks the schema, the bounds and the cost of the run; the model files
+    it names are checked by ``check_model_files`` (``load_scenario_file``
+    does both).
+    """
     if not isinstance(data, dict):
         raise ConfigError(f"{source}: a scenario must be a mapping, got {type(data).__name__}")
     try:
@@ -237,32 +364,222 @@ def parse_scenario(data: Any, *, source: str = "<scenario>") -> Scenario:
         raise ConfigError(f"{source}: {_first_error(err)}") from None
     except ConfigError as err:
         raise ConfigError(f"{source}: lidar: {err}") from None
+    except RecursionError:
+        raise ConfigError(f"{source}: nested too deeply (or refers to itself)") from None
     try:
         build_profile(scenario.faults)
+        _check_run_length(scenario)
     except ConfigError as err:
         raise ConfigError(f"{source}: {err}") from None
     if not scenario.name:
-        scenario = scenario.model_copy(update={"name": Path(source).stem})
+        scenario = scenario.model_copy(update={"name": Path(source).stem[:100]})
     return scenario
 
 
-def load_scenario_file(path: str | Path) -> Scenario:
-    """Read and validate one scenario file."""
-    path = Path(path)
+def check_model_files(scenario: Scenario) -> None:
+    """The robot URDF and every model obstacle: found where allowed and loadable.
+
+    The same check ``harness.sim.world.World`` runs before PyBullet sees a
+    file; here it runs when the scenario file is loaded, before any node
+    or board is started.
+    """
+    folders = [scenario.base_dir, robot_models_dir()]
+    where = scenario.source or "<scenario>"
+    refs = [("robot.urdf", scenario.robot.urdf)] + [
+        (f"obstacles[{i}].path", o.path)
+        for i, o in enumerate(scenario.obstacles)
+        if isinstance(o, Model)
+    ]
+    for field, ref in refs:
+        what = f"{where}: {field}: cannot load {ref!r}"
+        check_model_file(find_model_file(ref, folders, what=what), what=what)
+
+
+# -- reading YAML, bounded ----------------------------------------------------
+
+
+# YAML 1.2 floats: PyYAML (YAML 1.1) reads `1e-3` and `5e2`, without a dot, as text.
+_FLOAT_1_2 = re.compile(r"^[-+]?(\.[0-9]+|[0-9]+(\.[0-9]*)?)[eE][-+]?[0-9]+$")
+
+
+class _ScenarioLoader(yaml.SafeLoader):
+    """PyYAML's safe loader, refusing what no scenario needs and a hostile file uses.
+
+    Duplicate keys (PyYAML silently keeps the last), keys that are not text,
+    nesting deeper than MAX_YAML_DEPTH (PyYAML recurses: a deep file is a
+    RecursionError), and, checked on the composed document, alias "bombs":
+    a few lines whose aliases expand to billions of values.
+    """
+
+    def __init__(self, stream: str) -> None:
+        super().__init__(stream)
+        self._depth = 0
+
+    def compose_node(self, parent: yaml.Node | None, index: object) -> yaml.Node | None:
+        self._depth += 1
+        try:
+            if self._depth > MAX_YAML_DEPTH:
+                mark = self.peek_event().start_mark
+                raise yaml.composer.ComposerError(
+                    None, None, f"nested deeper than {MAX_YAML_DEPTH} levels", mark
+                )
+            return super().compose_node(parent, index)  # type: ignore[misc]
+        finally:
+            self._depth -= 1
+
+    def construct_mapping(self, node: yaml.MappingNode, deep: bool = False) -> dict[Any, Any]:
+        seen: dict[str, yaml.Mark] = {}
+        for key_node, _ in node.value:
+            if key_node.tag == "tag:yaml.org,2002:merge":
+                continue  # `<<: *defaults` keys may be overridden: not duplicates
+            key = self.construct_object(key_node) if isinstance(key_node, yaml.ScalarNode) else None
+            if not isinstance(key, str):
+                shown = key_node.value if isinstance(key_node, yaml.ScalarNode) else "a collection"
+                raise yaml.constructor.ConstructorError(
+                    None, None, f"keys must be text, got {str(shown)[:40]!r}", key_node.start_mark
+                )
+            if key in seen:
+                raise yaml.constructor.ConstructorError(
+                    None,
+                    None,
+                    f"duplicate key {key[:40]!r} (first at line {seen[key].line + 1})",
+                    key_node.start_mark,
+                )
+            seen[key] = key_node.start_mark
+        return super().construct_mapping(node, deep)
+
+
+_ScenarioLoader.add_implicit_resolver("tag:yaml.org,2002:float", _FLOAT_1_2, list("-+0123456789."))
+
+
+def _check_expanded(root: yaml.Node) -> None:
+    """Every value counted as often as aliases repeat it: bounded size, depth, no cycles."""
+    sizes: dict[int, tuple[int, int]] = {}  # id(node) -> (values, depth) below and with it
+    active: set[int] = set()
+
+    def visit(node: yaml.Node) -> tuple[int, int]:
+        key = id(node)
+        if key in sizes:
+            return sizes[key]
+        if key in active:
+            raise yaml.composer.ComposerError(
+                None, None, "an alias refers to the value it is inside", node.start_mark
+            )
+        if isinstance(node, yaml.ScalarNode):
+            if len(node.value) > MAX_YAML_SCALAR:
+                raise yaml.composer.ComposerError(
+                    None,
+                    None,
+                    f"a value longer than {MAX_YAML_SCALAR} characters",
+                    node.start_mark,
+                )
+            sizes[key] = (1, 1)
+            return sizes[key]
+        active.add(key)
+        children: list[yaml.Node] = []
+        if isinstance(node, yaml.SequenceNode):
+            children = list(node.value)
+        elif isinstance(node, yaml.MappingNode):
+            children = [part for pair in node.value for part in pair]
+        count, depth = 1, 0
+        for child in children:
+            child_count, child_depth = visit(child)
+            count += child_count
+            depth = max(depth, child_depth)
+            if count > MAX_YAML_NODES:
+                raise yaml.composer.ComposerError(
+                    None,
+                    None,
+                    f"more than {MAX_YAML_NODES} values once aliases are expanded",
+                    node.start_mark,
+                )
+        active.discard(key)
+        if depth + 1 > MAX_YAML_DEPTH:
+            raise yaml.composer.ComposerError(
+                None,
+                None,
+                f"nested deeper than {MAX_YAML_DEPTH} levels once aliases are expanded",
+                node.start_mark,
+            )
+        sizes[key] = (count, depth + 1)
+        return sizes[key]
+
+    visit(root)
+
+
+def load_yaml(text: str) -> Any:
+    """One YAML document, safely and within bounds; yaml.YAMLError for anything refused."""
+    loader = _ScenarioLoader(text)
     try:
-        text = path.read_text(encoding="utf-8")
+        node = loader.get_single_node()
+        if node is None:
+            return None
+        _check_expanded(node)
+        return loader.construct_document(node)
+    finally:
+        loader.dispose()
+
+
+def _yaml_problem(err: yaml.YAMLError) -> str:
+    """A PyYAML error as `YAML error at line N: problem`."""
+    mark = getattr(err, "problem_mark", None)
+    problem = getattr(err, "problem", None)
+    if isinstance(err, yaml.reader.ReaderError):
+        char = chr(err.character) if isinstance(err.character, int) else str(err.character)
+        return f"YAML error: unacceptable character U+{ord(char[:1] or ' '):04X} in the file"
+    where = f" at line {mark.line + 1}" if mark is not None else ""
+    return f"YAML error{where}: {' '.join(str(problem or 'invalid YAML').split())}"
+
+
+def _read_text(path: Path) -> str:
+    """The file's text: a regular file, at most MAX_FILE_BYTES, UTF-8; never blocks on a FIFO."""
+    try:
+        mode = os.stat(path).st_mode
     except FileNotFoundError:
         raise ConfigError(f"{path}: no such scenario file") from None
-    except (OSError, UnicodeDecodeError) as err:
-        raise ConfigError(f"{path}: cannot read: {err}") from None
+    except (OSError, ValueError) as err:
+        raise ConfigError(f"{path}: cannot read: {getattr(err, 'strerror', None) or err}") from None
+    if stat.S_ISDIR(mode):
+        raise ConfigError(f"{path}: is a folder, not a scenario file")
+    if not stat.S_ISREG(mode):
+        raise ConfigError(f"{path}: not a regular file")
     try:
-        data = yaml.safe_load(text)
+        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | os.O_NOCTTY)
+        try:
+            if not stat.S_ISREG(os.fstat(fd).st_mode):  # replaced since the stat above
+                raise ConfigError(f"{path}: not a regular file")
+            with os.fdopen(os.dup(fd), "rb") as handle:
+                data = handle.read(MAX_FILE_BYTES + 1)
+        finally:
+            os.close(fd)
+    except OSError as err:
+        raise ConfigError(f"{path}: cannot read: {err.strerror or err}") from None
+    if len(data) > MAX_FILE_BYTES:
+        raise ConfigError(f"{path}: larger than {MAX_FILE_BYTES >> 20} MiB; not a scenario file")
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError as err:
+        line = data[: err.start].count(b"\n") + 1
+        raise ConfigError(
+            f"{path}: not UTF-8 text (byte 0x{data[err.start]:02x} at line {line})"
+        ) from None
+
+
+def load_scenario_file(path: str | Path) -> Scenario:
+    """Read and validate one scenario file, and the model files it names."""
+    path = Path(path)
+    text = _read_text(path)
+    try:
+        data = load_yaml(text)
     except yaml.YAMLError as err:
-        mark = getattr(err, "problem_mark", None)
-        where = f" at line {mark.line + 1}" if mark is not None else ""
-        problem = getattr(err, "problem", None) or "invalid YAML"
-        raise ConfigError(f"{path}: YAML error{where}: {problem}") from None
-    return parse_scenario(data, source=str(path))
+        raise ConfigError(f"{path}: {_yaml_problem(err)}") from None
+    except RecursionError:
+        raise ConfigError(f"{path}: YAML error: nested too deeply") from None
+    except ValueError as err:  # e.g. an integer with more digits than Python converts
+        raise ConfigError(f"{path}: YAML error: {' '.join(str(err).split())[:200]}") from None
+    scenario = parse_scenario(data, source=str(path))
+    check_model_files(scenario)
+    return scenario
 
 
 def shipped_dir() -> Path:

@@ -29,6 +29,13 @@ def write(tmp_path: Path, text: str, name: str = "mine.yaml") -> Path:
     return path
 
 
+def changed(change: str) -> str:
+    """GOOD with `change` appended, replacing a top-level key GOOD already has (no duplicates)."""
+    key = change.split(":", 1)[0]
+    kept = [line for line in GOOD.splitlines(keepends=True) if not line.startswith(f"{key}:")]
+    return "".join(kept) + change
+
+
 def test_shipped_scenarios_load_with_unique_names() -> None:
     """Every shipped file validates, and names are unique."""
     scenarios = shipped_scenarios()
@@ -70,7 +77,7 @@ def test_each_mistake_names_file_and_field(
     tmp_path: Path, change: str, field: str, reason: str
 ) -> None:
     """A wrong value is reported as `file: field: reason`."""
-    path = write(tmp_path, GOOD + change)
+    path = write(tmp_path, changed(change))
     with pytest.raises(ConfigError, match=rf"^{path}: {field}: .*{reason}"):
         load_scenario_file(path)
 
