@@ -27,7 +27,13 @@ from typing import TYPE_CHECKING, Any
 import pytest
 
 from harness.pytest_cases import MARKER, MARKER_HELP, HilCase
-from harness.pytest_options import HilConfig, add_options, check_config, read_config
+from harness.pytest_options import (
+    SERIAL_LINKS,
+    HilConfig,
+    add_options,
+    check_config,
+    read_config,
+)
 
 if TYPE_CHECKING:
     from harness.links.base import LinkOptions
@@ -62,21 +68,32 @@ class HilBoard:
     link: str  # the device the board expects: rplidar or ldlidar
 
     def run_options(self) -> dict[str, Any]:
-        """Keyword arguments for ``hil.run`` that send the scenario to this board."""
+        """Keyword arguments for ``hil.run`` that send the scenario to this board.
+
+        The board runs its own driver and node, so the session's node
+        options (meant for the other tests) are dropped.
+        """
         return {
             "link": self.link,
             "port": self.port,
             "domain_id": self.domain_id,
             "ros_network": True,
+            "node": None,
+            "package": None,
+            "executable": None,
+            "workspace": None,
+            "params": (),
         }
 
 
 # -- hooks --------------------------------------------------------------------
 def pytest_addoption(parser: pytest.Parser) -> None:
+    """The --hil-* options and their ini twins (harness.pytest_options)."""
     add_options(parser)
 
 
 def pytest_configure(config: pytest.Config) -> None:
+    """Markers, and the options read and checked once: a bad value stops the session."""
     config.addinivalue_line("markers", "hil: needs a physical FOSSBot board (--hil-port)")
     config.addinivalue_line("markers", MARKER_HELP)
     # ROS 2's message code imports lark, which imports modules Python 3.11
@@ -90,6 +107,7 @@ def pytest_configure(config: pytest.Config) -> None:
 
 
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    """Without --hil-port, hil tests skip and say why (a port is never guessed)."""
     if config.stash[_CONFIG].port is not None:
         return
     skip = pytest.mark.skip(reason=NO_BOARD)
@@ -99,6 +117,7 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
 
 
 def pytest_generate_tests(metafunc: pytest.Metafunc) -> None:
+    """@pytest.mark.hil_scenarios: one hil_case per scenario and fault profile."""
     marker = metafunc.definition.get_closest_marker(MARKER)
     if marker is None:
         return
@@ -151,7 +170,7 @@ def hil_link_options(hil_config: HilConfig, hil_node: NodeUnderTest, hil_link: s
     """Link settings for every run of the test (the runner fills in threshold and rate)."""
     from harness.links.base import LinkOptions
 
-    physical = hil_link in ("rplidar", "ldlidar") and hil_config.port is not None
+    physical = hil_link in SERIAL_LINKS and hil_config.port is not None
     return LinkOptions(
         scan_timeout=hil_config.timeout,
         ready_timeout=hil_config.ready_timeout,
