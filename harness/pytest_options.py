@@ -136,8 +136,10 @@ def add_options(parser: pytest.Parser) -> None:
             kwargs.update(action="append", default=[])
         group.addoption(opt.flag, dest="hil_" + opt.name, **kwargs)
         if opt.ini:
-            kind = "linelist" if opt.repeat else "string"
-            parser.addini(opt.ini_name, f"default for {opt.flag}", type=kind)
+            if opt.repeat:
+                parser.addini(opt.ini_name, f"default for {opt.flag}", type="linelist")
+            else:
+                parser.addini(opt.ini_name, f"default for {opt.flag}", type="string")
 
 
 @dataclass(frozen=True)

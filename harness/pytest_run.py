@@ -173,7 +173,7 @@ class Hil:
                 scenario, threshold, faults, seed, link, status_regex, overrides
             )
         except ConfigError as err:
-            problem = str(err)  # failed outside the handler: no chained traceback
+            problem: str | None = str(err)  # failed outside the handler: no chained traceback
         else:
             problem = None
         if problem is not None:
