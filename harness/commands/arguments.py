@@ -6,7 +6,10 @@ Every type turns bad input into a one-line argparse error (exit 2).
 from __future__ import annotations
 
 import argparse
+import importlib.util
 import math
+import os
+import stat
 from collections.abc import Callable
 
 from harness.errors import ConfigError
@@ -53,10 +56,55 @@ def domain_id(text: str) -> int:
 
 
 def param(text: str) -> str:
+    """NAME:=VALUE, and (where rclpy is installed) one ROS 2 itself can parse.
+
+    A rule rcl cannot parse would stop the node before it starts; better a
+    usage error now than a failed run.
+    """
     name, sep, value = text.partition(":=")
     if not sep or not name or not value or any(c.isspace() for c in name):
         raise argparse.ArgumentTypeError(f"expected NAME:=VALUE, got {text!r}")
+    if importlib.util.find_spec("rclpy") is not None:
+        from rclpy.utilities import remove_ros_args
+
+        try:
+            remove_ros_args(["fossbot-hil", "--ros-args", "-p", text])
+        except Exception as err:  # noqa: BLE001 - rclpy's RCLInvalidROSArgsError and kin
+            reason = str(err).split("Error: ", 1)[-1].split(", at ", 1)[0]
+            raise argparse.ArgumentTypeError(
+                f"ROS 2 cannot parse {text!r}: {' '.join(reason.split())[:150]}"
+            ) from None
     return text
+
+
+def given(option: str) -> Callable[[str], str]:
+    """A value that must not be empty: '' would silently mean "not given"."""
+
+    def parse(text: str) -> str:
+        if not text.strip():
+            raise argparse.ArgumentTypeError("must not be empty")
+        return text
+
+    return parse
+
+
+def check_port(option: str, path: str) -> None:
+    """A port the user named must be a device (a tty), not a file or a folder or nothing.
+
+    Checked before the port is locked or opened, so a typo leaves nothing behind.
+    """
+    if not path.strip():
+        raise ConfigError(f"{option} must not be empty")
+    try:
+        mode = os.stat(path).st_mode
+    except FileNotFoundError:
+        raise ConfigError(f"{option} {path}: no such device") from None
+    except (OSError, ValueError) as err:
+        raise ConfigError(f"{option} {path}: {getattr(err, 'strerror', None) or err}") from None
+    if stat.S_ISDIR(mode):
+        raise ConfigError(f"{option} {path}: a folder, not a serial port")
+    if not stat.S_ISCHR(mode):
+        raise ConfigError(f"{option} {path}: not a serial port (not a character device)")
 
 
 def fault_list(text: str | None) -> list[str] | None:
@@ -89,10 +137,24 @@ def add_judging_options(parser: argparse.ArgumentParser) -> None:
 def add_node_options(parser: argparse.ArgumentParser) -> None:
     """The node under test and its ROS graph (ros2 link and virtual boards)."""
     node = parser.add_argument_group("node under test (ros2 link; default: the reference node)")
-    node.add_argument("--node", metavar="CMD", help='shell command, e.g. "python3 my_node.py"')
-    node.add_argument("--package", metavar="PKG", help="package in a colcon workspace")
-    node.add_argument("--executable", metavar="EXE", help="executable of --package")
-    node.add_argument("--workspace", metavar="DIR", help="colcon workspace (has install/)")
+    node.add_argument(
+        "--node",
+        type=given("--node"),
+        metavar="CMD",
+        help='shell command, e.g. "python3 my_node.py"',
+    )
+    node.add_argument(
+        "--package", type=given("--package"), metavar="PKG", help="package in a colcon workspace"
+    )
+    node.add_argument(
+        "--executable", type=given("--executable"), metavar="EXE", help="executable of --package"
+    )
+    node.add_argument(
+        "--workspace",
+        type=given("--workspace"),
+        metavar="DIR",
+        help="colcon workspace (has install/)",
+    )
     node.add_argument(
         "--param",
         action="append",
@@ -182,6 +244,8 @@ def check_link_options(args: argparse.Namespace) -> None:
     """Options that the chosen link would silently ignore are mistakes."""
     port = getattr(args, "port", None)
     processor = getattr(args, "processor", None)
+    if port is not None:
+        check_port("--port", port)
     if port and args.link not in SERIAL_LINKS:
         raise ConfigError(f"--port needs --link rplidar or ldlidar, not {args.link}")
     if processor and args.link != "inprocess":
