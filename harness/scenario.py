@@ -533,12 +533,14 @@ def _yaml_problem(err: yaml.YAMLError) -> str:
 
 def _read_text(path: Path) -> str:
     """The file's text: a regular file, at most MAX_FILE_BYTES, UTF-8; never blocks on a FIFO."""
+    shown = str(path) if len(str(path)) <= 200 else f"{str(path)[:100]}...{str(path)[-50:]}"
     try:
         mode = os.stat(path).st_mode
     except FileNotFoundError:
-        raise ConfigError(f"{path}: no such scenario file") from None
+        raise ConfigError(f"{shown}: no such scenario file") from None
     except (OSError, ValueError) as err:
-        raise ConfigError(f"{path}: cannot read: {getattr(err, 'strerror', None) or err}") from None
+        reason = getattr(err, "strerror", None) or err
+        raise ConfigError(f"{shown}: cannot read: {reason}") from None
     if stat.S_ISDIR(mode):
         raise ConfigError(f"{path}: is a folder, not a scenario file")
     if not stat.S_ISREG(mode):
@@ -593,14 +595,23 @@ def shipped_scenarios() -> list[Scenario]:
     return sorted((load_scenario_file(p) for p in files), key=lambda s: s.name)
 
 
+def _exists(path: Path) -> bool:
+    """Whether anything is at `path`; a name the OS refuses (too long, a NUL) is nothing."""
+    try:
+        os.stat(path)
+    except (OSError, ValueError):
+        return False
+    return True
+
+
 def resolve_scenario(ref: str) -> Scenario:
     """A shipped scenario name or a path to a scenario file."""
     candidate = Path(ref)
-    if candidate.suffix in SCENARIO_SUFFIXES or candidate.exists() or "/" in ref:
+    if candidate.suffix in SCENARIO_SUFFIXES or _exists(candidate) or "/" in ref:
         return load_scenario_file(candidate)
     for suffix in SCENARIO_SUFFIXES:
         shipped = shipped_dir() / f"{ref}{suffix}"
-        if shipped.is_file():
+        if _exists(shipped):
             return load_scenario_file(shipped)
     known = ", ".join(s.name for s in shipped_scenarios())
-    raise ConfigError(f"unknown scenario {ref!r} (shipped: {known}; or give a .yaml path)")
+    raise ConfigError(f"unknown scenario {ref[:100]!r} (shipped: {known}; or give a .yaml path)")
