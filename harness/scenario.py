@@ -357,6 +357,8 @@ def parse_scenario(data: Any, *, source: str = "<scenario>") -> Scenario:
     """
     if not isinstance(data, dict):
         raise ConfigError(f"{source}: a scenario must be a mapping, got {type(data).__name__}")
+    if "source" in data:  # the harness's own field: where the file is, never the file's say
+        raise ConfigError(f"{source}: source: unknown key")
     try:
         scenario = Scenario.model_validate({**data, "source": source})
         scenario.lidar.spec()
