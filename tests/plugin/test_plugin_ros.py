@@ -16,6 +16,8 @@ pytest_plugins = ["pytester"]
 pytestmark = [pytest.mark.ros, pytest.mark.timeout(120)]
 
 STUDENT = Path(__file__).parents[1] / "ros" / "student_node.py"
+# A generous per-scan deadline: a busy CI machine must not turn into a late answer.
+SLACK = ("--hil-timeout", "5", "-p", "no:cacheprovider")
 
 USER_TEST = """
 def test_lab_scenario(hil):
@@ -28,7 +30,7 @@ def test_lab_scenario(hil):
 def test_the_reference_node_passes_over_ros2(pytester: pytest.Pytester) -> None:
     """No node options: the bundled reference node, over ros2, in a reserved domain."""
     pytester.makepyfile(USER_TEST)
-    result = pytester.runpytest_subprocess("-s", "-p", "no:cacheprovider", timeout=90)
+    result = pytester.runpytest_subprocess("-s", *SLACK, timeout=90)
     result.assert_outcomes(passed=1)
     domain = re.search(r"domain (\d+)", result.stdout.str())
     assert domain and 1 <= int(domain[1]) <= 101, result.stdout.str()
@@ -39,7 +41,7 @@ def test_a_buggy_node_fails_with_the_oracles_explanation(pytester: pytest.Pytest
     """--hil-node names the student's node; the failure reads as the oracle's explanation."""
     pytester.makepyfile(USER_TEST)
     node = f"{sys.executable} {STUDENT} angle_in_degrees"
-    result = pytester.runpytest_subprocess("--hil-node", node, "-p", "no:cacheprovider", timeout=90)
+    result = pytester.runpytest_subprocess("--hil-node", node, *SLACK, timeout=90)
     result.assert_outcomes(failed=1)
     result.stdout.fnmatch_lines(
         [

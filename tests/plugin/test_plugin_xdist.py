@@ -121,7 +121,7 @@ def test_parallel_workers_run_good_and_buggy_nodes_without_cross_talk(
     # (loadgroup would say so more directly, but pytest-xdist 3.8 cannot
     # regroup tests under pytest 9.)
     result = pytester.runpytest_subprocess(
-        "-n", "2", "--dist", "loadfile", "-p", "no:cacheprovider", timeout=100
+        "-n", "2", "--dist", "loadfile", "--hil-timeout", "5", "-p", "no:cacheprovider", timeout=100
     )
     result.assert_outcomes(passed=6)
     log = [json.loads(line) for line in runs.read_text().splitlines()]
