@@ -236,6 +236,14 @@ def check_config(cfg: HilConfig, config: pytest.Config) -> None:
                 raise pytest.UsageError(
                     f"{src(name)} needs a link that runs a node, not --hil-link inprocess"
                 )
+    if cfg.port is not None:
+        from harness.commands.arguments import check_port
+        from harness.errors import ConfigError
+
+        try:
+            check_port("--hil-port", cfg.port)  # a typo is a usage error, not N failed tests
+        except ConfigError as err:
+            raise pytest.UsageError(str(err)) from None
     if cfg.port is not None and cfg.link is not None and cfg.link not in SERIAL_LINKS:
         raise pytest.UsageError(
             f"--hil-port drives a board through its LIDAR line: --hil-link must be "

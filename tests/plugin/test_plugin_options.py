@@ -3,7 +3,9 @@ one usage line. Runs pytest inside pytest (pytester); nothing here starts ROS.""
 
 from __future__ import annotations
 
+import os
 import sys
+from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
@@ -45,7 +47,8 @@ def test_options_and_ini_keys_are_listed_in_help(pytester: pytest.Pytester) -> N
             "--hil-workspace /nonexistent: no such folder",
         ),
         (["--hil-link", "inprocess", "--hil-param", "a:=1"], "--hil-param needs a link that"),
-        (["--hil-port", "/dev/ttyUSB0", "--hil-link", "ros2"], "--hil-link must be rplidar or"),
+        (["--hil-port=/dev/null", "--hil-link", "ros2"], "--hil-link must be rplidar or"),
+        (["--hil-port=/nonexistent/ttyUSB9"], "--hil-port /nonexistent/ttyUSB9: no such device"),
         (["-n", "2", "--hil-domain-id", "3"], "--hil-domain-id 3 with 2 xdist workers"),
     ],
 )
@@ -139,11 +142,21 @@ def test_hil_tests_skip_without_a_board_and_say_why(pytester: pytest.Pytester) -
     result.stdout.fnmatch_lines(["*no physical board named: give --hil-port*"])
 
 
+@pytest.fixture
+def tty() -> Iterator[str]:
+    """A serial device path (a pty slave) to name with --hil-port."""
+    master, slave = os.openpty()
+    path = os.ttyname(slave)
+    os.close(slave)
+    yield path
+    os.close(master)
+
+
 def test_board_fixture_defaults_to_rplidar_and_the_boards_domain(
-    pytester: pytest.Pytester, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+    pytester: pytest.Pytester, tty: str, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     """--hil-port alone: an RPLIDAR board in domain 0 (or ROS_DOMAIN_ID); --hil-link picks LD."""
-    port = str(tmp_path / "ttyUSB0")
+    port = tty
     pytester.makepyfile(
         f"""
         import pytest
@@ -156,15 +169,15 @@ def test_board_fixture_defaults_to_rplidar_and_the_boards_domain(
         """
     )
     monkeypatch.delenv("ROS_DOMAIN_ID", raising=False)
-    pytester.runpytest("--hil-port", port).assert_outcomes(passed=1)
+    pytester.runpytest(f"--hil-port={port}").assert_outcomes(passed=1)
     pytester.makepyfile(
         """
         def test_board(hil_board):
             assert (hil_board.link, hil_board.domain_id) == ("ldlidar", 4)
         """
     )
-    result = pytester.runpytest("--hil-port", port, "--hil-link", "ldlidar", "--hil-domain-id", "4")
-    result.assert_outcomes(passed=1)
+    board = (f"--hil-port={port}", "--hil-link", "ldlidar", "--hil-domain-id", "4")
+    pytester.runpytest(*board).assert_outcomes(passed=1)
 
 
 def test_the_plugin_loads_no_ros_simulator_or_numpy(pytester: pytest.Pytester) -> None:
