@@ -2,21 +2,26 @@
 
 The node is started the way a user would start it (a shell command, a
 colcon workspace's package/executable as ``ros2 run`` finds it, or the
-bundled reference node), with ``--ros-args`` appended. It runs in its own
-process group so that stopping it also stops anything it started, and its
-output goes to files so that a chatty node can never block on a full pipe.
+bundled reference node), with ``--ros-args`` appended. It runs under a
+small reaper process (``node_reaper.py``, a child subreaper) in its own
+session, so stopping it also stops everything it started, even processes
+that left its process group or session, and so does the harness dying. Its
+stdout and stderr are read as they come and only their tails kept, so a
+chatty node never blocks on a full pipe and a flooding one fills nothing.
 """
 
 from __future__ import annotations
 
 import atexit
+import contextlib
 import os
+import select
 import shlex
 import shutil
 import signal
 import subprocess
 import sys
-import tempfile
+import threading
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -24,8 +29,15 @@ from pathlib import Path
 from harness.errors import ConfigError
 
 AMENT_MARKERS = Path("share/ament_index/resource_index/packages")
-STOP_GRACE_S = 3.0  # per signal: SIGINT, then SIGTERM, then SIGKILL
-TAIL_BYTES = 8192
+REAPER = Path(__file__).with_name("node_reaper.py")
+INT_GRACE_S = 2.0  # a ROS 2 node stops on SIGINT well within this
+TERM_GRACE_S = 1.0  # then SIGTERM; then SIGKILL
+START_WAIT_S = 10.0  # for the reaper (a Python start-up) to report the node started
+# The reaper's own bounds (node_reaper.py: graces, SIGKILL wait, leftovers), plus slack.
+STOP_WAIT_S = INT_GRACE_S + TERM_GRACE_S + 5.0 + 0.5 + 5.0 + 2.0
+POLL_S = 0.05
+TAIL_BYTES = 16384
+LINE_CHARS = 300  # a longer line in a tail is cut (a flood may have no newlines)
 
 
 @dataclass(frozen=True)
@@ -159,108 +171,255 @@ def _stop_all_at_exit() -> None:
 atexit.register(_stop_all_at_exit)
 
 
-def _load_prctl():
-    """libc's prctl, loaded once here: the child must not dlopen between fork and exec."""
+class OutputTail:
+    """The last bytes of a node's stdout or stderr, read by a thread as they come.
+
+    The pipe is always drained, so a chatty (or flooding) node never blocks
+    on it, and only the tail is kept, so neither memory nor disk grows with
+    what it writes.
+    """
+
+    def __init__(self, fd: int, name: str, keep: int = TAIL_BYTES) -> None:
+        self.total = 0  # bytes written, all told
+        self._keep = keep
+        self._buffer = bytearray()
+        self._lock = threading.Lock()
+        self._thread = threading.Thread(target=self._pump, args=(fd,), name=name, daemon=True)
+        self._thread.start()
+
+    def _pump(self, fd: int) -> None:
+        try:
+            while chunk := os.read(fd, 1 << 16):
+                with self._lock:
+                    self.total += len(chunk)
+                    self._buffer += chunk
+                    if len(self._buffer) > 2 * self._keep:
+                        del self._buffer[: -self._keep]
+        except OSError:
+            pass
+        finally:
+            os.close(fd)
+
+    def text(self) -> str:
+        with self._lock:
+            return bytes(self._buffer[-self._keep :]).decode("utf-8", "replace")
+
+    def join(self, timeout: float) -> None:
+        """Wait (bounded) for end of file: every process holding the pipe has exited."""
+        self._thread.join(timeout)
+
+
+def _signal_name(number: int) -> str:
     try:
-        import ctypes
-
-        return ctypes.CDLL("libc.so.6", use_errno=True).prctl
-    except (OSError, AttributeError):
-        return None
-
-
-_PRCTL = _load_prctl()
-PR_SET_PDEATHSIG = 1
-
-
-def _die_with_parent() -> None:  # runs in the child between fork and exec
-    """Ask Linux to SIGTERM the node if the harness dies without cleaning up."""
-    if _PRCTL is not None:
-        _PRCTL(PR_SET_PDEATHSIG, signal.SIGTERM)
+        return signal.Signals(number).name
+    except ValueError:
+        return f"signal {number}"
 
 
 class NodeProcess:
-    """One running node under test."""
+    """One running node under test, started under node_reaper.py (see there)."""
 
     def __init__(self, command: NodeCommand, args: list[str], env: dict[str, str]) -> None:
         self.command = command
         self.argv = [*command.argv, *args]
         self.env = {**os.environ, **command.env, **env, "PYTHONUNBUFFERED": "1"}
-        self._dir = tempfile.TemporaryDirectory(prefix="fossbot-hil-node-")
-        self.stdout_path = Path(self._dir.name) / "stdout.log"
-        self.stderr_path = Path(self._dir.name) / "stderr.log"
-        self._popen: subprocess.Popen[bytes] | None = None
+        self._popen: subprocess.Popen[bytes] | None = None  # the reaper
+        self._status_fd: int | None = None
+        self._partial = b""
+        self._outputs: dict[str, OutputTail] = {}
+        self.node_pid: int | None = None
+        self.start_error: str | None = None
+        self._code: int | None = None
+        self.stopped_by: str | None = None  # "exited", "SIGINT", "SIGTERM" or "SIGKILL"
+        self.stop_seconds = 0.0
+        self.leftovers: list[str] = []  # "PID (name)" of processes killed after the node
+        self.stop_problem: str | None = None
+        self._done = False  # the reaper finished its stop (its last event)
         self.started_at = 0.0
 
     def start(self) -> None:
-        with open(self.stdout_path, "wb") as out, open(self.stderr_path, "wb") as err:
-            try:
-                self._popen = subprocess.Popen(
-                    self.argv,
-                    stdin=subprocess.DEVNULL,
-                    stdout=out,
-                    stderr=err,
-                    env=self.env,
-                    start_new_session=True,
-                    preexec_fn=_die_with_parent,
-                )
-            except OSError as error:
-                raise ConfigError(f"cannot start {self.command.description}: {error}") from None
-        self.started_at = time.monotonic()
+        """Start the node under the reaper; wait (bounded) until it runs or cannot."""
+        status_r, status_w = os.pipe()
+        out_r, out_w = os.pipe()
+        err_r, err_w = os.pipe()
+        argv = [
+            sys.executable,
+            "-I",  # the reaper needs the standard library only
+            "-S",
+            str(REAPER),
+            str(status_w),
+            str(os.getpid()),
+            f"{INT_GRACE_S:g}",
+            f"{TERM_GRACE_S:g}",
+            "--",
+            *self.argv,
+        ]
+        try:
+            self._popen = subprocess.Popen(
+                argv,
+                stdin=subprocess.DEVNULL,
+                stdout=out_w,
+                stderr=err_w,
+                env=self.env,
+                start_new_session=True,  # a Ctrl-C on the terminal is the harness's to handle
+                pass_fds=(status_w,),
+            )
+        except OSError as error:
+            for fd in (status_r, out_r, err_r):
+                os.close(fd)
+            raise ConfigError(f"cannot start {self.command.description}: {error}") from None
+        finally:
+            for fd in (status_w, out_w, err_w):
+                os.close(fd)
+        os.set_blocking(status_r, False)
+        self._status_fd = status_r
+        self._outputs = {
+            "stdout": OutputTail(out_r, "node-stdout"),
+            "stderr": OutputTail(err_r, "node-stderr"),
+        }
         _LIVE.add(self)
+        end = time.monotonic() + START_WAIT_S
+        while self.node_pid is None and self.start_error is None and self._status_fd is not None:
+            left = end - time.monotonic()
+            if left <= 0:
+                break
+            self._read_events(min(POLL_S, left))
+        self.started_at = time.monotonic()
+        if self.node_pid is None:
+            why = self.start_error or (
+                f"its supervisor ({REAPER.name}) did not report within {START_WAIT_S:g} s; "
+                f"stderr: {self.tail('stderr', 3)}"
+            )
+            self.stop()
+            raise ConfigError(f"cannot start {self.command.description}: {why}")
+
+    # -- what the reaper reports --------------------------------------------
+    def _read_events(self, timeout: float = 0.0) -> None:
+        """Take the reaper's event lines, waiting at most `timeout` for the first."""
+        fd = self._status_fd
+        if fd is None:
+            return
+        if timeout > 0:
+            select.select([fd], [], [], timeout)
+        while True:
+            try:
+                chunk = os.read(fd, 4096)
+            except BlockingIOError:
+                return
+            if not chunk:  # the reaper has exited
+                os.close(fd)
+                self._status_fd = None
+                return
+            *lines, self._partial = (self._partial + chunk).split(b"\n")
+            for line in lines:
+                self._event(line.decode("utf-8", "replace"))
+
+    def _event(self, line: str) -> None:
+        kind, _, rest = line.partition(" ")
+        if kind == "started":
+            self.node_pid = int(rest)
+        elif kind == "error":
+            self.start_error = rest
+        elif kind == "exited":
+            self._code = int(rest)
+        elif kind == "stopped":
+            how, _, seconds = rest.partition(" ")
+            self.stopped_by, self.stop_seconds = how, float(seconds or 0)
+        elif kind == "leftover":
+            pid, _, name = rest.partition(" ")
+            self.leftovers.append(name if pid == "0" else f"{pid} ({name})")
+        elif kind == "done":
+            self._done = True
 
     @property
     def pid(self) -> int | None:
-        return self._popen.pid if self._popen else None
+        """The node's own process id (not its reaper's)."""
+        return self.node_pid
 
     def returncode(self) -> int | None:
         """None while running; the exit code (negative: killed by that signal) after."""
-        return self._popen.poll() if self._popen else None
+        if self._popen is None:
+            return None
+        self._read_events()
+        if self._code is None and self._popen.poll() is not None:
+            self._read_events(POLL_S)  # the reaper's last words
+            if self._code is None:  # the reaper was killed (not by us): so was its node
+                self._code = self._popen.returncode or -signal.SIGKILL
+        return self._code
+
+    def output_bytes(self, which: str = "stderr") -> int:
+        """How much the node wrote on stdout or stderr, all told."""
+        output = self._outputs.get(which)
+        return output.total if output else 0
 
     def tail(self, which: str = "stderr", lines: int = 15) -> str:
-        """The last lines the node wrote on stdout or stderr."""
-        path = self.stderr_path if which == "stderr" else self.stdout_path
-        try:
-            with open(path, "rb") as handle:
-                handle.seek(max(0, path.stat().st_size - TAIL_BYTES))
-                text = handle.read().decode("utf-8", "replace")
-        except OSError:
+        """The last lines the node wrote on stdout or stderr (very long lines cut)."""
+        output = self._outputs.get(which)
+        if output is None:
             return ""
-        return "\n".join(text.rstrip().splitlines()[-lines:])
+        kept = output.text().rstrip().splitlines()[-lines:]
+        return "\n".join(
+            line if len(line) <= LINE_CHARS else f"{line[:LINE_CHARS]}... ({len(line)} characters)"
+            for line in kept
+        )
 
     def exit_summary(self, when: str = "") -> str:
         """`exited with code 1 <when>; last stderr: ...` for failure explanations."""
         code = self.returncode()
         if code is None:
             return "still running"
-        how = f"was killed by signal {-code}" if code < 0 else f"exited with code {code}"
+        if code < 0:
+            how = f"was killed by {_signal_name(-code)}"
+        else:
+            how = f"exited with code {code}"
+        words = [how, when]
+        if code == 0:
+            words.append("(finished on its own: a node must keep running until it is stopped)")
         last = self.tail("stderr", 3).replace("\n", " | ")
-        return " ".join(filter(None, [how, when])) + (f"; last stderr: {last}" if last else "")
+        return " ".join(w for w in words if w) + (f"; last stderr: {last}" if last else "")
 
-    def _signal_group(self, sig: int) -> None:
-        assert self._popen is not None
-        try:
-            os.killpg(self._popen.pid, sig)
-        except (ProcessLookupError, PermissionError):
-            pass
+    def stop_note(self) -> str:
+        """What stopping took beyond a plain SIGINT: signals ignored, processes left behind."""
+        notes = []
+        if self.stopped_by == "SIGTERM":
+            notes.append(f"did not stop on SIGINT within {INT_GRACE_S:g} s; SIGTERM stopped it")
+        elif self.stopped_by == "SIGKILL":
+            notes.append(
+                f"ignored SIGINT ({INT_GRACE_S:g} s) and SIGTERM ({TERM_GRACE_S:g} s): "
+                f"killed with SIGKILL, {self.stop_seconds:.1f} s after the stop began"
+            )
+        if self.leftovers:
+            count = len(self.leftovers)
+            notes.append(
+                f"left {count} process{'es' if count > 1 else ''} running after it stopped "
+                f"(killed): {', '.join(self.leftovers)}"
+            )
+        if self.stop_problem:
+            notes.append(self.stop_problem)
+        return "; ".join(notes)
 
     def stop(self) -> int | None:
-        """SIGINT, then SIGTERM, then SIGKILL (each after a bounded wait); reap all."""
+        """Stop the node and everything it started (SIGINT, SIGTERM, SIGKILL; bounded); reap all."""
         if self._popen is None:
             return None
-        for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGKILL):
-            if self._popen.poll() is not None:
-                break
-            self._signal_group(sig)
+        if self._popen.poll() is None:
+            self._popen.send_signal(signal.SIGTERM)  # the reaper's cue to stop its node
             try:
-                self._popen.wait(timeout=STOP_GRACE_S)
+                self._popen.wait(timeout=STOP_WAIT_S)
             except subprocess.TimeoutExpired:
-                continue
-        self._signal_group(signal.SIGKILL)  # children the node left behind
+                self._popen.kill()
+                with contextlib.suppress(subprocess.TimeoutExpired):
+                    self._popen.wait(timeout=STOP_WAIT_S)
+                self.stop_problem = f"its reaper did not finish within {STOP_WAIT_S:g} s"
+        end = time.monotonic() + 1.0
+        while self._status_fd is not None and time.monotonic() < end:
+            self._read_events(POLL_S)
+        if not self._done and self.node_pid is not None:  # the reaper died (or hung) early
+            with contextlib.suppress(ProcessLookupError, PermissionError):
+                os.killpg(self.node_pid, signal.SIGKILL)
+            self.stop_problem = self.stop_problem or "its reaper died before it stopped the node"
+            self.stop_problem += ": killed the node's process group"
+        for output in self._outputs.values():
+            output.join(1.0)
         _LIVE.discard(self)
-        return self._popen.wait()
-
-    def cleanup(self) -> None:
-        """Stop and remove the log files (after their tails were read)."""
-        self.stop()
-        self._dir.cleanup()
+        return self.returncode()
