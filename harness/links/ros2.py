@@ -9,12 +9,19 @@ Whether a node publishes its Bool before or after its String is learned as
 the run goes: a node seen to publish the Bool first costs no wait at all; for
 others a short grace after the String lets the Bool of the same callback
 arrive (bounded, a few ms; never a fixed per-scan wait of the deadline).
+
+A hostile node gets a verdict, not a hang (docs/hostile_nodes.md): a wrong
+message type on a topic is named from the ROS graph at once, a flood of
+messages ends the run, and when the run is over the node is stopped (and
+every process it started) before the diagnostics are written, so they say
+if it had to be killed.
 """
 
 from __future__ import annotations
 
 import time
-from collections.abc import Callable
+from collections import Counter, deque
+from collections.abc import Callable, Iterable
 
 from harness.answers import Answers, Received
 from harness.errors import ConfigError, LinkError
@@ -36,6 +43,10 @@ MIN_GRACE_S = 0.002  # wait for a Bool after the String while the order is unkno
 STOPPED_AFTER = 3  # consecutive missed deadlines end the run
 WARM_UP_RETRY_S = 0.5  # resend the warm-up scan this often until it is answered
 CATCH_UP_S = 2.0  # after a missed deadline, wait this long (at least) for the late answer
+FLOOD_SCANS = 5  # a flood is judged over this many recent scans...
+FLOOD_PER_SCAN = 10  # ...in which a topic carried more than this many messages a scan...
+FLOOD_MIN = 50  # ...and this many at least
+LOUD_BYTES = 1 << 20  # a node that wrote more than this is told how much, in the diagnostics
 
 
 def node_command(options: LinkOptions) -> NodeCommand:
@@ -79,6 +90,9 @@ class Ros2Link(Link):
         self._bool_first_seen = 0
         self._bool_after_gap = 0.0  # longest String -> Bool gap seen, seconds
         self._silent_scans = 0
+        self._counted: Counter[str] = Counter()  # observer.heard when the last collect ended
+        self._warmed_up = False
+        self._recent: deque[tuple[Counter[str], float]] = deque(maxlen=FLOOD_SCANS)
         self.startup_s = 0.0
 
     # -- life cycle -------------------------------------------------------
@@ -97,6 +111,7 @@ class Ros2Link(Link):
             gone = self._node_gone("before it was ready")
             if gone:
                 raise LinkError(gone)
+            self._check_types()
             if time.monotonic() >= deadline:
                 raise LinkError(
                     f"node {self.command.description} never became ready within "
@@ -104,7 +119,18 @@ class Ros2Link(Link):
                     f"publish {opts.status_topic} ({self.observer.graph_summary()})"
                 )
             self.observer.spin(POLL_S)
+            self.observer.inbox.clear()  # nothing heard before it is ready is an answer
         self.startup_s = time.perf_counter() - started
+
+    def _check_types(self) -> None:
+        """Fail at once, naming it, when the node uses a topic with another message type."""
+        assert self.observer is not None
+        wrong = self.observer.wrong_types()
+        if wrong:
+            raise LinkError(
+                f"node {self.command.description} uses the wrong message type: "
+                f"{'; '.join(wrong)} (DDS connects only equal types, so nothing crosses)"
+            )
 
     # Hooks a link that delivers scans another way (a device and its driver)
     # overrides; the lockstep machinery below stays the same.
@@ -148,7 +174,7 @@ class Ros2Link(Link):
             sent_ns = self._deliver(scan, -1)
 
             def answered(since: int = sent_ns) -> bool:
-                return any(h.kind == "status" and h.source_ns >= since for h in obs.inbox)
+                return obs.heard_since("status", since)
 
             outcome = self._wait_for(answered, min(WARM_UP_RETRY_S, deadline - time.perf_counter()))
             if outcome is None:
@@ -163,9 +189,12 @@ class Ros2Link(Link):
                 )
         if obs.node.count_publishers(opts.warning_topic) > 0:
             self._wait_for(lambda: obs.warning_publishers() > 0, WARM_UP_RETRY_S)
+        self._check_types()  # by now the node's other publishers are known too
         self._wait_for(lambda: False, self._grace())  # the answer's Bool, if any
         obs.drain()
         obs.inbox.clear()
+        self._counted = Counter(obs.heard)
+        self._warmed_up = True
 
     def close(self) -> None:
         if self.observer is not None:
@@ -176,14 +205,43 @@ class Ros2Link(Link):
             self.domain.release()
 
     def diagnostics(self) -> str:
+        """The node's last output and what the graph showed; then stop it and say how that went.
+
+        The runner asks for diagnostics once, when the run is over (before
+        closing the link): stopping the node here lets them say whether it
+        had to be killed or left processes behind. Its output is taken
+        first, so its shutdown messages do not push out the lines that matter.
+        """
         if self.process is None:
             return ""
         parts = []
         for which in ("stderr", "stdout"):
             tail = self.process.tail(which)
+            written = self.process.output_bytes(which)
+            if written > LOUD_BYTES:
+                parts.append(f"node {which}: {written / 1e6:.0f} MB written (last lines below)")
             if tail:
                 parts.append(f"node {which} (last lines):\n{tail}")
+        parts += self._graph_notes()
+        self.process.stop()
+        note = self.process.stop_note()
+        if note:
+            parts.append(f"stopping node {self.command.description}: {note}")
         return "\n".join(parts)
+
+    def _graph_notes(self) -> list[str]:
+        """Topic trouble in the graph at the end (a publisher made after it was ready)."""
+        obs = self.observer
+        if obs is None or not obs.context.ok():
+            return []
+        notes = [f"wrong message type: {w}" for w in obs.wrong_types()]
+        silent = not obs.heard["warning"] and not obs.warning_publishers()
+        if self._warmed_up and not notes and silent:
+            notes.append(
+                f"no Bool came on {self.options.warning_topic} all run; the graph: "
+                f"{obs.node_topics()}"
+            )
+        return notes
 
     # -- lockstep ---------------------------------------------------------
     def send(self, scan: Scan, tick: int) -> None:
@@ -246,10 +304,10 @@ class Ros2Link(Link):
             return h.source_ns >= self._sent_ns
 
         def status_in() -> bool:
-            return any(h.kind == "status" and mine(h) for h in obs.inbox)
+            return obs.heard_since("status", self._sent_ns)
 
         def warning_in() -> bool:
-            return any(h.kind == "warning" and mine(h) for h in obs.inbox)
+            return obs.heard_since("warning", self._sent_ns)
 
         timeout = self._deadline(scan)
         outcome = self._wait_for(status_in, self._sent_at + timeout - time.perf_counter())
@@ -276,9 +334,29 @@ class Ros2Link(Link):
         else:
             answers.waited = time.perf_counter() - self._sent_at
         self._watch_silence(answers, tick)
+        self._watch_flood(answers)
         return answers
 
-    def _sort(self, answers: Answers, heard: list[Heard], mine) -> None:
+    def _watch_flood(self, answers: Answers) -> None:
+        """End the run when the node publishes far more than one message a scan on a topic."""
+        assert self.observer is not None
+        heard = Counter(self.observer.heard)
+        self._recent.append((heard - self._counted, time.perf_counter() - self._sent_at))
+        self._counted = heard
+        if answers.problem is not None:
+            return
+        topics = {"status": self.options.status_topic, "warning": self.options.warning_topic}
+        for kind, topic in topics.items():
+            count = sum(counts[kind] for counts, _ in self._recent)
+            if count >= FLOOD_MIN and count > FLOOD_PER_SCAN * len(self._recent):
+                seconds = sum(s for _, s in self._recent)
+                answers.problem = (
+                    f"node floods {topic}: {count} messages in {seconds:.2f} s over the last "
+                    f"{len(self._recent)} scans (one per scan expected)"
+                )
+                return
+
+    def _sort(self, answers: Answers, heard: Iterable[Heard], mine) -> None:
         """Split what arrived into this scan's answers and late ones; learn the Bool order."""
         first_status = next((h for h in heard if h.kind == "status" and mine(h)), None)
         for h in heard:
@@ -337,5 +415,6 @@ class Ros2Link(Link):
         else:
             answers.problem = (
                 f"node stopped answering: no status on {self.options.status_topic} for "
-                f"{self._silent_scans} scans in a row"
+                f"{self._silent_scans} scans in a row (the node is still running: stuck in a "
+                "callback, or not publishing)"
             )

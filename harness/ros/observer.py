@@ -3,13 +3,15 @@
 It lives in its own rclpy Context (domain id given explicitly), is spun by
 hand with bounded ``spin_once`` calls (no threads), and stamps everything it
 hears with the publisher's DDS source timestamp, so answers can be matched
-to the scan they belong to.
+to the scan they belong to. It also reads the ROS graph, to say what a node
+that never connects offers instead (other topic names, other types, QoS).
 """
 
 from __future__ import annotations
 
 import os
 import time
+from collections import Counter, deque
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
@@ -17,8 +19,10 @@ from typing import Any
 import rclpy
 from rclpy.context import Context
 from rclpy.executors import SingleThreadedExecutor
+from rclpy.node import NodeNameNonExistentError
 from rclpy.qos import QoSProfile, ReliabilityPolicy
 from rclpy.signals import SignalHandlerOptions
+from rclpy.topic_endpoint_info import TopicEndpointInfo
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import LaserScan
 from std_msgs.msg import Bool, String
@@ -27,6 +31,11 @@ from harness.ros.messages import clock_message, scan_from_message, scan_message
 from harness.scan import Scan
 
 QOS = QoSProfile(depth=50, reliability=ReliabilityPolicy.RELIABLE)
+INBOX_LIMIT = 10_000  # messages kept between two collects: more is a flood, not answers
+SCAN_TYPE = "sensor_msgs/msg/LaserScan"
+STATUS_TYPE = "std_msgs/msg/String"
+WARNING_TYPE = "std_msgs/msg/Bool"
+PLUMBING = {"/rosout", "/parameter_events", "/clock"}  # every node has these; not worth naming
 
 
 @dataclass(frozen=True)
@@ -63,7 +72,10 @@ class Observer:
         self.context = Context()
         # The harness handles SIGINT/SIGTERM itself (stop the node, report);
         # rclpy's own handlers would shut the context down under our feet.
+        # args=[]: not sys.argv, where the user's NAME:=VALUE items would be
+        # taken for remappings of the harness's own node.
         rclpy.init(
+            args=[],
             context=self.context,
             domain_id=domain_id,
             signal_handler_options=SignalHandlerOptions.NO,
@@ -72,6 +84,7 @@ class Observer:
         self.executor = SingleThreadedExecutor(context=self.context)
         self.executor.add_node(self.node)
         self.scan_topic, self.status_topic = scan_topic, status_topic
+        self.warning_topic = warning_topic
         # Either we publish the scans (ros2 link) or a board's driver does and
         # we listen to what the node under test receives (serial links).
         self.scan_pub = (
@@ -85,7 +98,9 @@ class Observer:
             )
         )
         self.clock_pub = self.node.create_publisher(Clock, "/clock", QOS)
-        self.inbox: list[Heard] = []
+        self.inbox: deque[Heard] = deque(maxlen=INBOX_LIMIT)
+        self.heard: Counter[str] = Counter()  # messages of each kind, all told
+        self.latest: dict[str, int] = {}  # newest source timestamp of each kind (O(1) checks)
         self.status_sub = self.node.create_subscription(
             String, status_topic, self._hear("status", lambda m: m.data), QOS
         )
@@ -98,9 +113,10 @@ class Observer:
 
     def _hear(self, kind: str, value_of: Callable[[Any], str | bool | Scan]):
         def callback(msg: object, info: dict) -> None:
-            self.inbox.append(
-                Heard(kind, value_of(msg), int(info["source_timestamp"]), time.perf_counter())
-            )
+            source_ns = int(info["source_timestamp"])
+            self.heard[kind] += 1
+            self.latest[kind] = max(source_ns, self.latest.get(kind, 0))
+            self.inbox.append(Heard(kind, value_of(msg), source_ns, time.perf_counter()))
 
         return callback
 
@@ -120,10 +136,14 @@ class Observer:
     def drain(self, limit: int = 100) -> None:
         """Handle everything already queued without waiting."""
         for _ in range(limit):
-            before = len(self.inbox)
+            before = self.heard.total()
             self.executor.spin_once(timeout_sec=0.0)
-            if len(self.inbox) == before:
+            if self.heard.total() == before:
                 return
+
+    def heard_since(self, kind: str, source_ns: int) -> bool:
+        """Has a message of `kind` published at or after `source_ns` arrived?"""
+        return self.latest.get(kind, 0) >= source_ns
 
     def warning_publishers(self) -> int:
         """Publishers of the node's warning topic matched to our subscription."""
@@ -147,18 +167,86 @@ class Observer:
             return self.scan_pub.get_subscription_count()
         return self.node.count_subscribers(self.scan_topic) - 1
 
+    # -- the graph: what the node under test offers ---------------------------
+    def _others(self, infos: list[TopicEndpointInfo]) -> list[TopicEndpointInfo]:
+        """Endpoints that are not this observer's."""
+        me = (self.node.get_name(), self.node.get_namespace())
+        return [i for i in infos if (i.node_name, i.node_namespace) != me]
+
+    def _wrong_type(self, topic: str, want: str, *, publishers: bool) -> str | None:
+        """'NODE publishes TOPIC as TYPE' when others use `topic` only with other types."""
+        infos = self._others(
+            self.node.get_publishers_info_by_topic(topic)
+            if publishers
+            else self.node.get_subscriptions_info_by_topic(topic)
+        )
+        if not infos or any(i.topic_type == want for i in infos):
+            return None
+        who = sorted(
+            {
+                f"{_full_name(i)} {'publishes' if publishers else 'subscribes to'} "
+                f"{topic} as {i.topic_type}"
+                for i in infos
+            }
+        )
+        return (
+            f"{', '.join(who)}, but the harness {'expects' if publishers else 'publishes'} {want}"
+        )
+
+    def wrong_types(self) -> list[str]:
+        """Topics the node under test uses with another message type than the harness.
+
+        DDS connects a publisher and a subscription only if their types are
+        the same, so nothing on such a topic ever crosses: say it, rather
+        than "never ready" or "no answer".
+        """
+        checks = [
+            self._wrong_type(self.status_topic, STATUS_TYPE, publishers=True),
+            self._wrong_type(self.warning_topic, WARNING_TYPE, publishers=True),
+        ]
+        if self.scan_pub is not None:
+            checks.append(self._wrong_type(self.scan_topic, SCAN_TYPE, publishers=False))
+        return [c for c in checks if c is not None]
+
+    def qos_mismatch(self) -> str | None:
+        """Why a status publisher of the right type did not match our subscription, if known."""
+        if self.status_sub.get_publisher_count() > 0:
+            return None
+        for info in self._others(self.node.get_publishers_info_by_topic(self.status_topic)):
+            if info.topic_type != STATUS_TYPE:
+                continue
+            if info.qos_profile.reliability == ReliabilityPolicy.BEST_EFFORT:
+                return (
+                    f"{_full_name(info)} publishes {self.status_topic} best-effort; the harness "
+                    "subscribes reliable, which DDS does not match: publish reliable (the default)"
+                )
+        return None
+
+    def node_topics(self) -> str:
+        """What each other node in the domain publishes and subscribes to, in one line."""
+        described = []
+        me = (self.node.get_name(), self.node.get_namespace())
+        for name, namespace in self.node.get_node_names_and_namespaces():
+            if (name, namespace) == me:
+                continue
+            try:
+                pubs = self.node.get_publisher_names_and_types_by_node(name, namespace)
+                subs = self.node.get_subscriber_names_and_types_by_node(name, namespace)
+            except NodeNameNonExistentError:  # it left the graph meanwhile
+                continue
+            full = f"{namespace.rstrip('/')}/{name}"
+            described.append(
+                f"{full} publishes {_topic_list(pubs)} and subscribes to {_topic_list(subs)}"
+            )
+        return "; ".join(described) or "no other node in this ROS domain"
+
     def graph_summary(self) -> str:
         """What the node under test offers, for 'never became ready' explanations."""
-        topics = [
-            f"{name} [{', '.join(t.split('/')[-1] for t in types)}]"
-            for name, types in self.node.get_topic_names_and_types()
-            if name not in ("/rosout", "/parameter_events", "/clock")
-        ]
-        return (
+        counts = (
             f"subscribers on {self.scan_topic}: {self._scan_readers()}, "
-            f"publishers on {self.status_topic}: {self.status_sub.get_publisher_count()}; "
-            f"topics seen: {', '.join(topics) or 'none'}"
+            f"publishers on {self.status_topic}: {self.status_sub.get_publisher_count()}"
         )
+        return "; ".join(filter(None, [counts, self.qos_mismatch(), self.node_topics()]))
 
     def close(self) -> None:
         """Tear down node, executor and context, in that order; safe to call twice.
@@ -171,3 +259,20 @@ class Observer:
             self.executor.shutdown(timeout_sec=1.0)
             self.context.try_shutdown()
             self.context.destroy()
+
+
+def _full_name(info: TopicEndpointInfo) -> str:
+    """The endpoint's node, e.g. /fossbot_lidar_node (DDS may know the endpoint first)."""
+    if info.node_name == "_NODE_NAME_UNKNOWN_":
+        return "the node"
+    return f"{info.node_namespace.rstrip('/')}/{info.node_name}"
+
+
+def _topic_list(names_and_types: list[tuple[str, list[str]]]) -> str:
+    """'/a (std_msgs/msg/String), /b (...)' without the topics every node has."""
+    shown = [
+        f"{topic} ({', '.join(types)})"
+        for topic, types in sorted(names_and_types)
+        if topic not in PLUMBING
+    ]
+    return ", ".join(shown) or "nothing"
