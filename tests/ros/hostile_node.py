@@ -1,0 +1,275 @@
+#!/usr/bin/env python3
+"""Hostile nodes under test: each misbehaves in one way the harness must survive.
+
+Run as ``python3 hostile_node.py VARIANT [--pids FILE] --ros-args ...``.
+Every variant otherwise answers each scan correctly (nearest valid return,
+warning below the threshold), so the misbehaviour is the only thing wrong.
+With ``--pids FILE`` the node appends ``PID STARTTIME`` for itself and for
+every process it starts, so a test can prove that none outlives the run.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import signal
+import subprocess
+import sys
+import threading
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+import rclpy
+from rclpy.executors import ExternalShutdownException
+from rclpy.node import Node
+from sensor_msgs.msg import LaserScan
+from std_msgs.msg import Bool, Int32, String
+
+MISBEHAVE_AT = 3  # mid-run variants answer this many scans (warm-up included) first
+
+
+def start_time(pid: int) -> str:
+    """Start time in clock ticks (/proc/PID/stat field 22): with the pid, unique."""
+    stat = Path(f"/proc/{pid}/stat").read_text()
+    return stat.rsplit(")", 1)[1].split()[19]
+
+
+def record_pid(pids: Path | None, pid: int) -> None:
+    if pids is not None:
+        with pids.open("a") as handle:
+            handle.write(f"{pid} {start_time(pid)}\n")
+
+
+class Answering(Node):
+    """A correct Lab 07 node; `on_scan` hooks let each variant break one thing."""
+
+    def __init__(self, status_type: type = String, warning_type: type = Bool) -> None:
+        super().__init__("fossbot_lidar_node")
+        self.declare_parameter("lidar_topic", "/scan")
+        self.declare_parameter("lidar_status_topic", "/lidar_status")
+        self.declare_parameter("warning_topic", "/obstacle_warning")
+        self.declare_parameter("threshold", 0.5)
+        self.threshold = self.get_parameter("threshold").value
+        self.scans = 0
+        self.before_answer: Callable[[int], None] = lambda count: None
+        self.status_topic = self.get_parameter("lidar_status_topic").value
+        self.status_pub = self.create_publisher(status_type, self.status_topic, 10)
+        self.warning_pub = self.create_publisher(
+            warning_type, self.get_parameter("warning_topic").value, 10
+        )
+        self.sub = self.create_subscription(
+            LaserScan, self.get_parameter("lidar_topic").value, self.on_scan, 10
+        )
+
+    def on_scan(self, msg: LaserScan) -> None:
+        self.scans += 1
+        self.before_answer(self.scans)
+        best, index = math.inf, None
+        for i, r in enumerate(msg.ranges):
+            if math.isfinite(r) and msg.range_min <= r <= msg.range_max and r < best:
+                best, index = r, i
+        if index is None:
+            self.answer("No obstacle", False)
+        else:
+            angle = msg.angle_min + index * msg.angle_increment
+            self.answer(f"Obstacle at {best:.3f} m, {angle:.3f} rad", best < self.threshold)
+
+    def answer(self, text: str, warning: bool) -> None:
+        self.status_pub.publish(String(data=text))
+        self.warning_pub.publish(Bool(data=warning))
+
+
+# -- variants: each builds its node (or never gets that far) ------------------
+
+
+def crash_at_start(pids: Path | None) -> Node:
+    raise RuntimeError("hostile: crash before the node exists")
+
+
+def crash_mid_run(pids: Path | None) -> Node:
+    node = Answering()
+
+    def crash(count: int) -> None:
+        if count > MISBEHAVE_AT:
+            raise RuntimeError(f"hostile: crash in scan callback {count}")
+
+    node.before_answer = crash
+    return node
+
+
+def hang(pids: Path | None) -> Node:
+    """Blocks forever inside the scan callback."""
+    node = Answering()
+    stuck = threading.Event()
+
+    def block(count: int) -> None:
+        if count > MISBEHAVE_AT:
+            stuck.wait()
+
+    node.before_answer = block
+    return node
+
+
+def exits_early(pids: Path | None) -> Node:
+    """'Finishes' with exit code 0 after a few scans."""
+    node = Answering()
+
+    def finish(count: int) -> None:
+        if count > MISBEHAVE_AT:
+            os._exit(0)
+
+    node.before_answer = finish
+    return node
+
+
+def _flood(body: Callable[[], None]) -> None:
+    threading.Thread(target=lambda: [body() for _ in iter(int, 1)], daemon=True).start()
+
+
+def flood_status(pids: Path | None) -> Node:
+    """Publishes status Strings as fast as it can, besides its answers."""
+    node = Answering()
+    flood = String(data="flood")
+    _flood(lambda: node.status_pub.publish(flood))
+    return node
+
+
+def flood_warning(pids: Path | None) -> Node:
+    """Publishes warning Bools as fast as it can, besides its answers."""
+    node = Answering()
+    flood = Bool(data=False)
+    _flood(lambda: node.warning_pub.publish(flood))
+    return node
+
+
+def flood_output(pids: Path | None) -> Node:
+    """Writes to stdout and stderr as fast as it can (a print in a hot loop, gone wrong)."""
+    line = "x" * 200 + "\n"
+    _flood(lambda: (sys.stdout.write(line), sys.stderr.write(line)))
+    return Answering()
+
+
+def status_as_bool(pids: Path | None) -> Node:
+    """Publishes a Bool on the status topic (and no String anywhere)."""
+    node = Answering(status_type=Bool)
+    node.answer = lambda text, warning: node.status_pub.publish(Bool(data=warning))
+    return node
+
+
+def warning_as_int32(pids: Path | None) -> Node:
+    """A String status, but the warning as std_msgs/Int32."""
+    node = Answering(warning_type=Int32)
+
+    def answer(text: str, warning: bool) -> None:
+        node.status_pub.publish(String(data=text))
+        node.warning_pub.publish(Int32(data=int(warning)))
+
+    node.answer = answer
+    return node
+
+
+def status_topic_wrong(pids: Path | None) -> Node:
+    """Publishes its status on /lidar_status_wrong, whatever the parameter says."""
+    node = Answering()
+    node.destroy_publisher(node.status_pub)
+    node.status_pub = node.create_publisher(String, "/lidar_status_wrong", 10)
+    return node
+
+
+def status_parameter_ignored(pids: Path | None) -> Node:
+    """Publishes on /lidar_status, ignoring the lidar_status_topic parameter."""
+    node = Answering()
+    if node.status_topic != "/lidar_status":
+        node.destroy_publisher(node.status_pub)
+        node.status_pub = node.create_publisher(String, "/lidar_status", 10)
+    return node
+
+
+def ignores_signals(pids: Path | None) -> Node:
+    """Ignores SIGINT and SIGTERM: only SIGKILL ends it."""
+    node = Answering()
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_IGN)
+    return node
+
+
+DAEMON = """
+import os, sys, time
+if os.fork():
+    os._exit(0)
+os.setsid()
+if os.fork():
+    os._exit(0)
+stat = open(f"/proc/{os.getpid()}/stat").read().rsplit(")", 1)[1].split()
+with open(sys.argv[1], "a") as handle:
+    handle.write(f"{os.getpid()} {stat[19]}\\n")
+while True:
+    time.sleep(60)
+"""
+
+
+def leaves_children(pids: Path | None) -> Node:
+    """Starts a child in its own process group and a daemon in a new session; neither stops.
+
+    The child ignores SIGINT and SIGTERM; the daemon double-forks away from the node.
+    """
+    assert pids is not None, "leaves_children needs --pids FILE"
+    child = subprocess.Popen(
+        [
+            sys.executable,
+            "-c",
+            "import signal, time\n"
+            "signal.signal(signal.SIGINT, signal.SIG_IGN)\n"
+            "signal.signal(signal.SIGTERM, signal.SIG_IGN)\n"
+            "while True: time.sleep(60)",
+        ],
+        start_new_session=True,
+    )
+    record_pid(pids, child.pid)
+    subprocess.run([sys.executable, "-c", DAEMON, str(pids)], check=True, timeout=10)
+    deadline = time.monotonic() + 10
+    while len(pids.read_text().splitlines()) < 3 and time.monotonic() < deadline:
+        time.sleep(0.01)  # bounded poll: the daemon has written its pid
+    return Answering()
+
+
+VARIANTS: dict[str, Callable[[Path | None], Node]] = {
+    f.__name__: f
+    for f in (
+        crash_at_start,
+        crash_mid_run,
+        hang,
+        exits_early,
+        flood_status,
+        flood_warning,
+        flood_output,
+        status_as_bool,
+        warning_as_int32,
+        status_topic_wrong,
+        status_parameter_ignored,
+        ignores_signals,
+        leaves_children,
+    )
+}
+
+
+def main() -> None:
+    args = sys.argv[1:]
+    if not args or args[0] not in VARIANTS:
+        sys.exit(f"usage: hostile_node.py {{{','.join(VARIANTS)}}} [--pids FILE] --ros-args ...")
+    pids = Path(args[args.index("--pids") + 1]) if "--pids" in args else None
+    record_pid(pids, os.getpid())
+    rclpy.init(args=sys.argv)
+    node = VARIANTS[args[0]](pids)
+    try:
+        rclpy.spin(node)
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    finally:
+        node.destroy_node()
+        rclpy.try_shutdown()
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,232 @@
+"""Hostile nodes: each misbehaviour gets a clear verdict in bounded time, and nothing survives.
+
+Every node is a real process (tests/ros/hostile_node.py) over real DDS. It
+writes its pid, and the pids of every process it starts, to a file; after
+the run none of them may be alive. Deadlines are short so that each test
+takes seconds; the timeout marker is only a backstop.
+"""
+
+from __future__ import annotations
+
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+from command_line import COMMAND, fossbot_hil
+
+from harness.links.base import LinkOptions
+from harness.runner import run
+from harness.scenario import resolve_scenario
+from harness.trace import RunResult
+
+pytestmark = [pytest.mark.ros, pytest.mark.timeout(60)]
+
+HOSTILE = Path(__file__).parent / "hostile_node.py"
+SCENARIO = Path(__file__).parent / "hostile_wall.yaml"  # 21 ticks, a wall 0.4 m ahead
+TIMEOUT_S, READY_S = 0.3, 5.0
+RUN_LIMIT_S = 45  # the CLI run, bounded
+
+
+def node(variant: str, pids: Path) -> str:
+    return f"{sys.executable} {HOSTILE} {variant} --pids {pids}"
+
+
+def hostile_cli(variant: str, pids: Path, *extra: str) -> subprocess.CompletedProcess[str]:
+    """`fossbot-hil run` against the variant, short deadlines; no harness traceback, ever."""
+    done = fossbot_hil(
+        "run",
+        str(SCENARIO),
+        "--timeout",
+        f"{TIMEOUT_S}",
+        "--ready-timeout",
+        f"{READY_S:g}",
+        "--node",
+        node(variant, pids),
+        *extra,
+        timeout=RUN_LIMIT_S,
+    )
+    assert "Traceback" not in done.stderr, done.stderr
+    return done
+
+
+def hostile_api(variant: str, pids: Path) -> RunResult:
+    """The same run through the runner API, for what only the result's diagnostics show."""
+    options = LinkOptions(node=node(variant, pids), scan_timeout=TIMEOUT_S, ready_timeout=READY_S)
+    return run(resolve_scenario(str(SCENARIO)), "ros2", options)
+
+
+def recorded(pids: Path) -> list[tuple[int, str]]:
+    """(pid, start time) of the node and of each process it started."""
+    lines = [line.split() for line in pids.read_text().splitlines()]
+    return [(int(fields[0]), fields[1]) for fields in lines if len(fields) == 2]
+
+
+def alive(pid: int, started: str) -> bool:
+    """That very process (same start time) still exists and is not a zombie."""
+    try:
+        stat = Path(f"/proc/{pid}/stat").read_text()
+    except OSError:
+        return False
+    fields = stat.rsplit(")", 1)[1].split()
+    return fields[19] == started and fields[0] != "Z"
+
+
+def survivors(pids: Path) -> list[int]:
+    return [pid for pid, started in recorded(pids) if alive(pid, started)]
+
+
+@pytest.fixture
+def pids(tmp_path: Path):
+    """The file the node writes its pids to; whatever a failed test leaves is killed."""
+    path = tmp_path / "pids"
+    yield path
+    if path.exists():
+        for pid in survivors(path):
+            subprocess.run(["kill", "-9", str(pid)], check=False)
+
+
+def explanation(done: subprocess.CompletedProcess[str]) -> str:
+    return done.stdout + done.stderr
+
+
+def test_crash_at_start(pids: Path) -> None:
+    """Exits before it is ready: its exit code and last stderr line, at once."""
+    done = hostile_cli("crash_at_start", pids)
+    assert done.returncode == 1, explanation(done)
+    assert "exited with code 1 before it was ready" in done.stdout
+    assert "RuntimeError: hostile: crash before the node exists" in done.stdout
+    assert len(recorded(pids)) == 1 and survivors(pids) == []
+
+
+def test_crash_mid_run(pids: Path) -> None:
+    """Raises in its 4th callback (warm-up, ticks 0 and 1 answered): tick 2 names the crash."""
+    done = hostile_cli("crash_mid_run", pids)
+    assert done.returncode == 1, explanation(done)
+    assert "hostile_wall: t=0.20 s tick 2: " in done.stdout
+    assert "exited with code 1; last stderr:" in done.stdout
+    assert "RuntimeError: hostile: crash in scan callback 4" in done.stdout
+    assert survivors(pids) == []
+
+
+def test_hang_in_callback(pids: Path) -> None:
+    """Blocks forever in a callback: three missed deadlines end the run; the node is stopped."""
+    done = hostile_cli("hang", pids)
+    assert done.returncode == 1, explanation(done)
+    assert "tick 2: " in done.stdout and "no status within the deadline (0.30 s)" in done.stdout
+    assert "node stopped answering: no status on /lidar_status for 3 scans in a row" in (
+        done.stdout
+    )
+    assert survivors(pids) == []
+
+
+def test_exit_code_0_mid_run_is_an_error(pids: Path) -> None:
+    """'Finishing' after a few scans is not a pass."""
+    done = hostile_cli("exits_early", pids)
+    assert done.returncode == 1, explanation(done)
+    assert "tick 2: " in done.stdout
+    assert "exited with code 0 (finished on its own: a node must keep running" in done.stdout
+    assert survivors(pids) == []
+
+
+@pytest.mark.parametrize(
+    ("variant", "topic"),
+    [("flood_status", "/lidar_status"), ("flood_warning", "/obstacle_warning")],
+)
+def test_message_flood_ends_the_run(variant: str, topic: str, pids: Path) -> None:
+    """Publishing as fast as it can on a topic: the run ends, naming the topic and the count."""
+    done = hostile_cli(variant, pids)
+    assert done.returncode == 1, explanation(done)
+    assert f"node floods {topic}: " in done.stdout
+    assert "(one per scan expected)" in done.stdout
+    assert survivors(pids) == []
+
+
+def test_output_flood_is_drained_and_only_its_tail_kept(pids: Path) -> None:
+    """Megabytes on stdout and stderr: no blocked node, no growing buffer, the tail shown."""
+    result = hostile_api("flood_output", pids)
+    assert result.ok, result.first_failure
+    assert "node stdout: " in result.diagnostics and "MB written" in result.diagnostics
+    assert "node stderr (last lines):\nxxxx" in result.diagnostics
+    assert len(result.diagnostics) < 20_000  # two 15-line tails and a few notes
+    assert survivors(pids) == []
+
+
+@pytest.mark.parametrize(
+    ("variant", "wrong"),
+    [
+        ("status_as_bool", "publishes /lidar_status as std_msgs/msg/Bool"),
+        (
+            "warning_as_int32",
+            "/fossbot_lidar_node publishes /obstacle_warning as std_msgs/msg/Int32",
+        ),
+    ],
+)
+def test_wrong_message_type_is_named(variant: str, wrong: str, pids: Path) -> None:
+    """DDS never connects different types: the graph says which topic has which type."""
+    done = hostile_cli(variant, pids)
+    assert done.returncode == 1, explanation(done)
+    assert "uses the wrong message type: " in done.stdout and wrong in done.stdout
+    assert "but the harness expects std_msgs/msg/" in done.stdout
+    assert survivors(pids) == []
+
+
+@pytest.mark.parametrize(
+    ("variant", "extra", "publishes"),
+    [
+        ("status_topic_wrong", (), "/lidar_status_wrong (std_msgs/msg/String)"),
+        (
+            "status_parameter_ignored",
+            ("--param", "lidar_status_topic:=/robot/status", "--status-topic", "/robot/status"),
+            "/lidar_status (std_msgs/msg/String)",
+        ),
+    ],
+)
+def test_wrong_topic_names_are_listed(
+    variant: str, extra: tuple[str, ...], publishes: str, pids: Path
+) -> None:
+    """A status on another topic: 'never ready', and what the node does publish."""
+    done = hostile_cli(variant, pids, *extra, "--ready-timeout", "3")
+    assert done.returncode == 1, explanation(done)
+    assert "never became ready within 3 s" in done.stdout
+    assert f"/fossbot_lidar_node publishes {publishes}, /obstacle_warning" in done.stdout
+    assert "subscribes to /scan (sensor_msgs/msg/LaserScan)" in done.stdout
+    assert survivors(pids) == []
+
+
+def test_node_ignoring_sigint_and_sigterm_is_killed(pids: Path) -> None:
+    """Closing escalates to SIGKILL after bounded waits, and the diagnostics say so."""
+    result = hostile_api("ignores_signals", pids)
+    assert result.ok, result.first_failure
+    assert "ignored SIGINT (2 s) and SIGTERM (1 s): killed with SIGKILL, " in result.diagnostics
+    assert survivors(pids) == []
+
+
+def test_processes_the_node_leaves_behind_are_killed(pids: Path) -> None:
+    """A child in its own session ignoring signals, and a double-forked daemon: both go."""
+    result = hostile_api("leaves_children", pids)
+    assert result.ok, result.first_failure
+    assert len(recorded(pids)) == 3
+    assert "left 2 processes running after it stopped (killed)" in result.diagnostics
+    assert survivors(pids) == []
+
+
+def test_nothing_survives_a_killed_harness(pids: Path) -> None:
+    """SIGKILL the harness mid-start: the node's reaper still stops the node and its strays."""
+    harness = subprocess.Popen(
+        [*COMMAND, "run", str(SCENARIO), "--node", node("leaves_children", pids)],
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+    )
+    deadline = time.monotonic() + 30
+    while time.monotonic() < deadline and not (pids.exists() and len(recorded(pids)) == 3):
+        time.sleep(0.05)  # bounded poll: the node and both strays are up
+    assert len(recorded(pids)) == 3
+    harness.send_signal(signal.SIGKILL)
+    assert harness.wait(timeout=10) == -signal.SIGKILL
+    deadline = time.monotonic() + 20
+    while survivors(pids) and time.monotonic() < deadline:
+        time.sleep(0.05)  # bounded poll: Linux tells the reaper its parent died
+    assert survivors(pids) == []
