@@ -38,9 +38,33 @@ class DomainReservation:
         self.release()
 
 
+def _lock_dir() -> Path:
+    """The shared folder of lock files: sticky and world-writable like /tmp, so
+    every user's runs on this machine take ids from the same pool."""
+    if not LOCK_DIR.is_dir():
+        LOCK_DIR.mkdir(parents=True, exist_ok=True)
+        try:
+            os.chmod(LOCK_DIR, 0o1777)
+        except OSError:  # made by another user a moment ago: theirs to set
+            pass
+    return LOCK_DIR
+
+
 def _try_lock(domain_id: int) -> int | None:
-    LOCK_DIR.mkdir(parents=True, exist_ok=True)
-    handle = os.open(LOCK_DIR / f"{domain_id}.lock", os.O_RDWR | os.O_CREAT, 0o666)
+    """A locked handle on the id's file, or None when another run holds it.
+
+    A file another user made without write access for us counts as taken:
+    better one id fewer than a crash.
+    """
+    path = _lock_dir() / f"{domain_id}.lock"
+    try:
+        handle = os.open(path, os.O_RDWR | os.O_CREAT, 0o666)
+    except PermissionError:
+        return None
+    try:
+        os.fchmod(handle, 0o666)  # the umask must not lock other users out
+    except OSError:
+        pass  # not ours: its owner set it
     try:
         fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
     except OSError:
