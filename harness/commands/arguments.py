@@ -112,6 +112,16 @@ def fault_list(text: str | None) -> list[str] | None:
     return [f.strip() for f in text.split(",") if f.strip()] if text else None
 
 
+def add_scenario_overrides(parser: argparse.ArgumentParser) -> None:
+    """--seed and --faults: the same scenarios under other fault draws or profiles."""
+    parser.add_argument("--seed", type=seed, help="override the scenarios' seed")
+    parser.add_argument(
+        "--faults",
+        metavar="NAME[,NAME]",
+        help="fault profiles replacing the scenarios' own (see docs/faults.md)",
+    )
+
+
 def add_judging_options(parser: argparse.ArgumentParser) -> None:
     """How answers are judged and waited for: threshold, status regex, timeout."""
     parser.add_argument(

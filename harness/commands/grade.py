@@ -19,11 +19,11 @@ from harness.commands.arguments import (
     add_judging_options,
     add_link_option,
     add_node_options,
+    add_scenario_overrides,
     check_status_regex,
     fault_list,
     link_options,
     positive,
-    seed,
 )
 from harness.errors import ConfigError
 from harness.grading import LAB_EXECUTABLE, LAB_PACKAGE
@@ -81,12 +81,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="scenario name or file (repeatable; default: all shipped)",
     )
     add_link_option(parser)
-    parser.add_argument("--seed", type=seed, help="override the scenarios' seed")
-    parser.add_argument(
-        "--faults",
-        metavar="NAME[,NAME]",
-        help="fault profiles replacing the scenarios' own (see docs/faults.md)",
-    )
+    add_scenario_overrides(parser)
     add_judging_options(parser)
     parser.add_argument(
         "--build-timeout",

@@ -14,11 +14,11 @@ from harness.commands.arguments import (
     add_judging_options,
     add_link_option,
     add_node_options,
+    add_scenario_overrides,
     check_link_options,
     check_status_regex,
     fault_list,
     link_options,
-    seed,
 )
 from harness.errors import ConfigError
 from harness.runner import RunSettings
@@ -42,12 +42,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="shipped scenario name or path to a scenario file (default: all shipped)",
     )
     add_link_option(parser)
-    parser.add_argument("--seed", type=seed, help="override the scenarios' seed")
-    parser.add_argument(
-        "--faults",
-        metavar="NAME[,NAME]",
-        help="fault profiles replacing the scenarios' own (see docs/faults.md)",
-    )
+    add_scenario_overrides(parser)
     add_judging_options(parser)
     parser.add_argument("--gui", action="store_true", help="open the PyBullet viewer")
     parser.add_argument("--junit-xml", metavar="FILE", help="write a JUnit XML report")
