@@ -356,7 +356,10 @@ def parse_scenario(data: Any, *, source: str = "<scenario>") -> Scenario:
     does both).
     """
     if not isinstance(data, dict):
-        raise ConfigError(f"{source}: a scenario must be a mapping, got {type(data).__name__}")
+        got = {type(None): "nothing (an empty file?)", list: "a list", str: "text"}.get(
+            type(data), type(data).__name__
+        )
+        raise ConfigError(f"{source}: a scenario must be a mapping of fields, got {got}")
     if "source" in data:  # the harness's own field: where the file is, never the file's say
         raise ConfigError(f"{source}: source: unknown key")
     try:
@@ -530,7 +533,11 @@ def _yaml_problem(err: yaml.YAMLError) -> str:
         char = chr(err.character) if isinstance(err.character, int) else str(err.character)
         return f"YAML error: unacceptable character U+{ord(char[:1] or ' '):04X} in the file"
     where = f" at line {mark.line + 1}" if mark is not None else ""
-    return f"YAML error{where}: {' '.join(str(problem or 'invalid YAML').split())}"
+    text = str(problem or "invalid YAML")
+    context = getattr(err, "context", None)
+    if context and text.startswith("but "):  # "expected a single document ..., but found ..."
+        text = f"{context}, {text}"
+    return f"YAML error{where}: {' '.join(text.split())}"
 
 
 def _read_text(path: Path) -> str:
