@@ -381,6 +381,27 @@ def parse_scenario(data: Any, *, source: str = "<scenario>") -> Scenario:
     return scenario
 
 
+def check_reachable(scenario: Scenario) -> None:
+    """A distance or turn its segment's speed cannot cover within the timeout fails now.
+
+    The simulation refuses these too, but only once the link (and so the
+    node under test) is up; a file loaded from disk is refused before.
+    """
+    where = scenario.source or "<scenario>"
+    for index, segment in enumerate(scenario.motion.segments):
+        until = segment.until
+        for name, value, unit, speed, what, speed_unit in (
+            ("distance", until.distance, "m", segment.linear, "linear", "m/s"),
+            ("turn", until.turn, "rad", segment.angular, "angular", "rad/s"),
+        ):
+            needed = value / abs(speed) if value is not None and speed else math.inf
+            if value is not None and needed > until.timeout:
+                raise ConfigError(
+                    f"{where}: motion.segments[{index}].until: {name} {value:g} {unit} not "
+                    f"reached within {until.timeout:g} s ({what} {speed:g} {speed_unit})"
+                )
+
+
 def check_model_files(scenario: Scenario) -> None:
     """The robot URDF and every model obstacle: found where allowed and loadable.
 
@@ -589,6 +610,7 @@ def load_scenario_file(path: str | Path) -> Scenario:
     except ValueError as err:  # e.g. an integer with more digits than Python converts
         raise ConfigError(f"{path}: YAML error: {' '.join(str(err).split())[:200]}") from None
     scenario = parse_scenario(data, source=str(path))
+    check_reachable(scenario)
     check_model_files(scenario)
     return scenario
 

@@ -153,3 +153,24 @@ def test_messages_are_one_line(tmp_path: Path) -> None:
         with pytest.raises(ConfigError) as info:
             load_scenario_file(path)
         assert "\n" not in str(info.value)
+
+
+@pytest.mark.parametrize(
+    ("segment", "reason"),
+    [
+        (
+            "{angular: 1.0, until: {distance: 1.0}}",
+            r"distance 1 m not reached within 60 s \(linear 0",
+        ),
+        (
+            "{linear: 0.1, until: {distance: 10, timeout: 5}}",
+            r"distance 10 m not reached within 5 s",
+        ),
+        ("{angular: 0.5, until: {turn: 6, timeout: 2}}", r"turn 6 rad not reached within 2 s"),
+    ],
+)
+def test_unreachable_segment_is_refused_at_load(tmp_path: Path, segment: str, reason: str) -> None:
+    """A distance or turn the speed cannot cover is refused when the file loads."""
+    path = write(tmp_path, f"description: x\nmotion:\n  segments:\n    - {segment}\n")
+    with pytest.raises(ConfigError, match=rf"^{path}: motion\.segments\[0\]\.until: {reason}"):
+        load_scenario_file(path)
