@@ -43,9 +43,10 @@ MIN_GRACE_S = 0.002  # wait for a Bool after the String while the order is unkno
 STOPPED_AFTER = 3  # consecutive missed deadlines end the run
 WARM_UP_RETRY_S = 0.5  # resend the warm-up scan this often until it is answered
 CATCH_UP_S = 2.0  # after a missed deadline, wait this long (at least) for the late answer
-FLOOD_SCANS = 5  # a flood is judged over this many recent scans...
-FLOOD_PER_SCAN = 10  # ...in which a topic carried more than this many messages a scan...
-FLOOD_MIN = 50  # ...and this many at least
+FLOOD_SCANS = 5  # a flood is judged over this many recent scans, in which a topic carried
+FLOOD_PER_SCAN = 5  # more than this many messages a scan,
+FLOOD_MIN = 30  # this many at least,
+FLOOD_RATE_HZ = 200.0  # and this many a second (a 10 Hz timer during long waits is no flood)
 LOUD_BYTES = 1 << 20  # a node that wrote more than this is told how much, in the diagnostics
 
 
@@ -348,8 +349,9 @@ class Ros2Link(Link):
         topics = {"status": self.options.status_topic, "warning": self.options.warning_topic}
         for kind, topic in topics.items():
             count = sum(counts[kind] for counts, _ in self._recent)
-            if count >= FLOOD_MIN and count > FLOOD_PER_SCAN * len(self._recent):
-                seconds = sum(s for _, s in self._recent)
+            seconds = sum(s for _, s in self._recent)
+            many = count >= FLOOD_MIN and count > FLOOD_PER_SCAN * len(self._recent)
+            if many and count >= FLOOD_RATE_HZ * seconds:
                 answers.problem = (
                     f"node floods {topic}: {count} messages in {seconds:.2f} s over the last "
                     f"{len(self._recent)} scans (one per scan expected)"
