@@ -26,7 +26,9 @@ from rclpy.node import Node
 from sensor_msgs.msg import LaserScan
 from std_msgs.msg import Bool, Int32, String
 
-MISBEHAVE_AT = 3  # mid-run variants answer this many scans (warm-up included) first
+# Mid-run variants misbehave from the scan stamped this (simulated) time on:
+# tick 2 at 10 Hz, however often the harness had to resend its warm-up scan.
+MISBEHAVE_AT_S = 0.2
 
 
 def start_time(pid: int) -> str:
@@ -51,8 +53,7 @@ class Answering(Node):
         self.declare_parameter("warning_topic", "/obstacle_warning")
         self.declare_parameter("threshold", 0.5)
         self.threshold = self.get_parameter("threshold").value
-        self.scans = 0
-        self.before_answer: Callable[[int], None] = lambda count: None
+        self.before_answer: Callable[[float], None] = lambda stamp: None
         self.status_topic = self.get_parameter("lidar_status_topic").value
         self.status_pub = self.create_publisher(status_type, self.status_topic, 10)
         self.warning_pub = self.create_publisher(
@@ -63,8 +64,7 @@ class Answering(Node):
         )
 
     def on_scan(self, msg: LaserScan) -> None:
-        self.scans += 1
-        self.before_answer(self.scans)
+        self.before_answer(msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9)
         best, index = math.inf, None
         for i, r in enumerate(msg.ranges):
             if math.isfinite(r) and msg.range_min <= r <= msg.range_max and r < best:
@@ -90,9 +90,9 @@ def crash_at_start(pids: Path | None) -> Node:
 def crash_mid_run(pids: Path | None) -> Node:
     node = Answering()
 
-    def crash(count: int) -> None:
-        if count > MISBEHAVE_AT:
-            raise RuntimeError(f"hostile: crash in scan callback {count}")
+    def crash(stamp: float) -> None:
+        if stamp >= MISBEHAVE_AT_S - 1e-6:
+            raise RuntimeError(f"hostile: crash in the callback of the scan stamped {stamp:.1f} s")
 
     node.before_answer = crash
     return node
@@ -103,8 +103,8 @@ def hang(pids: Path | None) -> Node:
     node = Answering()
     stuck = threading.Event()
 
-    def block(count: int) -> None:
-        if count > MISBEHAVE_AT:
+    def block(stamp: float) -> None:
+        if stamp >= MISBEHAVE_AT_S - 1e-6:
             stuck.wait()
 
     node.before_answer = block
@@ -115,8 +115,8 @@ def exits_early(pids: Path | None) -> Node:
     """'Finishes' with exit code 0 after a few scans."""
     node = Answering()
 
-    def finish(count: int) -> None:
-        if count > MISBEHAVE_AT:
+    def finish(stamp: float) -> None:
+        if stamp >= MISBEHAVE_AT_S - 1e-6:
             os._exit(0)
 
     node.before_answer = finish
