@@ -124,7 +124,8 @@ class Ros2Link(Link):
         self.startup_s = time.perf_counter() - started
 
     def _check_types(self) -> None:
-        """Fail at once, naming it, when the node uses a topic with another message type."""
+        """Fail at once, naming it, when the node publishes what can never reach the harness:
+        another message type on a topic, or best-effort where the harness needs reliable."""
         assert self.observer is not None
         wrong = self.observer.wrong_types()
         if wrong:
@@ -132,6 +133,9 @@ class Ros2Link(Link):
                 f"node {self.command.description} uses the wrong message type: "
                 f"{'; '.join(wrong)} (DDS connects only equal types, so nothing crosses)"
             )
+        qos = self.observer.qos_mismatches()
+        if qos:
+            raise LinkError(f"node {self.command.description} cannot be heard: {'; '.join(qos)}")
 
     # Hooks a link that delivers scans another way (a device and its driver)
     # overrides; the lockstep machinery below stays the same.

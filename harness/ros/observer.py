@@ -208,19 +208,26 @@ class Observer:
             checks.append(self._wrong_type(self.scan_topic, SCAN_TYPE, publishers=False))
         return [c for c in checks if c is not None]
 
-    def qos_mismatch(self) -> str | None:
-        """Why a status publisher of the right type did not match our subscription, if known."""
-        if self.status_sub.get_publisher_count() > 0:
-            return None
-        for info in self._others(self.node.get_publishers_info_by_topic(self.status_topic)):
-            if info.topic_type != STATUS_TYPE:
+    def qos_mismatches(self) -> list[str]:
+        """Publishers of the right type that our reliable subscriptions can never match."""
+        found = []
+        for sub, topic, want in (
+            (self.status_sub, self.status_topic, STATUS_TYPE),
+            (self.warning_sub, self.warning_topic, WARNING_TYPE),
+        ):
+            if sub.get_publisher_count() > 0:
                 continue
-            if info.qos_profile.reliability == ReliabilityPolicy.BEST_EFFORT:
-                return (
-                    f"{_full_name(info)} publishes {self.status_topic} best-effort; the harness "
-                    "subscribes reliable, which DDS does not match: publish reliable (the default)"
-                )
-        return None
+            for info in self._others(self.node.get_publishers_info_by_topic(topic)):
+                if info.topic_type == want and (
+                    info.qos_profile.reliability == ReliabilityPolicy.BEST_EFFORT
+                ):
+                    found.append(
+                        f"{_full_name(info)} publishes {topic} best-effort, but the harness "
+                        "subscribes reliable, which DDS never matches: publish reliable "
+                        "(the default QoS)"
+                    )
+                    break
+        return found
 
     def node_topics(self) -> str:
         """What each other node in the domain publishes and subscribes to, in one line."""
@@ -246,7 +253,7 @@ class Observer:
             f"subscribers on {self.scan_topic}: {self._scan_readers()}, "
             f"publishers on {self.status_topic}: {self.status_sub.get_publisher_count()}"
         )
-        return "; ".join(filter(None, [counts, self.qos_mismatch(), self.node_topics()]))
+        return "; ".join([counts, *self.qos_mismatches(), self.node_topics()])
 
     def close(self) -> None:
         """Tear down node, executor and context, in that order; safe to call twice.

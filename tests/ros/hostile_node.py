@@ -23,6 +23,7 @@ from pathlib import Path
 import rclpy
 from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
+from rclpy.qos import qos_profile_sensor_data
 from sensor_msgs.msg import LaserScan
 from std_msgs.msg import Bool, Int32, String
 
@@ -169,6 +170,17 @@ def warning_as_int32(pids: Path | None) -> Node:
     return node
 
 
+def best_effort(pids: Path | None) -> Node:
+    """Publishes status and warning best-effort (sensor-data QoS copied from the scan)."""
+    node = Answering()
+    for pub in (node.status_pub, node.warning_pub):
+        node.destroy_publisher(pub)
+    topics = (node.status_topic, node.get_parameter("warning_topic").value)
+    node.status_pub = node.create_publisher(String, topics[0], qos_profile_sensor_data)
+    node.warning_pub = node.create_publisher(Bool, topics[1], qos_profile_sensor_data)
+    return node
+
+
 def status_topic_wrong(pids: Path | None) -> Node:
     """Publishes its status on /lidar_status_wrong, whatever the parameter says."""
     node = Answering()
@@ -246,6 +258,7 @@ VARIANTS: dict[str, Callable[[Path | None], Node]] = {
         flood_output,
         status_as_bool,
         warning_as_int32,
+        best_effort,
         status_topic_wrong,
         status_parameter_ignored,
         ignores_signals,

@@ -186,6 +186,14 @@ def test_wrong_message_type_is_named(variant: str, wrong: str, pids: Path) -> No
     assert survivors(pids) == []
 
 
+def test_best_effort_publisher_is_named(pids: Path) -> None:
+    """A best-effort status never matches the harness's reliable subscription: said at once."""
+    done = hostile_cli("best_effort", pids)
+    assert done.returncode == 1, explanation(done)
+    says(done, "cannot be heard: ", "publishes /lidar_status best-effort, but the harness")
+    assert survivors(pids) == []
+
+
 @pytest.mark.parametrize(
     ("variant", "extra", "publishes"),
     [
