@@ -17,6 +17,7 @@ COMMAND_MODULES = (
     "emulate",
     "replay",
     "grade",
+    "bench",
 )
 
 

@@ -1,0 +1,130 @@
+"""The bench's figures from its stages, and the issue's targets (pure).
+
+One flat dictionary of named figures (the keys ``fossbot-hil bench --json``
+prints), the ratio of each stage to the ray-casting floor, the real-time
+factors, and each target with whether it was met.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+from typing import Any
+
+from harness.bench.stage import StageResult
+from harness.bench.stats import overhead_ratio
+
+__all__ = ["REQUIRED_KEYS", "TARGETS", "OVERHEAD_FORMULA", "Target", "check_targets", "figures"]
+
+#: The keys issue 7 asks `bench --json` for; each is a number, or null when its stage did not run.
+REQUIRED_KEYS = (
+    "raycast_scans_per_s",
+    "inprocess_scans_per_s",
+    "ros2_lockstep_scans_per_s",
+    "ros2_round_trip_ms_median",
+    "ros2_round_trip_ms_p99",
+    "overhead_ratio",
+    "node_startup_s",
+    "lab_suite_wall_s",
+    "serial_lockstep_scans_per_s",
+    "serial_rate_error_pct",
+    "serial_jitter_p99_ms",
+    "peak_rss_mb",
+)
+
+OVERHEAD_FORMULA = (
+    "(ros2 lockstep s/scan - raycast s/scan - median round trip s) "
+    "/ (raycast s/scan + median round trip s)"
+)
+
+#: Throughput stages, by the name their figures carry.
+_THROUGHPUT = {
+    "raycast": "raycast",
+    "synthesis": "synthesis",
+    "inprocess": "inprocess",
+    "ros2": "ros2_lockstep",
+    "serial": "serial_lockstep",
+}
+
+
+@dataclass(frozen=True)
+class Target:
+    """A goal from the issue: `key` compared by `met` against `goal`."""
+
+    key: str
+    label: str
+    goal: str
+    met: Callable[[float], bool]
+
+
+TARGETS = (
+    Target("ros2_lockstep_scans_per_s", "ROS 2 lockstep", ">= 500 scans/s", lambda v: v >= 500),
+    Target("overhead_ratio", "harness overhead per scan", "<= 25 %", lambda v: v <= 0.25),
+    Target("lab_suite_wall_s", "lab trio over ROS 2", "< 5 s", lambda v: v < 5.0),
+    Target("lab_suite_cli_wall_s", "lab trio, CLI from spawn", "< 5 s", lambda v: v < 5.0),
+    Target("serial_rate_error_pct", "serial byte rate error", "within 1 %", lambda v: abs(v) <= 1),
+    Target("serial_jitter_p99_ms", "revolution jitter p99", "< 2 ms", lambda v: v < 2.0),
+)
+
+
+def _extra(stage: StageResult | None, key: str) -> Any:
+    return stage.extra.get(key) if stage is not None else None
+
+
+def figures(stages: Mapping[str, StageResult], peak_rss_mb: float) -> dict[str, Any]:
+    """Every named figure; None where the stage that measures it did not run."""
+    out: dict[str, Any] = {}
+    for stage_name, prefix in _THROUGHPUT.items():
+        stage = stages.get(stage_name)
+        out[f"{prefix}_scans_per_s"] = stage.scans_per_s if stage else None
+    raycast, ros2, serial = stages.get("raycast"), stages.get("ros2"), stages.get("serial")
+    pacing, suite = stages.get("pacing"), stages.get("suite")
+    out["raycast_truth_ms"] = _extra(raycast, "truth_ms")
+    out["synthesis_harsh_scans_per_s"] = _extra(stages.get("synthesis"), "harsh_scans_per_s")
+    out["ros2_round_trip_ms_median"] = _extra(ros2, "round_trip_ms_median")
+    out["ros2_round_trip_ms_p99"] = _extra(ros2, "round_trip_ms_p99")
+    out["ros2_wait_ms_median"] = _extra(ros2, "wait_ms_median")
+    out["ros2_scan_ms"] = ros2.scan_s * 1000.0 if ros2 else None
+    out["overhead_ratio"] = None
+    rtt = out["ros2_round_trip_ms_median"]
+    if raycast is not None and ros2 is not None and rtt is not None:
+        out["overhead_ratio"] = overhead_ratio(ros2.scan_s, raycast.scan_s, rtt / 1000.0)
+    out["node_startup_s"] = _extra(ros2, "startup_s")
+    out["serial_startup_s"] = _extra(serial, "startup_s")
+    out["lab_suite_wall_s"] = suite.seconds if suite else None
+    out["lab_suite_cli_wall_s"] = _extra(suite, "cli_wall_s")
+    out["serial_rate_error_pct"] = _extra(pacing, "reader_rate_error_pct")
+    out["serial_jitter_p99_ms"] = _extra(pacing, "reader_jitter_p99_ms")
+    out["serial_pacer_rate_error_pct"] = _extra(pacing, "pacer_rate_error_pct")
+    out["serial_pacer_jitter_p99_ms"] = _extra(pacing, "pacer_jitter_p99_ms")
+    out["peak_rss_mb"] = peak_rss_mb
+    floor = raycast.scan_s if raycast else None
+    out["ratio_to_raycast"] = {
+        prefix: (stage.scan_s / floor if floor and stage else None)
+        for name, prefix in _THROUGHPUT.items()
+        if name != "raycast"
+        for stage in [stages.get(name)]
+    }
+    out["real_time_factor"] = {
+        prefix: stage.real_time_factor if stage else None
+        for name, prefix in _THROUGHPUT.items()
+        for stage in [stages.get(name)]
+    }
+    return out
+
+
+def check_targets(values: Mapping[str, Any]) -> list[dict[str, Any]]:
+    """Each target with the measured value and whether it was met (None: not measured)."""
+    checked = []
+    for target in TARGETS:
+        value = values.get(target.key)
+        checked.append(
+            {
+                "key": target.key,
+                "label": target.label,
+                "target": target.goal,
+                "value": value,
+                "met": None if value is None else bool(target.met(value)),
+            }
+        )
+    return checked

@@ -1,0 +1,59 @@
+"""The board's end of a paced serial line, in its own process, timing what arrives.
+
+Run as ``python -m harness.bench.line_reader PTY SECONDS``: opens the pty's
+slave, sends an RPLIDAR SCAN request, and reads until the line closes or
+SECONDS pass, recording the monotonic time and size of every read. Prints
+one JSON object: ``{"reads": [[t, n], ...], "data": "<hex>"}``. A separate
+process, as the board's driver is: the harness's threads (and its GIL)
+do not delay the reads it times. Standard library only, so it starts fast.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import select
+import sys
+import time
+
+SCAN_REQUEST = bytes((0xA5, 0x20))
+POLL_S = 0.05
+
+
+def read_line(path: str, seconds: float) -> tuple[list[tuple[float, int]], bytes]:
+    """Read from `path` until it closes or `seconds` pass; (time, size) of each read, the bytes."""
+    fd = os.open(path, os.O_RDWR | os.O_NOCTTY | os.O_NONBLOCK)
+    reads: list[tuple[float, int]] = []
+    data = bytearray()
+    try:
+        os.write(fd, SCAN_REQUEST)
+        deadline = time.monotonic() + seconds
+        while (left := deadline - time.monotonic()) > 0:
+            if not select.select([fd], [], [], min(POLL_S, left))[0]:
+                continue
+            try:
+                chunk = os.read(fd, 65536)
+            except BlockingIOError:
+                continue
+            except OSError:  # EIO: the harness closed its end
+                break
+            if not chunk:
+                break
+            reads.append((time.monotonic(), len(chunk)))
+            data += chunk
+    finally:
+        os.close(fd)
+    return reads, bytes(data)
+
+
+def main(argv: list[str]) -> int:
+    if len(argv) != 2:
+        print("usage: python -m harness.bench.line_reader PTY SECONDS", file=sys.stderr)
+        return 2
+    reads, data = read_line(argv[0], float(argv[1]))
+    json.dump({"reads": reads, "data": data.hex()}, sys.stdout)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))

@@ -1,0 +1,21 @@
+"""Stage 'serial': lockstep through the virtual board, the rplidar link.
+
+The harness plays the FOSSBot's RPLIDAR A1M8 on a pty; the bundled board
+driver (the ``rplidar`` package) reads it and publishes /scan, and the
+reference node answers, each in its own process. Per scan: the revolution
+is encoded and written, the driver's /scan of it is awaited, then the
+node's answers, as in ``fossbot-hil run --link rplidar``.
+"""
+
+from __future__ import annotations
+
+from harness.bench.ros2_lockstep import measure_link
+from harness.bench.stage import StageResult
+from harness.bench.workload import Workload
+
+
+def measure_serial(workload: Workload) -> StageResult:
+    """The rplidar link: a virtual board (emulated A1M8 on a pty, its driver, the node)."""
+    result = measure_link("rplidar", workload)
+    result.name = "serial"
+    return result

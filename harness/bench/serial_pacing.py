@@ -1,0 +1,136 @@
+"""Stage 'pacing': real-time RPLIDAR streaming at 115200 baud over a pty, timed at both ends.
+
+A pty ignores the baud rate, so real-time emulation paces itself
+(``serial_line.pacing``). Here the device server streams a scenario's
+revolutions in realtime mode to a reader in another process (the board's
+end, ``line_reader``), which asks for a scan as a driver does and stamps
+every read. Figures, at the reader (what the board sees):
+
+- byte rate error: bytes per second inside each revolution's back-to-back
+  stretch, over the nominal 115200 / 10 bytes per second, minus 1, in %;
+- period jitter p99: nearest-rank p99 of |start-to-start interval - period|
+  of the revolutions' start nodes, in ms (with under 100 intervals, the
+  maximum).
+
+The pacer's own view (write times) is reported beside them. Revolutions are
+handed over one period ahead of their slot, as a real-time producer should,
+so the figures are the line's, not the producer's.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import subprocess
+import sys
+
+import numpy as np
+
+from harness.bench.stage import StageResult
+from harness.bench.stats import (
+    arrival_rate,
+    jitter_p99_ms,
+    read_times,
+    rplidar_revolution_starts,
+)
+from harness.errors import LinkError
+from harness.runner import RunSettings, fault_profile
+from harness.scenario import Scenario
+
+SCAN_READY_S = 5.0  # the reader process starts and asks for a scan within this
+READER_SLACK_S = 5.0  # beyond the streaming time, for the reader to start and report
+
+
+def _revolutions(scenario: Scenario, count: int, samples_per_rev: int) -> list[list]:
+    """Device samples of the scenario's first `count` ticks (cycled if it is shorter)."""
+    from harness.devices.revolution import samples_from_scan
+    from harness.sim.simulation import Simulation
+
+    spec = scenario.lidar_spec
+    profile = fault_profile(scenario, RunSettings())
+    rng = np.random.default_rng(scenario.seed)
+    revs = []
+    with Simulation(scenario) as sim:
+        for tick in sim.ticks():
+            scan = profile.emit(tick.truth, spec, rng, stamp=tick.t)
+            revs.append(
+                samples_from_scan(scan, samples_per_rev=samples_per_rev, max_range_m=spec.range_max)
+            )
+            if len(revs) == count:
+                break
+    return [revs[k % len(revs)] for k in range(count)]
+
+
+def measure_pacing(scenario: Scenario, seconds: float) -> StageResult:
+    """Stream about `seconds` of revolutions in real time; the line's rate and jitter."""
+    from harness.devices.profiles import PROFILES
+    from harness.serial_line.ports import PtyPort
+    from harness.serial_line.server import DeviceServer
+
+    profile = PROFILES["rplidar"]
+    period = scenario.lidar_spec.scan_time
+    count = max(3, math.ceil(seconds / period))
+    device = profile.make_device(scenario.lidar_spec.rate_hz)
+    revs = _revolutions(scenario, count, profile.samples_per_rev(device, 1.0 / period))
+    port = PtyPort()
+    reader = subprocess.Popen(
+        [sys.executable, "-m", "harness.bench.line_reader", port.slave_path, str(seconds + 3.0)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+    )
+    try:
+        server = DeviceServer(
+            device, port, mode="realtime", baudrate=profile.baudrate, revolution_period_s=period
+        )
+        with server:
+            if not server.wait_until(lambda d: d.mode == "scan", SCAN_READY_S):
+                raise LinkError(f"the line reader did not ask for a scan in {SCAN_READY_S:g} s")
+            for k, rev in enumerate(revs):
+                if k and not server.wait_until(
+                    lambda _, n=k: server.stats().revolutions_sent >= n, 2 * period + 1.0
+                ):
+                    raise LinkError(f"revolution {k - 1} did not start within two periods")
+                server.send_revolution(rev, k)
+            if not server.wait_idle(2 * period + 1.0):
+                raise LinkError("the last revolution did not finish within two periods")
+            stats = server.stats()
+        port.close()  # the reader sees the line close and reports
+        out, err = reader.communicate(timeout=seconds + READER_SLACK_S)
+    finally:
+        port.close()
+        if reader.poll() is None:
+            reader.kill()
+            reader.wait(5.0)
+    if reader.returncode != 0:
+        raise LinkError(f"line reader failed: {err.decode(errors='replace').strip()[-300:]}")
+    seen = json.loads(out)
+    reads = [(float(t), int(n)) for t, n in seen["reads"]]
+    data = bytes.fromhex(seen["data"])
+    starts = rplidar_revolution_starts(data)[: len(revs)]
+    if len(starts) < len(revs):
+        raise LinkError(f"the reader saw {len(starts)} of {len(revs)} revolutions")
+    rev_bytes = len(revs[-1]) * 5
+    segments = [(a, b) for a, b in zip(starts, starts[1:], strict=False)]
+    segments.append((starts[-1], starts[-1] + rev_bytes))
+    rate = arrival_rate(reads, segments)
+    nominal = profile.baudrate / 10.0
+    pacing = stats.pacing
+    assert pacing is not None
+    streamed = len(revs) * period
+    return StageResult(
+        "pacing",
+        len(revs),
+        streamed,
+        streamed,
+        extra={
+            "baudrate": profile.baudrate,
+            "period_ms": period * 1000.0,
+            "revolution_bytes": rev_bytes,
+            "reader_rate_error_pct": (rate / nominal - 1.0) * 100.0 if rate else None,
+            "reader_jitter_p99_ms": jitter_p99_ms(read_times(reads, starts), period),
+            "pacer_rate_error_pct": pacing.mean_rate_error_pct,
+            "pacer_jitter_p99_ms": pacing.period_jitter_p99_ms,
+            "underruns": stats.underruns,
+            "overrun_bytes": stats.overrun_bytes,
+        },
+    )

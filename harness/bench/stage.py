@@ -1,0 +1,98 @@
+"""What one bench stage measured, and the loop that times a link stage.
+
+The link stages time the product's own loop (``runner.judge_frames``) from
+the first scan to the last tick judged, so what they report is what a run
+costs; the link's start-up and the node's stop are timed apart.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Iterator
+from dataclasses import dataclass, field
+
+from harness.bench.workload import Workload, prepared_frames
+from harness.links.base import Link
+from harness.runner import Frame, judge_frames
+from harness.trace import RunResult, TickRecord
+
+
+@dataclass
+class StageResult:
+    """Scans a stage pushed through in `seconds` of wall time, and its own extra figures."""
+
+    name: str
+    scans: int
+    seconds: float
+    simulated_s: float  # simulated time those scans cover (scans x scan time)
+    extra: dict[str, float | int | str | None] = field(default_factory=dict)
+
+    @property
+    def scans_per_s(self) -> float:
+        return self.scans / self.seconds if self.seconds > 0 else float("inf")
+
+    @property
+    def scan_s(self) -> float:
+        """Wall time per scan."""
+        return self.seconds / self.scans
+
+    @property
+    def real_time_factor(self) -> float:
+        """Simulated seconds per wall second."""
+        return self.simulated_s / self.seconds if self.seconds > 0 else float("inf")
+
+
+@dataclass
+class LinkRun:
+    """One link stage's run: the product's result plus when each tick was judged."""
+
+    result: RunResult
+    seconds: float  # first scan sent (after warm-up) to last tick judged
+    judged_at: list[float]
+
+    @property
+    def failed(self) -> int:
+        return len(self.result.failed_ticks)
+
+
+def run_through(link: Link, workload: Workload) -> LinkRun:
+    """Judge the workload's chained frames through an opened `link`, timed.
+
+    The first scan is exchanged once as a warm-up before the clock starts
+    (judge_frames warms up again: one more exchange, inside the timing, as
+    in every run). The clock stops at the last judged tick, before the link
+    reports its diagnostics (which stops a node process).
+    """
+    oracle = workload.oracle()
+    result = RunResult(
+        scenario="+".join(s.name for s in workload.scenarios),
+        link=link.name,
+        seed=0,
+        threshold=workload.threshold,
+        faults="scenarios' own",
+    )
+    judged_at: list[float] = []
+
+    def on_tick(record: TickRecord) -> None:
+        judged_at.append(time.perf_counter())
+
+    with prepared_frames(workload) as frames:
+        first = next(frames)
+        link.warm_up(first.scan)
+
+        def all_frames() -> Iterator[Frame]:
+            yield first
+            yield from frames
+
+        started = time.perf_counter()
+        judge_frames(all_frames(), link, oracle, result, on_tick=on_tick)
+    end = judged_at[-1] if judged_at else time.perf_counter()
+    return LinkRun(result, end - started, judged_at)
+
+
+def simulated_seconds(run: RunResult) -> float:
+    """Simulated time the judged ticks cover (the last tick's time plus one scan)."""
+    if not run.records:
+        return 0.0
+    last = run.records[-1]
+    return last.t + last.scan.scan_time

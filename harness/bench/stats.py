@@ -1,0 +1,131 @@
+"""Pure figures for the bench: percentiles, ratios, overhead, line rates (no I/O).
+
+Kept apart from the stages so the formulas the report quotes are in one
+place and testable in milliseconds.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from itertools import pairwise
+
+__all__ = [
+    "RPLIDAR_NODE_BYTES",
+    "RPLIDAR_SCAN_DESCRIPTOR",
+    "arrival_rate",
+    "jitter_p99_ms",
+    "median",
+    "overhead_ratio",
+    "percentile",
+    "read_times",
+    "rplidar_revolution_starts",
+]
+
+#: The RPLIDAR's reply descriptor to SCAN: 0xA5 0x5A, 5-byte nodes, multiple response, type 0x81.
+RPLIDAR_SCAN_DESCRIPTOR = bytes((0xA5, 0x5A, 0x05, 0x00, 0x00, 0x40, 0x81))
+RPLIDAR_NODE_BYTES = 5
+
+
+def percentile(values: Sequence[float], q: float) -> float:
+    """Nearest-rank percentile, `q` in (0, 100]: a value that occurred, never interpolated.
+
+    With fewer than 100 values the 99th percentile is the maximum.
+    """
+    if not values:
+        raise ValueError("percentile of no values")
+    if not 0 < q <= 100:
+        raise ValueError(f"q must be in (0, 100], got {q}")
+    ordered = sorted(values)
+    return ordered[max(0, math.ceil(q / 100.0 * len(ordered)) - 1)]
+
+
+def median(values: Sequence[float]) -> float:
+    """The middle value (the mean of the two middle ones for an even count)."""
+    if not values:
+        raise ValueError("median of no values")
+    ordered = sorted(values)
+    mid = len(ordered) // 2
+    return ordered[mid] if len(ordered) % 2 else (ordered[mid - 1] + ordered[mid]) / 2.0
+
+
+def overhead_ratio(scan_s: float, raycast_s: float, round_trip_s: float) -> float:
+    """Harness time per scan beyond ray casting and one DDS round trip, as a fraction of them.
+
+    ``(scan_s - raycast_s - round_trip_s) / (raycast_s + round_trip_s)``, where
+    `scan_s` is the wall time of one lockstep scan, `raycast_s` the ray casting
+    of that scan alone and `round_trip_s` the median publish-to-answer time.
+    0 means the harness adds nothing to the two costs it cannot avoid.
+    """
+    floor = raycast_s + round_trip_s
+    if floor <= 0:
+        raise ValueError("ray casting plus round trip must take some time")
+    return (scan_s - floor) / floor
+
+
+def jitter_p99_ms(starts_s: Sequence[float], period_s: float) -> float | None:
+    """p99 of |start-to-start interval - period|, in ms (None for fewer than two starts)."""
+    intervals = [b - a for a, b in pairwise(starts_s)]
+    if not intervals:
+        return None
+    return percentile([abs(i - period_s) * 1000.0 for i in intervals], 99)
+
+
+def rplidar_revolution_starts(data: bytes) -> list[int]:
+    """Byte offsets of the revolution-start nodes in an RPLIDAR standard scan stream.
+
+    `data` begins with the SCAN reply descriptor; then come 5-byte nodes whose
+    first byte holds the start flag S (bit 0) and its inverse (bit 1).
+    """
+    head = RPLIDAR_SCAN_DESCRIPTOR
+    if not data.startswith(head):
+        raise ValueError("the stream does not start with the RPLIDAR scan descriptor")
+    starts = []
+    for offset in range(len(head), len(data) - RPLIDAR_NODE_BYTES + 1, RPLIDAR_NODE_BYTES):
+        if data[offset] & 0b11 == 0b01:
+            starts.append(offset)
+    return starts
+
+
+def read_times(reads: Sequence[tuple[float, int]], offsets: Sequence[int]) -> list[float]:
+    """When the reader had each byte offset: the time of the read that brought it."""
+    times = []
+    ends = []
+    total = 0
+    for t, n in reads:
+        total += n
+        ends.append((total, t))
+    k = 0
+    for offset in offsets:
+        while k < len(ends) and ends[k][0] <= offset:
+            k += 1
+        if k == len(ends):
+            break
+        times.append(ends[k][1])
+    return times
+
+
+def arrival_rate(
+    reads: Sequence[tuple[float, int]], segments: Sequence[tuple[int, int]]
+) -> float | None:
+    """Bytes per second inside busy stretches, as the reader saw them arrive.
+
+    `reads` are (time, bytes) of each read in order; `segments` are byte
+    ranges [start, end) sent back to back (one revolution each). For each,
+    the bytes that came between the first and the last read ending inside it
+    over the time between those reads; idle gaps between stretches never
+    count. None if no stretch had two reads.
+    """
+    ends = []
+    total = 0
+    for t, n in reads:
+        total += n
+        ends.append((t, total))
+    got_bytes = got_time = 0.0
+    for lo, hi in segments:
+        inside = [(t, e) for t, e in ends if lo < e < hi]
+        if len(inside) >= 2:
+            (t1, e1), (t2, e2) = inside[0], inside[-1]
+            got_bytes += e2 - e1
+            got_time += t2 - t1
+    return got_bytes / got_time if got_time > 0 else None

@@ -1,0 +1,43 @@
+"""Stage 'synthesis': simulation plus fault models, the emitted scans and nothing else.
+
+The runner's frame stream without a link: each tick moves the robot, casts
+the rays and applies the scenario's fault profile. A second pass applies
+the ``harsh`` profile (noise, dropouts, ghosts, NaN driver: every random
+draw) to the same scenarios, to show the most the fault stage can cost.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import replace
+
+from harness.bench.stage import StageResult
+from harness.bench.workload import Workload, prepared_frames
+
+HARSH = ("harsh",)
+
+
+def _timed_frames(workload: Workload) -> tuple[int, float, float]:
+    """(scans, wall seconds, simulated seconds) of consuming the frame stream."""
+    scans, last_t, scan_time = 0, 0.0, 0.0
+    with prepared_frames(workload) as frames:
+        started = time.perf_counter()
+        for frame in frames:
+            scans += 1
+            last_t, scan_time = frame.t, frame.scan.scan_time
+        seconds = time.perf_counter() - started
+    return scans, seconds, last_t + scan_time
+
+
+def measure_synthesis(workload: Workload) -> StageResult:
+    """Scans per second of simulation + faults (scenarios' own profiles; harsh as an extra)."""
+    scans, seconds, simulated = _timed_frames(workload)
+    harsh = replace(workload, settings=replace(workload.settings, faults=HARSH))
+    harsh_scans, harsh_seconds, _ = _timed_frames(harsh)
+    return StageResult(
+        "synthesis",
+        scans,
+        seconds,
+        simulated,
+        extra={"harsh_scans_per_s": harsh_scans / harsh_seconds},
+    )

@@ -1,0 +1,105 @@
+"""The scans every bench stage measures: the lab's three scenarios, repeated.
+
+Each stage runs the same scenarios with the same seeds, so its scans per
+second compare with the ray-casting floor scan for scan. The simulations
+are built before a stage's clock starts (a world is built once per run,
+not per scan) and chained into one stream of frames with ticks and times
+running on, so one link and one node serve the whole stream.
+"""
+
+from __future__ import annotations
+
+import contextlib
+from collections.abc import Iterator, Sequence
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from harness.errors import ConfigError
+from harness.faults import FaultProfile
+from harness.oracle import Oracle
+from harness.runner import Frame, RunSettings, effective_threshold, fault_profile
+from harness.scenario import Scenario, resolve_scenario
+
+if TYPE_CHECKING:
+    from harness.sim.simulation import Simulation
+
+LAB_TRIO = ("approach_wall", "drive_past_10m", "out_of_range")
+
+
+@dataclass(frozen=True)
+class Workload:
+    """Scenarios run in turn, `repeats` times over, with one settings override."""
+
+    scenarios: tuple[Scenario, ...]
+    repeats: int = 1
+    settings: RunSettings = RunSettings()
+
+    @property
+    def threshold(self) -> float:
+        """The one threshold the node is started with (every scenario must share it)."""
+        values = {effective_threshold(s, self.settings) for s in self.scenarios}
+        if len(values) != 1:
+            raise ConfigError(f"bench scenarios need one threshold, got {sorted(values)}")
+        return values.pop()
+
+    @property
+    def scan_rate_hz(self) -> float:
+        """The LIDAR rate the device emulators are built for (every scenario must share it)."""
+        rates = {s.lidar_spec.rate_hz for s in self.scenarios}
+        if len(rates) != 1:
+            raise ConfigError(f"bench scenarios need one LIDAR rate, got {sorted(rates)}")
+        return rates.pop()
+
+    def runs(self) -> list[Scenario]:
+        """Every scenario run, in order."""
+        return [s for _ in range(self.repeats) for s in self.scenarios]
+
+    def profiles(self) -> list[FaultProfile]:
+        return [fault_profile(s, self.settings) for s in self.runs()]
+
+    def oracle(self) -> Oracle:
+        """One oracle for the chained stream (same threshold and noise for every run)."""
+        sigmas = {p.noise_sigma for p in self.profiles()}
+        if len(sigmas) != 1:
+            raise ConfigError(f"bench scenarios need one noise sigma, got {sorted(sigmas)}")
+        return Oracle(
+            self.threshold, noise_sigma=sigmas.pop(), status_pattern=self.settings.status_pattern
+        )
+
+
+def lab_workload(repeats: int = 1, names: Sequence[str] = LAB_TRIO) -> Workload:
+    """The lab's scenarios (approach a wall, drive past 10 m, out of range)."""
+    return Workload(tuple(resolve_scenario(n) for n in names), repeats)
+
+
+@contextlib.contextmanager
+def prepared_frames(workload: Workload) -> Iterator[Iterator[Frame]]:
+    """Build every simulation now; yield the lazy, chained frame stream; close them all.
+
+    Ticks and times run on across runs (run 2's tick 0 follows run 1's last
+    tick one scan time later), so answers never look older than the scan.
+    """
+    from harness.sim.simulation import Simulation  # imports pybullet
+
+    with contextlib.ExitStack() as stack:
+        runs = []
+        for scenario, profile in zip(workload.runs(), workload.profiles(), strict=True):
+            sim = stack.enter_context(Simulation(scenario))
+            seed = workload.settings.seed if workload.settings.seed is not None else scenario.seed
+            runs.append((sim, profile, np.random.default_rng(seed)))
+        yield _chained(runs)
+
+
+def _chained(runs: list[tuple[Simulation, FaultProfile, np.random.Generator]]) -> Iterator[Frame]:
+    tick0, t0 = 0, 0.0
+    for sim, profile, rng in runs:
+        tick = None
+        for tick in sim.ticks():
+            t = t0 + tick.t
+            scan = profile.emit(tick.truth, sim.spec, rng, stamp=t)
+            yield Frame(tick0 + tick.tick, t, tick.x, tick.y, tick.yaw, scan)
+        if tick is not None:
+            tick0 += tick.tick + 1
+            t0 += tick.t + sim.spec.scan_time
