@@ -1,0 +1,69 @@
+"""`fossbot-hil bench`: every figure is there and numeric; speed is measured, never asserted."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import pytest
+from command_line import fossbot_hil
+
+from harness.bench.figures import REQUIRED_KEYS
+
+
+def _number(value: object) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+
+
+@pytest.mark.ros
+@pytest.mark.slow
+@pytest.mark.timeout(120)
+def test_quick_json_has_every_figure_and_the_machine() -> None:
+    done = fossbot_hil("bench", "--quick", "--json", timeout=110)
+    assert done.returncode == 0, done.stderr
+    report = json.loads(done.stdout)  # one JSON object and nothing else on stdout
+    missing = [k for k in REQUIRED_KEYS if not _number(report.get(k))]
+    assert not missing, f"not numeric: {missing}; errors: {report['errors']}"
+    machine = report["machine"]
+    assert machine["cores"] >= 1 and machine["cpu"] and machine["python"] and machine["os"]
+    assert {t["key"] for t in report["targets"]} >= {
+        "ros2_lockstep_scans_per_s",
+        "overhead_ratio",
+        "lab_suite_wall_s",
+        "serial_rate_error_pct",
+        "serial_jitter_p99_ms",
+    }
+    assert all(isinstance(t["met"], bool) for t in report["targets"] if t["value"] is not None)
+    assert report["stages"]["ros2"]["failed_ticks"] == 0
+
+
+def test_only_the_stages_without_ros() -> None:
+    """Stages left out give null figures; the run still exits 0."""
+    done = fossbot_hil("bench", "--quick", "--json", "--only", "raycast,inprocess", timeout=60)
+    assert done.returncode == 0, done.stderr
+    report = json.loads(done.stdout)
+    assert _number(report["raycast_scans_per_s"]) and _number(report["inprocess_scans_per_s"])
+    assert report["ros2_lockstep_scans_per_s"] is None and report["overhead_ratio"] is None
+    assert set(report["stages"]) == {"raycast", "inprocess"}
+    assert report["ratio_to_raycast"]["inprocess"] > 0
+
+
+def test_table_without_json() -> None:
+    done = fossbot_hil("bench", "--quick", "--only", "raycast", timeout=60)
+    assert done.returncode == 0, done.stderr
+    assert "ray casting alone" in done.stdout and "targets met" in done.stdout
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["--only", "nope"], "--only 'nope': unknown stage nope"),
+        (["--only", ","], "unknown stage (none given)"),
+        (["--repeat", "3"], "unrecognized arguments: --repeat"),
+    ],
+)
+def test_bad_options_are_one_line_and_exit_2(args: list[str], message: str) -> None:
+    done = fossbot_hil("bench", *args, timeout=60)
+    assert done.returncode == 2
+    assert done.stdout == ""
+    assert done.stderr.count("\n") == 1 and message in done.stderr
