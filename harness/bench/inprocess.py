@@ -26,5 +26,9 @@ def measure_inprocess(workload: Workload) -> StageResult:
         len(run.result.records),
         run.seconds,
         simulated_seconds(run.result),
-        extra={"failed_ticks": run.failed, "error": run.result.error},
+        extra={
+            "cpu_ms_per_scan": run.cpu_s * 1000.0 / max(1, len(run.result.records)),
+            "failed_ticks": run.failed,
+            "error": run.result.error,
+        },
     )

@@ -10,12 +10,13 @@ not time out.
 
 from __future__ import annotations
 
+import os
 import time
 
 from harness.bench.stage import LinkRun, StageResult, run_through, simulated_seconds
 from harness.bench.stats import median, percentile
 from harness.bench.workload import Workload
-from harness.links.base import LinkOptions, create_link
+from harness.links.base import Link, LinkOptions, create_link
 
 
 def round_trips_s(run: LinkRun) -> list[float]:
@@ -32,6 +33,24 @@ def waits_s(run: LinkRun) -> list[float]:
     return [r.answers.waited for r in run.result.records if not r.answers.timed_out]
 
 
+def process_cpu_s(pid: int | None) -> float | None:
+    """CPU seconds (user + system) a live process has used so far, from /proc (Linux only)."""
+    if pid is None:
+        return None
+    try:
+        with open(f"/proc/{pid}/stat", "rb") as stat:
+            fields = stat.read().rsplit(b")", 1)[1].split()
+    except OSError:
+        return None
+    ticks = os.sysconf("SC_CLK_TCK")
+    return (int(fields[11]) + int(fields[12])) / ticks  # utime, stime: fields 14 and 15
+
+
+def _node_pids(link: Link) -> list[int | None]:
+    """The node under test and, for a board link, its LIDAR driver."""
+    return [getattr(getattr(link, attr, None), "pid", None) for attr in ("process", "driver")]
+
+
 def measure_link(link_name: str, workload: Workload) -> StageResult:
     """Open `link_name` with the reference node, run the workload through it, close it."""
     options = LinkOptions(threshold=workload.threshold, scan_rate_hz=workload.scan_rate_hz)
@@ -40,21 +59,34 @@ def measure_link(link_name: str, workload: Workload) -> StageResult:
         started = time.perf_counter()
         link.open()
         opened_s = time.perf_counter() - started
-        run = run_through(link, workload)
+        pids = _node_pids(link)
+        before = [process_cpu_s(pid) for pid in pids]
+        after: list[float | None] = []
+        run = run_through(
+            link, workload, at_end=lambda: after.extend(process_cpu_s(pid) for pid in pids)
+        )
         startup_s = getattr(link, "startup_s", opened_s)
     finally:
         started = time.perf_counter()
         link.close()
         closed_s = time.perf_counter() - started
+    scans = len(run.result.records)
+    node_cpu = [
+        (b - a) * 1000.0 / scans if a is not None and b is not None and scans else None
+        for a, b in zip(before, after or [None] * len(before), strict=True)
+    ]
     trips = [t * 1000.0 for t in round_trips_s(run)]
     waits = [w * 1000.0 for w in waits_s(run)]
     return StageResult(
         link_name,
-        len(run.result.records),
+        scans,
         run.seconds,
         simulated_seconds(run.result),
         extra={
             "startup_s": startup_s,
+            "cpu_ms_per_scan": run.cpu_s * 1000.0 / scans if scans else None,
+            "node_cpu_ms_per_scan": node_cpu[0],
+            "driver_cpu_ms_per_scan": node_cpu[1],
             "open_s": opened_s,
             "close_s": closed_s,
             "round_trip_ms_median": median(trips) if trips else None,

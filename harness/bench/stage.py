@@ -8,7 +8,7 @@ costs; the link's start-up and the node's stop are timed apart.
 from __future__ import annotations
 
 import time
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 
 from harness.bench.workload import Workload, prepared_frames
@@ -49,19 +49,25 @@ class LinkRun:
     result: RunResult
     seconds: float  # first scan sent (after warm-up) to last tick judged
     judged_at: list[float]
+    cpu_s: float = 0.0  # CPU time of this process (all its threads) over the same stretch
 
     @property
     def failed(self) -> int:
         return len(self.result.failed_ticks)
 
 
-def run_through(link: Link, workload: Workload) -> LinkRun:
+def run_through(
+    link: Link, workload: Workload, *, at_end: Callable[[], None] | None = None
+) -> LinkRun:
     """Judge the workload's chained frames through an opened `link`, timed.
 
     The first scan is exchanged once as a warm-up before the clock starts
     (judge_frames warms up again: one more exchange, inside the timing, as
     in every run). The clock stops at the last judged tick, before the link
-    reports its diagnostics (which stops a node process).
+    reports its diagnostics (which stops a node process); `at_end` is
+    called then, e.g. to read the node's CPU time while it still runs. CPU
+    time is taken over the same stretch: on a shared machine it moves less
+    than wall time.
     """
     oracle = workload.oracle()
     result = RunResult(
@@ -72,9 +78,15 @@ def run_through(link: Link, workload: Workload) -> LinkRun:
         faults="scenarios' own",
     )
     judged_at: list[float] = []
+    cpu_at = [0.0]
+    exhausted = [False]
 
     def on_tick(record: TickRecord) -> None:
         judged_at.append(time.perf_counter())
+        cpu_at[0] = time.process_time()
+        if exhausted[0] and at_end is not None:  # the last tick: the frames ran out before it
+            exhausted[0] = False
+            at_end()
 
     with prepared_frames(workload) as frames:
         first = next(frames)
@@ -83,11 +95,13 @@ def run_through(link: Link, workload: Workload) -> LinkRun:
         def all_frames() -> Iterator[Frame]:
             yield first
             yield from frames
+            exhausted[0] = True
 
+        cpu_started = time.process_time()
         started = time.perf_counter()
         judge_frames(all_frames(), link, oracle, result, on_tick=on_tick)
     end = judged_at[-1] if judged_at else time.perf_counter()
-    return LinkRun(result, end - started, judged_at)
+    return LinkRun(result, end - started, judged_at, max(0.0, cpu_at[0] - cpu_started))
 
 
 def simulated_seconds(run: RunResult) -> float:
