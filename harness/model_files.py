@@ -40,6 +40,7 @@ __all__ = [
     "MAX_MODEL_BYTES",
     "MESH_SUFFIXES",
     "ModelFile",
+    "ModelParts",
     "check_model_file",
     "find_model_file",
     "robot_models_dir",
@@ -57,6 +58,14 @@ SDF_SHAPES = ("box", "cylinder", "sphere", "capsule", "mesh", "plane")
 def robot_models_dir() -> Path:
     """Folder of the shipped robot and world models (``robot_models/``)."""
     return Path(str(resources.files("harness.robot_models")))
+
+
+@dataclass(frozen=True)
+class ModelParts:
+    """What a checked URDF holds, for checks that name its parts (empty for SDF)."""
+
+    links: tuple[str, ...] = ()
+    joints: tuple[tuple[str, str], ...] = ()  # (name, type)
 
 
 @dataclass(frozen=True)
@@ -234,6 +243,8 @@ def _unique_names(elements: Iterable[ET.Element], kind: str, what: str) -> list[
         name = element.get("name", "")
         if not name.strip():
             raise ConfigError(f"{what}: a <{kind}> without a name")
+        if not name.isprintable():
+            raise ConfigError(f"{what}: a <{kind}> name with control characters: {name[:40]!r}")
         if name in names:
             raise ConfigError(f"{what}: two {kind}s named {name!r}")
         names.append(name)
@@ -342,7 +353,7 @@ def _urdf_geometry(holder: ET.Element, what: str) -> str | None:
     return None
 
 
-def _check_urdf(root: ET.Element, model: ModelFile, what: str) -> None:
+def _check_urdf(root: ET.Element, model: ModelFile, what: str) -> ModelParts:
     if root.tag != "robot":
         raise ConfigError(f"{what}: not a URDF: the root element is <{root.tag}>, not <robot>")
     links = root.findall("link")
@@ -392,6 +403,8 @@ def _check_urdf(root: ET.Element, model: ModelFile, what: str) -> None:
     _check_tree(names, tree, what)
     for filename, where in meshes:
         _check_mesh(filename, model, ("package://",), where)
+    kinds = [joint.get("type", "") for joint in joints]
+    return ModelParts(tuple(names), tuple(zip(joint_names, kinds, strict=True)))
 
 
 # -- SDF -------------------------------------------------------------------
@@ -486,14 +499,15 @@ def _check_sdf(root: ET.Element, model: ModelFile, what: str) -> None:
         _check_mesh(uri, model, ("model://", "package://"), where)
 
 
-def check_model_file(model: ModelFile, *, what: str = "") -> None:
+def check_model_file(model: ModelFile, *, what: str = "") -> ModelParts:
     """Refuse a URDF/SDF file PyBullet would choke, crash or print garbage on.
 
-    `what` prefixes the messages (e.g. ``cannot load 'table.urdf'``).
+    `what` prefixes the messages (e.g. ``cannot load 'table.urdf'``). A
+    URDF's link and joint names come back, for checks that name them.
     """
     label = what or str(model.path)
     root = _parse_xml(model.path, label)
     if model.path.suffix == ".sdf":
         _check_sdf(root, model, label)
-    else:
-        _check_urdf(root, model, label)
+        return ModelParts()
+    return _check_urdf(root, model, label)

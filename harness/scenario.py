@@ -34,6 +34,7 @@ from pydantic import (
 from harness.errors import ConfigError
 from harness.faults import build_profile
 from harness.lidar_spec import PRESETS, LidarSpec, preset
+from harness.messages import shown
 from harness.model_files import check_model_file, find_model_file, robot_models_dir
 from harness.sim.geometry import cylinder_segments
 
@@ -56,6 +57,7 @@ MAX_COORDINATE = 1000.0  # m, |x| and |y| of anything placed in the world
 MIN_SIZE, MAX_SIZE = 0.001, 100.0  # m, sizes of walls, boxes and cylinders
 MAX_RANGE = 100.0  # m, LIDAR range_max, the threshold and obstacle conditions
 MAX_PATH = 1024  # characters of a model path
+WHEEL_JOINTS = ("left_wheel_joint", "right_wheel_joint")  # what wheels mode drives
 
 
 class _Strict(BaseModel):
@@ -305,7 +307,8 @@ def _field_path(loc: Sequence[Any]) -> str:
         elif part in _UNION_TAGS or str(part).startswith("function-"):
             continue  # union branch tags add nothing for the reader
         else:
-            out += f".{part}" if out else str(part)
+            text = shown(str(part), 40) if str(part).isprintable() else repr(str(part))[:40]
+            out += f".{text}" if out else text
     return out or "(top level)"
 
 
@@ -316,7 +319,7 @@ def _first_error(err: ValidationError) -> str:
         msg = "unknown key"
     elif first["type"] == "missing":
         msg = "required field is missing"
-    return f"{_field_path(first['loc'])}: {msg}"
+    return f"{_field_path(first['loc'])}: {shown(msg, 300)}"
 
 
 def _check_run_length(scenario: Scenario) -> None:
@@ -355,27 +358,28 @@ def parse_scenario(data: Any, *, source: str = "<scenario>") -> Scenario:
     it names are checked by ``check_model_files`` (``load_scenario_file``
     does both).
     """
+    where = shown(source)
     if not isinstance(data, dict):
         got = {type(None): "nothing (an empty file?)", list: "a list", str: "text"}.get(
             type(data), type(data).__name__
         )
-        raise ConfigError(f"{source}: a scenario must be a mapping of fields, got {got}")
+        raise ConfigError(f"{where}: a scenario must be a mapping of fields, got {got}")
     if "source" in data:  # the harness's own field: where the file is, never the file's say
-        raise ConfigError(f"{source}: source: unknown key")
+        raise ConfigError(f"{where}: source: unknown key")
     try:
         scenario = Scenario.model_validate({**data, "source": source})
         scenario.lidar.spec()
     except ValidationError as err:
-        raise ConfigError(f"{source}: {_first_error(err)}") from None
+        raise ConfigError(f"{where}: {_first_error(err)}") from None
     except ConfigError as err:
-        raise ConfigError(f"{source}: lidar: {err}") from None
+        raise ConfigError(f"{where}: lidar: {err}") from None
     except RecursionError:
-        raise ConfigError(f"{source}: nested too deeply (or refers to itself)") from None
+        raise ConfigError(f"{where}: nested too deeply (or refers to itself)") from None
     try:
         build_profile(scenario.faults)
         _check_run_length(scenario)
     except ConfigError as err:
-        raise ConfigError(f"{source}: {err}") from None
+        raise ConfigError(f"{where}: {err}") from None
     if not scenario.name:
         scenario = scenario.model_copy(update={"name": Path(source).stem[:100]})
     return scenario
@@ -387,7 +391,7 @@ def check_reachable(scenario: Scenario) -> None:
     The simulation refuses these too, but only once the link (and so the
     node under test) is up; a file loaded from disk is refused before.
     """
-    where = scenario.source or "<scenario>"
+    where = shown(scenario.source or "<scenario>")
     for index, segment in enumerate(scenario.motion.segments):
         until = segment.until
         for name, value, unit, speed, what, speed_unit in (
@@ -410,15 +414,33 @@ def check_model_files(scenario: Scenario) -> None:
     or board is started.
     """
     folders = [scenario.base_dir, robot_models_dir()]
-    where = scenario.source or "<scenario>"
+    where = shown(scenario.source or "<scenario>")
     refs = [("robot.urdf", scenario.robot.urdf)] + [
         (f"obstacles[{i}].path", o.path)
         for i, o in enumerate(scenario.obstacles)
         if isinstance(o, Model)
     ]
+    robot = None
     for field, ref in refs:
         what = f"{where}: {field}: cannot load {ref!r}"
-        check_model_file(find_model_file(ref, folders, what=what), what=what)
+        parts = check_model_file(find_model_file(ref, folders, what=what), what=what)
+        robot = parts if robot is None else robot
+    assert robot is not None
+    urdf = scenario.robot.urdf
+    if scenario.robot.lidar_link not in robot.links:
+        raise ConfigError(
+            f"{where}: robot.lidar_link: no link named {scenario.robot.lidar_link!r} in "
+            f"{urdf!r} (links: {', '.join(robot.links)})"
+        )
+    if scenario.motion.mode == "wheels":
+        joints = dict(robot.joints)
+        for name in WHEEL_JOINTS:
+            if joints.get(name) not in ("revolute", "continuous"):
+                kind = f"a {joints[name]} joint" if name in joints else "no such joint"
+                raise ConfigError(
+                    f"{where}: motion.mode: wheels mode needs a revolute joint {name!r} in "
+                    f"{urdf!r} ({kind}; joints: {', '.join(joints) or 'none'})"
+                )
 
 
 # -- reading YAML, bounded ----------------------------------------------------
@@ -563,52 +585,53 @@ def _yaml_problem(err: yaml.YAMLError) -> str:
 
 def _read_text(path: Path) -> str:
     """The file's text: a regular file, at most MAX_FILE_BYTES, UTF-8; never blocks on a FIFO."""
-    shown = str(path) if len(str(path)) <= 200 else f"{str(path)[:100]}...{str(path)[-50:]}"
+    name = shown(str(path))
     try:
         mode = os.stat(path).st_mode
     except FileNotFoundError:
-        raise ConfigError(f"{shown}: no such scenario file") from None
+        raise ConfigError(f"{name}: no such scenario file") from None
     except (OSError, ValueError) as err:
         reason = getattr(err, "strerror", None) or err
-        raise ConfigError(f"{shown}: cannot read: {reason}") from None
+        raise ConfigError(f"{name}: cannot read: {reason}") from None
     if stat.S_ISDIR(mode):
-        raise ConfigError(f"{path}: is a folder, not a scenario file")
+        raise ConfigError(f"{name}: is a folder, not a scenario file")
     if not stat.S_ISREG(mode):
-        raise ConfigError(f"{path}: not a regular file")
+        raise ConfigError(f"{name}: not a regular file")
     try:
         fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | os.O_NOCTTY)
         try:
             if not stat.S_ISREG(os.fstat(fd).st_mode):  # replaced since the stat above
-                raise ConfigError(f"{path}: not a regular file")
+                raise ConfigError(f"{name}: not a regular file")
             with os.fdopen(os.dup(fd), "rb") as handle:
                 data = handle.read(MAX_FILE_BYTES + 1)
         finally:
             os.close(fd)
     except OSError as err:
-        raise ConfigError(f"{path}: cannot read: {err.strerror or err}") from None
+        raise ConfigError(f"{name}: cannot read: {err.strerror or err}") from None
     if len(data) > MAX_FILE_BYTES:
-        raise ConfigError(f"{path}: larger than {MAX_FILE_BYTES >> 20} MiB; not a scenario file")
+        raise ConfigError(f"{name}: larger than {MAX_FILE_BYTES >> 20} MiB; not a scenario file")
     try:
         return data.decode("utf-8")
     except UnicodeDecodeError as err:
         line = data[: err.start].count(b"\n") + 1
         raise ConfigError(
-            f"{path}: not UTF-8 text (byte 0x{data[err.start]:02x} at line {line})"
+            f"{name}: not UTF-8 text (byte 0x{data[err.start]:02x} at line {line})"
         ) from None
 
 
 def load_scenario_file(path: str | Path) -> Scenario:
     """Read and validate one scenario file, and the model files it names."""
     path = Path(path)
+    name = shown(str(path))
     text = _read_text(path)
     try:
         data = load_yaml(text)
     except yaml.YAMLError as err:
-        raise ConfigError(f"{path}: {_yaml_problem(err)}") from None
+        raise ConfigError(f"{name}: {_yaml_problem(err)}") from None
     except RecursionError:
-        raise ConfigError(f"{path}: YAML error: nested too deeply") from None
+        raise ConfigError(f"{name}: YAML error: nested too deeply") from None
     except ValueError as err:  # e.g. an integer with more digits than Python converts
-        raise ConfigError(f"{path}: YAML error: {' '.join(str(err).split())[:200]}") from None
+        raise ConfigError(f"{name}: YAML error: {' '.join(str(err).split())[:200]}") from None
     scenario = parse_scenario(data, source=str(path))
     check_reachable(scenario)
     check_model_files(scenario)

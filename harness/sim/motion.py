@@ -24,12 +24,12 @@ import numpy as np
 
 from harness.errors import ConfigError
 from harness.lidar_spec import LidarSpec
-from harness.scenario import Motion, Segment
+from harness.messages import shown
+from harness.scenario import WHEEL_JOINTS, Motion, Segment
 
 EPS_TIME = 1e-9  # s; segment ends closer than this to a step boundary fall on it
 AHEAD_HALF_WIDTH = math.radians(10.0)  # obstacle_ahead_* look within +-10 deg of +x
 WHEEL_MAX_TORQUE = 0.5  # N m per wheel motor in wheels mode
-WHEEL_JOINTS = ("left_wheel_joint", "right_wheel_joint")
 SETTLE_STEPS = 24  # physics steps (0.1 s) the robot rests on its wheels before t = 0
 
 
@@ -139,7 +139,7 @@ class MotionScript:
 
     def __init__(self, motion: Motion, *, source: str = "") -> None:
         self.segments = list(motion.segments)
-        self.where = source or "<scenario>"
+        self.where = shown(source or "<scenario>")
         self.index = 0
         self.elapsed = 0.0  # s spent in the current segment
         self.t = 0.0  # s since the script started

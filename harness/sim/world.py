@@ -24,6 +24,7 @@ from types import TracebackType
 import numpy as np
 
 from harness.errors import ConfigError
+from harness.messages import shown
 from harness.model_files import check_model_file, find_model_file, robot_models_dir
 from harness.scenario import Box, Cylinder, Model, Scenario, Wall
 from harness.sim import bullet
@@ -60,7 +61,7 @@ class World:
 
     def __init__(self, scenario: Scenario, *, gui: bool = False) -> None:
         self.scenario = scenario
-        self.where = scenario.source or "<scenario>"
+        self.where = shown(scenario.source or "<scenario>")
         if gui and sys.platform.startswith("linux") and not os.environ.get("DISPLAY"):
             raise ConfigError("--gui needs a display")
         self.client: int = bullet.connect(gui)

@@ -132,6 +132,7 @@ def assert_refused(outcome: Outcome, phrase: str) -> str:
     lines = outcome.stderr.splitlines()
     assert len(lines) == 1 and outcome.stderr.endswith("\n"), outcome.stderr[-2000:]
     assert lines[0].startswith("fossbot-hil: error: "), lines[0]
+    assert lines[0].isprintable(), repr(lines[0])  # no escape sequences, no stray controls
     assert phrase in lines[0], (phrase, lines[0])
     assert outcome.stdout == "", outcome.stdout[-2000:]
     return lines[0]

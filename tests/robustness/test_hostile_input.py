@@ -249,7 +249,22 @@ SCENARIO_FILES: list[tuple[str, str | bytes, str]] = [
     ),
     ("tab_indent", "description: x\n\tmotion: 1\n", "YAML error at line 2"),
     ("blank_description", scenario_with("description: '   '\n"), "description: must not be blank"),
+    (
+        "no_such_lidar_link",
+        scenario_with("robot: {lidar_link: laser}\n"),
+        "robot.lidar_link: no link named 'laser' in 'fossbot_v2.urdf' (links: base_footprint",
+    ),
     ("name_with_newline", scenario_with('name: "a\\nb"\n'), "name: must be printable text"),
+    (
+        "escapes_in_a_key",
+        BASE + '"a\\nb\\e[31m": 1\n',
+        "'a\\nb\\x1b[31m': unknown key",
+    ),
+    (
+        "escapes_in_a_type",
+        scenario_with('obstacles: [{type: "a\\nb\\e[31m"}]\n'),
+        "obstacles[0]: Input tag 'a\\nb\\x1b[31m' found",
+    ),
 ]
 
 
@@ -288,6 +303,17 @@ def test_a_folder_instead_of_a_file(
         ["run", "folder.yaml", "--link", "inprocess"], tmp_path, capfd, monkeypatch
     )
     assert_refused(outcome, "folder.yaml: is a folder, not a scenario file")
+
+
+def test_file_name_with_a_newline_and_an_escape(
+    tmp_path: Path, capfd: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A file name cannot break the one-line message or recolour the terminal."""
+    (tmp_path / "new\nline\x1b[31m.yaml").write_text(scenario_with("sped: 1\n"))
+    outcome = run_in_process(
+        ["run", "new\nline\x1b[31m.yaml", "--link", "inprocess"], tmp_path, capfd, monkeypatch
+    )
+    assert_refused(outcome, "new\\nline\\x1b[31m.yaml: sped: unknown key")
 
 
 def test_missing_file_and_too_long_name(
@@ -473,6 +499,14 @@ MODELS: list[tuple[str, str, str | bytes, dict[str, str | bytes], str, bool]] = 
         False,
     ),
     ("duplicate_links", "r.urdf", robot(link("a") + link("a")), {}, "two links named 'a'", False),
+    (
+        "link_name_with_newline",
+        "r.urdf",
+        robot(link("a&#10;b")),
+        {},
+        "a <link> name with control characters: 'a\\nb'",
+        False,
+    ),
     ("two_root_links", "r.urdf", robot(link("a") + link("b")), {}, "2 root links ('a', 'b')", True),
     (
         "joint_loop",
@@ -905,6 +939,19 @@ def test_emulate_with_bad_faults_prints_nothing(workdir: Path) -> None:
         ["emulate", "ldlidar", "--scenario", "s.yaml", "--faults", "bogus"], workdir
     )
     assert outcome.stdout == ""
+
+
+def test_wheels_mode_needs_wheel_joints(
+    tmp_path: Path, capfd: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Wheels mode with a robot that has no wheel joints is refused when the file loads."""
+    (tmp_path / "r.urdf").write_text(robot(link("a")))
+    text = scenario_with("robot: {urdf: r.urdf, lidar_link: a}\n").replace(
+        "motion:\n", "motion:\n  mode: wheels\n"
+    )
+    (tmp_path / "s.yaml").write_text(text)
+    outcome = run_in_process(["run", "s.yaml", "--link", "inprocess"], tmp_path, capfd, monkeypatch)
+    assert_refused(outcome, "motion.mode: wheels mode needs a revolute joint 'left_wheel_joint'")
 
 
 def test_scenario_checks_come_before_the_node(workdir: Path) -> None:
