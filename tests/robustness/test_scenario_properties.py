@@ -1,0 +1,383 @@
+"""Generated scenario files: the harness runs each one or refuses it in one line, nothing else.
+
+Hypothesis builds scenarios that are valid or nearly so (every field, fault
+profiles and inline faults from harness/faults.py), then mutates some of
+them: wrong types, missing and extra keys, extreme numbers, random text,
+and corrupted YAML text. Each is written to a file and loaded; a scenario
+the loader accepts is then really simulated and judged over the inprocess
+link. The only exception allowed anywhere is ConfigError, whose message is
+one line naming the file. A smaller sample runs through the real
+`fossbot-hil run` command to prove the exit codes.
+
+Deterministic (derandomized, no example database) so CI sees the same
+files every time; each example is short (valid runs are at most a few
+simulated seconds and a few hundred thousand beams).
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+import subprocess
+import sys
+from collections import Counter
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import pytest
+import yaml
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from harness.errors import ConfigError
+from harness.faults import CONVENTIONS, DROPOUT_VALUES, NAMED_PROFILES
+from harness.lidar_spec import PRESETS
+from harness.links.base import LinkOptions
+from harness.runner import run
+from harness.scenario import Cylinder, Scenario, load_scenario_file
+from harness.sim.geometry import cylinder_segments
+
+IN_PROCESS_EXAMPLES = 520
+CLI_EXAMPLES = 30
+# A valid scenario is run only if it is this cheap; the generator keeps almost all of them so.
+RUN_SECONDS, RUN_BEAMS, RUN_CYLINDER_SIDES = 5.0, 300_000, 20_000
+
+COMMON = settings(
+    deadline=None,
+    derandomize=True,
+    database=None,
+    print_blob=True,
+    suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large],
+)
+
+# -- valid-ish scenarios -----------------------------------------------------
+
+
+def floats(lo: float, hi: float) -> st.SearchStrategy[float]:
+    return st.floats(lo, hi, allow_nan=False, allow_infinity=False)
+
+
+def point(span: float = 5.0) -> st.SearchStrategy[list[float]]:
+    return st.lists(floats(-span, span), min_size=2, max_size=2)
+
+
+walls = st.fixed_dictionaries(
+    {"type": st.just("wall"), "start": point(), "end": point()},
+    optional={"thickness": floats(0.01, 0.5), "height": floats(0.05, 2.0)},
+)
+boxes = st.fixed_dictionaries(
+    {
+        "type": st.just("box"),
+        "position": point(),
+        "size": st.lists(floats(0.01, 2.0), min_size=3, max_size=3),
+    },
+    optional={"yaw": floats(-7, 7)},
+)
+cylinders = st.fixed_dictionaries(
+    {"type": st.just("cylinder"), "position": point(), "radius": floats(0.005, 1.0)},
+    optional={"height": floats(0.05, 2.0)},
+)
+models = st.fixed_dictionaries(
+    {
+        "type": st.just("model"),
+        "path": st.sampled_from(["fossbot_v2.urdf", "missing.urdf", "../up.urdf", "/abs.sdf"]),
+    },
+    optional={"position": st.lists(floats(-5, 5), min_size=3, max_size=3), "yaw": floats(-4, 4)},
+)
+obstacles = st.lists(st.one_of(walls, walls, boxes, cylinders, models), max_size=4)
+
+inline_faults = st.one_of(
+    st.fixed_dictionaries({"type": st.just("noise"), "sigma": floats(0, 0.05)}),
+    st.fixed_dictionaries(
+        {"type": st.just("dropouts"), "rate": floats(0, 0.3)},
+        optional={"value": st.sampled_from(sorted(DROPOUT_VALUES))},
+    ),
+    st.fixed_dictionaries({"type": st.just("spurious"), "rate": floats(0, 0.1)}),
+    st.fixed_dictionaries(
+        {"type": st.just("convention"), "name": st.sampled_from(sorted(CONVENTIONS))}
+    ),
+)
+faults = st.lists(st.one_of(st.sampled_from(sorted(NAMED_PROFILES)), inline_faults), max_size=4)
+
+
+def signed(lo: float, hi: float) -> st.SearchStrategy[float]:
+    """A speed away from zero, either way."""
+    return st.builds(lambda v, s: v * s, floats(lo, hi), st.sampled_from([-1.0, 1.0]))
+
+
+segments = st.one_of(
+    st.fixed_dictionaries(
+        {"until": st.fixed_dictionaries({"duration": floats(0.05, 1.0)})},
+        optional={"linear": floats(-0.5, 0.5), "angular": floats(-1.5, 1.5)},
+    ),
+    st.fixed_dictionaries(
+        {
+            "linear": signed(0.2, 1.0),
+            "until": st.fixed_dictionaries({"distance": floats(0.01, 0.3)}),
+        }
+    ),
+    st.fixed_dictionaries(
+        {"angular": signed(0.5, 3.0), "until": st.fixed_dictionaries({"turn": floats(0.05, 1.5)})}
+    ),
+    st.fixed_dictionaries(
+        {
+            "linear": floats(0.0, 0.5),
+            "until": st.fixed_dictionaries(
+                {"obstacle_ahead_below": floats(0.1, 3.0), "timeout": floats(0.2, 1.5)}
+            ),
+        }
+    ),
+    st.fixed_dictionaries(
+        {
+            "until": st.fixed_dictionaries(
+                {"obstacle_ahead_above": floats(0.1, 3.0), "timeout": floats(0.2, 1.5)}
+            )
+        },
+        optional={"angular": floats(-2, 2)},
+    ),
+)
+
+lidar = st.fixed_dictionaries(
+    {"preset": st.sampled_from(sorted(PRESETS))},
+    optional={
+        "samples": st.integers(1, 720),
+        "angle_min": floats(-math.pi, math.pi),
+        "angle_increment": floats(0.002, 0.1),
+        "range_min": floats(0.01, 0.3),
+        "range_max": floats(1.0, 20.0),
+        "rate_hz": floats(1.0, 50.0),
+    },
+)
+
+scenarios = st.fixed_dictionaries(
+    {
+        "description": st.text(
+            st.characters(categories=["L", "N", "Zs", "P"]), min_size=1, max_size=40
+        ),
+        "motion": st.fixed_dictionaries(
+            {"segments": st.lists(segments, min_size=1, max_size=3)},
+            optional={"mode": st.sampled_from(["kinematic", "kinematic", "wheels"])},
+        ),
+    },
+    optional={
+        "name": st.from_regex(r"[a-z][a-z0-9_]{0,20}", fullmatch=True),
+        "lidar": lidar,
+        "robot": st.fixed_dictionaries(
+            {},
+            optional={
+                "start": st.fixed_dictionaries(
+                    {}, optional={"x": floats(-1, 1), "y": floats(-1, 1), "yaw": floats(-4, 4)}
+                ),
+                "lidar_link": st.sampled_from(["lidar_scan_frame", "base_link", "laser"]),
+            },
+        ),
+        "obstacles": obstacles,
+        "faults": faults,
+        "threshold": floats(0.05, 3.0),
+        "seed": st.integers(0, 2**32 - 1),
+    },
+)
+
+# -- mutations ---------------------------------------------------------------
+
+weird_values = st.one_of(
+    st.none(),
+    st.booleans(),
+    st.integers(-(2**70), 2**70),
+    st.floats(allow_nan=True, allow_infinity=True),
+    st.sampled_from([0, -1, 1e-300, 1e300, -1e300, 2**64, 600.0001, 10_000, 16384, 0.5]),
+    st.text(max_size=20),
+    st.builds(lambda c, n: c * n, st.characters(), st.integers(200, 5000)),
+    st.sampled_from(
+        [
+            "gazebo",
+            "wall",
+            "cylinder",
+            "model",
+            "noisy",
+            "harsh",
+            "wheels",
+            "1e-3",
+            "fossbot_v2.urdf",
+            "../../etc/passwd",
+            "/etc/passwd.urdf",
+            "\x1b[31mred",
+            "a\nb",
+            "",
+        ]
+    ),
+    st.lists(st.integers(-3, 3), max_size=3),
+    st.dictionaries(st.sampled_from(["type", "x", "duration", "sigma"]), st.integers(), max_size=2),
+)
+extra_keys = st.one_of(
+    st.sampled_from(["sped", "source", "type", "until", "timeout", "x", "samples"]),
+    st.text(max_size=8),
+    st.integers(0, 3),
+)
+
+
+def places(node: Any) -> Iterator[tuple[Any, Any]]:
+    """Every (container, key-or-index) pair in a nested structure."""
+    if isinstance(node, dict):
+        for key in list(node):
+            yield node, key
+            yield from places(node[key])
+    elif isinstance(node, list):
+        for index in range(len(node)):
+            yield node, index
+            yield from places(node[index])
+
+
+@st.composite
+def mutated(draw: st.DrawFn, base: st.SearchStrategy[dict[str, Any]]) -> dict[str, Any]:
+    """A scenario with 0-3 structural mutations: replace, delete, add a key, wrap, scale."""
+    data = copy.deepcopy(draw(base))
+    for _ in range(draw(st.integers(0, 3))):
+        spots = list(places(data))
+        container, key = draw(st.sampled_from(spots))
+        action = draw(st.sampled_from(["replace", "replace", "delete", "add", "wrap", "scale"]))
+        if action == "replace":
+            container[key] = draw(weird_values)
+        elif action == "delete":
+            del container[key]
+        elif action == "add":
+            target = container[key] if isinstance(container[key], dict) else container
+            if isinstance(target, dict):
+                target[draw(extra_keys)] = draw(weird_values)
+        elif action == "wrap":
+            container[key] = [container[key]]
+        else:
+            value = container[key]
+            if isinstance(value, (int, float)) and not isinstance(value, bool):
+                container[key] = value * draw(st.sampled_from([-1, 0, 1e3, 1e9, 1e-9]))
+    return data
+
+
+@st.composite
+def scenario_files(draw: st.DrawFn) -> bytes:
+    """The bytes of a scenario file: mutated data as YAML, sometimes corrupted as text."""
+    text = yaml.safe_dump(draw(mutated(scenarios)), allow_unicode=True, sort_keys=False)
+    data = text.encode("utf-8")
+    corruption = draw(st.sampled_from(["none"] * 8 + ["truncate", "insert", "bytes"]))
+    if corruption == "truncate":
+        data = data[: draw(st.integers(0, len(data)))]
+    elif corruption == "insert":
+        at = draw(st.integers(0, len(data)))
+        data = data[:at] + draw(st.text(max_size=10)).encode() + data[at:]
+    elif corruption == "bytes":
+        at = draw(st.integers(0, len(data)))
+        data = data[:at] + draw(st.binary(min_size=1, max_size=8)) + data[at:]
+    return data
+
+
+# -- the property ------------------------------------------------------------
+
+
+def cheap_enough(scenario: Scenario) -> bool:
+    """Whether running this valid scenario stays short here (see RUN_*)."""
+    seconds = sum(s.worst_case_seconds() for s in scenario.motion.segments)
+    spec = scenario.lidar_spec
+    beams = (seconds * spec.rate_hz + 2) * spec.samples
+    sides = sum(cylinder_segments(o.radius) for o in scenario.obstacles if isinstance(o, Cylinder))
+    return seconds <= RUN_SECONDS and beams <= RUN_BEAMS and sides <= RUN_CYLINDER_SIDES
+
+
+def check_refusal(err: ConfigError, path: Path) -> None:
+    """A refusal is one printable line that names the file."""
+    message = str(err)
+    assert message and message.isprintable(), repr(message)  # one line, no escapes
+    assert message.startswith(f"{path}: "), message
+
+
+def outcome(path: Path, stats: Counter[str]) -> int | None:
+    """Load and (if valid and cheap) run one file: the exit code the CLI should give.
+
+    None when the file is valid but too costly to run here.
+    """
+    stats["generated"] += 1
+    try:
+        scenario = load_scenario_file(path)
+    except ConfigError as err:
+        check_refusal(err, path)
+        stats["refused at load"] += 1
+        return 2
+    if not cheap_enough(scenario):
+        stats["valid, too long to run here"] += 1
+        return None
+    try:
+        result = run(scenario, "inprocess", LinkOptions())
+    except ConfigError as err:  # a condition not met in time, a robot without wheel joints
+        check_refusal(err, path)
+        stats["refused while running"] += 1
+        return 2
+    assert result.records, "a run that started judges at least one scan"
+    stats["ran"] += 1
+    return 0 if result.ok else 1
+
+
+@pytest.mark.timeout(300)
+def test_generated_scenarios_run_or_are_refused(
+    tmp_path: Path, record_property: Any, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Each generated file is run or refused with one ConfigError line; never anything else."""
+    stats: Counter[str] = Counter()
+
+    @settings(COMMON, max_examples=IN_PROCESS_EXAMPLES)
+    @given(scenario_files())
+    def check(data: bytes) -> None:
+        path = tmp_path / f"generated_{stats['generated']}.yaml"
+        path.write_bytes(data)
+        try:
+            outcome(path, stats)
+        finally:
+            path.unlink()
+
+    check()
+    for key, value in stats.items():
+        record_property(key, value)
+    with capsys.disabled():
+        print(f"\n[scenario properties, in process] {dict(stats)}")
+    assert stats["generated"] >= 500
+    assert stats["ran"] >= 50 and stats["refused at load"] >= 100, dict(stats)
+
+
+@pytest.mark.timeout(300)
+def test_generated_scenarios_through_the_command(
+    tmp_path: Path, record_property: Any, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A sample through `fossbot-hil run FILE --link inprocess`: the exit code the run implies,
+    and for a refusal exactly one stderr line and no traceback."""
+    stats: Counter[str] = Counter()
+    codes: Counter[int] = Counter()
+
+    @settings(COMMON, max_examples=CLI_EXAMPLES)
+    @given(scenario_files())
+    def check(data: bytes) -> None:
+        path = tmp_path / f"generated_{stats['generated']}.yaml"
+        path.write_bytes(data)
+        try:
+            expected = outcome(path, stats)
+            if expected is None:
+                return
+            done = subprocess.run(
+                [sys.executable, "-m", "harness.cli", "run", str(path), "--link", "inprocess"],
+                capture_output=True,
+                text=True,
+                timeout=60,
+            )
+        finally:
+            path.unlink()
+        codes[done.returncode] += 1
+        assert "Traceback" not in done.stderr, done.stderr
+        assert done.returncode == expected, (expected, done.returncode, done.stderr[-1000:])
+        if expected == 2:
+            lines = done.stderr.splitlines()
+            assert len(lines) == 1 and lines[0].startswith("fossbot-hil: error: "), done.stderr
+            assert done.stdout == ""
+
+    check()
+    record_property("exit codes", dict(codes))
+    with capsys.disabled():
+        print(f"\n[scenario properties, command] {dict(stats)} exit codes {dict(codes)}")
+    assert stats["generated"] >= CLI_EXAMPLES and codes[2] >= 5 and codes[0] + codes[1] >= 5
