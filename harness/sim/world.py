@@ -17,7 +17,7 @@ import contextlib
 import math
 import os
 import sys
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 from pathlib import Path
 from types import TracebackType
 
@@ -50,7 +50,7 @@ def yaw_quaternion(yaw: float) -> tuple[float, float, float, float]:
     return (0.0, 0.0, math.sin(yaw / 2.0), math.cos(yaw / 2.0))
 
 
-def quaternion_yaw(q: tuple[float, float, float, float] | list[float]) -> float:
+def quaternion_yaw(q: Sequence[float]) -> float:
     """Heading (rotation about +z) of a quaternion (x, y, z, w)."""
     x, y, z, w = q
     return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
@@ -121,8 +121,8 @@ class World:
                 ),
             )
         if isinstance(obstacle, Box):
-            half = tuple(s / 2.0 for s in obstacle.size)
-            return (self._add_box(obstacle.position, half, obstacle.yaw),)
+            extents = tuple(s / 2.0 for s in obstacle.size)
+            return (self._add_box(obstacle.position, extents, obstacle.yaw),)
         if isinstance(obstacle, Cylinder):
             return (self._add_cylinder(obstacle),)
         return self._add_model(index, obstacle)
