@@ -89,6 +89,12 @@ def figures(stages: Mapping[str, StageResult], peak_rss_mb: float) -> dict[str, 
     rtt = out["ros2_round_trip_ms_median"]
     if raycast is not None and ros2 is not None and rtt is not None:
         out["overhead_ratio"] = overhead_ratio(ros2.scan_s, raycast.scan_s, rtt / 1000.0)
+    out["inprocess_cpu_ms_per_scan"] = _extra(stages.get("inprocess"), "cpu_ms_per_scan")
+    out["ros2_cpu_ms_per_scan"] = _extra(ros2, "cpu_ms_per_scan")
+    out["ros2_node_cpu_ms_per_scan"] = _extra(ros2, "node_cpu_ms_per_scan")
+    out["serial_cpu_ms_per_scan"] = _extra(serial, "cpu_ms_per_scan")
+    out["serial_node_cpu_ms_per_scan"] = _extra(serial, "node_cpu_ms_per_scan")
+    out["serial_driver_cpu_ms_per_scan"] = _extra(serial, "driver_cpu_ms_per_scan")
     out["node_startup_s"] = _extra(ros2, "startup_s")
     out["serial_startup_s"] = _extra(serial, "startup_s")
     out["lab_suite_wall_s"] = suite.seconds if suite else None

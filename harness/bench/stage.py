@@ -65,9 +65,10 @@ def run_through(
     (judge_frames warms up again: one more exchange, inside the timing, as
     in every run). The clock stops at the last judged tick, before the link
     reports its diagnostics (which stops a node process); `at_end` is
-    called then, e.g. to read the node's CPU time while it still runs. CPU
-    time is taken over the same stretch: on a shared machine it moves less
-    than wall time.
+    called then, e.g. to read the node's CPU time while it still runs.
+    Building and closing worlds between runs is taken out. CPU time is
+    taken over the same stretch: on a shared machine it moves less than
+    wall time.
     """
     oracle = workload.oracle()
     result = RunResult(
@@ -78,30 +79,35 @@ def run_through(
         faults="scenarios' own",
     )
     judged_at: list[float] = []
-    cpu_at = [0.0]
-    exhausted = [False]
-
-    def on_tick(record: TickRecord) -> None:
-        judged_at.append(time.perf_counter())
-        cpu_at[0] = time.process_time()
-        if exhausted[0] and at_end is not None:  # the last tick: the frames ran out before it
-            exhausted[0] = False
-            at_end()
-
     with prepared_frames(workload) as frames:
         first = next(frames)
         link.warm_up(first.scan)
+        exhausted = False
+        end = {"cpu": 0.0, "setup": 0.0, "setup_cpu": 0.0}
 
         def all_frames() -> Iterator[Frame]:
+            nonlocal exhausted
             yield first
             yield from frames
-            exhausted[0] = True
+            exhausted = True
 
+        def on_tick(record: TickRecord) -> None:
+            nonlocal exhausted
+            judged_at.append(time.perf_counter())
+            end.update(cpu=time.process_time(), setup=frames.setup_s, setup_cpu=frames.setup_cpu_s)
+            if exhausted and at_end is not None:  # the last tick: the frames ran out before it
+                exhausted = False
+                at_end()
+
+        setup, setup_cpu = frames.setup_s, frames.setup_cpu_s
         cpu_started = time.process_time()
         started = time.perf_counter()
         judge_frames(all_frames(), link, oracle, result, on_tick=on_tick)
-    end = judged_at[-1] if judged_at else time.perf_counter()
-    return LinkRun(result, end - started, judged_at, max(0.0, cpu_at[0] - cpu_started))
+    if not judged_at:
+        return LinkRun(result, 0.0, judged_at)
+    seconds = judged_at[-1] - started - (end["setup"] - setup)
+    cpu_s = end["cpu"] - cpu_started - (end["setup_cpu"] - setup_cpu)
+    return LinkRun(result, seconds, judged_at, max(0.0, cpu_s))
 
 
 def simulated_seconds(run: RunResult) -> float:

@@ -130,6 +130,8 @@ def figures_table(report: dict[str, Any]) -> Table:
         ("ros2_round_trip_ms_median", "ROS 2 round trip, median", "ms", 3),
         ("ros2_round_trip_ms_p99", "ROS 2 round trip, p99", "ms", 3),
         ("overhead_ratio", "harness overhead per scan", "%", 1),
+        ("ros2_cpu_ms_per_scan", "ROS 2 lockstep: harness CPU per scan", "ms", 3),
+        ("ros2_node_cpu_ms_per_scan", "ROS 2 lockstep: node CPU per scan", "ms", 3),
         ("node_startup_s", "node start-up (start to ready)", "s", 2),
         ("lab_suite_wall_s", "lab trio over ROS 2", "s", 2),
         ("lab_suite_cli_wall_s", "lab trio, CLI from spawn", "s", 2),
