@@ -34,6 +34,7 @@ from importlib import resources
 from pathlib import Path, PurePosixPath
 
 from harness.errors import ConfigError
+from harness.messages import shown
 
 __all__ = [
     "MAX_MESH_BYTES",
@@ -109,19 +110,20 @@ def _resolved_inside(candidate: Path, root: Path, what: str) -> Path:
     try:
         real = candidate.resolve(strict=True)
     except (OSError, RuntimeError) as err:  # RuntimeError: a symlink loop (Python < 3.13)
-        raise ConfigError(f"{what}: cannot resolve {candidate}: {_reason(err)}") from None
+        where = shown(str(candidate))
+        raise ConfigError(f"{what}: cannot resolve {where}: {_reason(err)}") from None
     if not _inside(real, root):
         raise ConfigError(
-            f"{what}: resolves to {real}, outside {root} "
+            f"{what}: resolves to {shown(str(real))}, outside {shown(str(root))} "
             "(model files must stay inside the scenario's folder or robot_models/)"
         )
     try:
         mode = os.stat(real).st_mode
     except OSError as err:
-        raise ConfigError(f"{what}: cannot read {real}: {_reason(err)}") from None
+        raise ConfigError(f"{what}: cannot read {shown(str(real))}: {_reason(err)}") from None
     if not stat.S_ISREG(mode):
         kind = "a folder" if stat.S_ISDIR(mode) else "not a regular file"
-        raise ConfigError(f"{what}: {real} is {kind}")
+        raise ConfigError(f"{what}: {shown(str(real))} is {kind}")
     return real
 
 
@@ -141,7 +143,7 @@ def find_model_file(ref: str, folders: Sequence[Path | None], *, what: str = "")
     for folder in folders:
         if folder is None:
             continue
-        tried.append(str(folder))
+        tried.append(shown(str(folder)))
         candidate = folder / relative
         if _exists(candidate):
             root = folder.resolve()
@@ -307,10 +309,10 @@ def _check_mesh(filename: str, model: ModelFile, schemes: tuple[str, ...], what:
         if folder.parent == folder:
             break
         folder = folder.parent
-    above = (
-        f" and the folders above it up to {model.root}" if model.path.parent != model.root else ""
-    )
-    raise ConfigError(f"{label}: no such file (looked in {model.path.parent}{above})")
+    here = shown(str(model.path.parent))
+    above = f" and the folders above it up to {shown(str(model.root))}"
+    above = above if model.path.parent != model.root else ""
+    raise ConfigError(f"{label}: no such file (looked in {here}{above})")
 
 
 # -- URDF ------------------------------------------------------------------
