@@ -49,10 +49,10 @@ def emulate(
     from harness.sim.simulation import Simulation
 
     spec = scenario.lidar_spec
+    faults = fault_profile(scenario, settings)  # a mistake here opens nothing
     device = profile.make_device(spec.rate_hz)
     line = SerialPort(port, profile.baudrate) if port else PtyPort()
     announce(f"port: {port or line.slave_path}")
-    faults = fault_profile(scenario, settings)
     rng = np.random.default_rng(settings.seed if settings.seed is not None else scenario.seed)
     revolutions = 0
     server = DeviceServer(

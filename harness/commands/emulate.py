@@ -6,7 +6,7 @@ import argparse
 
 from rich.console import Console
 
-from harness.commands.arguments import fault_list, seed
+from harness.commands.arguments import check_port, fault_list, seed
 from harness.scenario import resolve_scenario
 
 NAME = "emulate"
@@ -32,6 +32,8 @@ def run(args: argparse.Namespace, console: Console) -> int:
     from harness.emulate import emulate
     from harness.runner import RunSettings
 
+    if args.port is not None:
+        check_port("--port", args.port)
     scenario = resolve_scenario(args.scenario)
     settings = RunSettings(seed=args.seed, faults=fault_list(args.faults))
     summary = emulate(

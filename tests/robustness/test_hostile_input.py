@@ -879,17 +879,17 @@ OPTIONS: list[tuple[str, list[str], str]] = [
     (
         "emulate_port_missing",
         ["emulate", "rplidar", "--scenario", "s.yaml", "--port", "/dev/does_not_exist"],
-        "--port /dev/does_not_exist: cannot open",
+        "--port /dev/does_not_exist: no such device",
     ),
     (
         "emulate_port_regular_file",
         ["emulate", "ldlidar", "--scenario", "s.yaml", "--port", "regular_file"],
-        "--port regular_file: cannot open",
+        "--port regular_file: not a serial port",
     ),
     (
         "emulate_port_folder",
         ["emulate", "rplidar", "--scenario", "s.yaml", "--port", "a_folder"],
-        "Is a directory",
+        "--port a_folder: a folder, not a serial port",
     ),
     (
         "emulate_bad_scenario",
@@ -909,11 +909,6 @@ def test_hostile_option(workdir: Path, args: list[str], phrase: str) -> None:
     assert_nothing_left(workdir, before)
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="emulate's --port has no type check: '' means 'no port' and it serves on a new pty "
-    "(harness/commands/emulate.py, not this suite's to change)",
-)
 def test_emulate_with_an_empty_port_is_refused(workdir: Path) -> None:
     """`emulate --port ''` should be refused like `run --port ''`."""
     outcome = run_command(["emulate", "rplidar", "--scenario", "s.yaml", "--port", ""], workdir)
@@ -928,11 +923,6 @@ def test_emulate_with_bad_faults_exits_2(workdir: Path) -> None:
     assert_refused(Outcome(outcome.code, "", outcome.stderr), "unknown fault profile 'bogus'")
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="emulate opens the port and prints 'port: ...' before it checks --faults "
-    "(harness/emulate.py: build the fault profile before opening the line)",
-)
 def test_emulate_with_bad_faults_prints_nothing(workdir: Path) -> None:
     """`emulate --faults bogus` should print nothing on stdout before refusing."""
     outcome = run_command(
