@@ -71,8 +71,23 @@ def _extra(stage: StageResult | None, key: str) -> Any:
     return stage.extra.get(key) if stage is not None else None
 
 
-def figures(stages: Mapping[str, StageResult], peak_rss_mb: float) -> dict[str, Any]:
-    """Every named figure; None where the stage that measures it did not run."""
+def _children_peak_mb(stages: Mapping[str, StageResult]) -> float:
+    """The most memory the processes of one link stage held at once (node, board driver)."""
+    most = 0.0
+    for name in ("ros2", "serial"):
+        stage = stages.get(name)
+        if stage is not None:
+            peaks = (stage.extra.get("node_peak_rss_mb"), stage.extra.get("driver_peak_rss_mb"))
+            most = max(most, sum(p for p in peaks if isinstance(p, (int, float))))
+    return most
+
+
+def figures(stages: Mapping[str, StageResult], harness_peak_rss_mb: float) -> dict[str, Any]:
+    """Every named figure; None where the stage that measures it did not run.
+
+    ``peak_rss_mb`` is the harness's own peak plus the most its child
+    processes (node, board driver) held at once in one link stage.
+    """
     out: dict[str, Any] = {}
     for stage_name, prefix in _THROUGHPUT.items():
         stage = stages.get(stage_name)
@@ -103,7 +118,12 @@ def figures(stages: Mapping[str, StageResult], peak_rss_mb: float) -> dict[str, 
     out["serial_jitter_p99_ms"] = _extra(pacing, "reader_jitter_p99_ms")
     out["serial_pacer_rate_error_pct"] = _extra(pacing, "pacer_rate_error_pct")
     out["serial_pacer_jitter_p99_ms"] = _extra(pacing, "pacer_jitter_p99_ms")
-    out["peak_rss_mb"] = peak_rss_mb
+    children = _children_peak_mb(stages)
+    out["peak_rss_mb"] = harness_peak_rss_mb + children
+    out["peak_rss_mb_harness"] = harness_peak_rss_mb
+    out["peak_rss_mb_children"] = children if children else None
+    out["node_peak_rss_mb"] = _extra(ros2, "node_peak_rss_mb")
+    out["serial_driver_peak_rss_mb"] = _extra(serial, "driver_peak_rss_mb")
     floor = raycast.scan_s if raycast else None
     out["ratio_to_raycast"] = {
         prefix: (stage.scan_s / floor if floor and stage else None)

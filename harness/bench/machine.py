@@ -52,14 +52,13 @@ def describe() -> dict[str, object]:
     }
 
 
-def peak_rss_mb() -> dict[str, float]:
-    """Peak resident memory: this process, its largest reaped child, and their sum (MB).
+def peak_rss_mb() -> float:
+    """Peak resident memory of this process (``ru_maxrss``), MB.
 
-    ``ru_maxrss`` is in KiB on Linux. The children's figure is the largest
-    single descendant that was waited for (node processes, board drivers,
-    the CLI run), not their sum; adding it to ours bounds what one run needs.
+    Not ``RUSAGE_CHILDREN``: a child started by fork and exec keeps the
+    parent's high-water mark from before its exec, so that figure only
+    mirrors the harness. The bench reads its node processes' own peaks
+    (``VmHWM``) instead, while they run.
     """
-    scale = 1024.0 if platform.system() != "Darwin" else 1.0  # macOS reports bytes
-    own = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * scale / 1e6
-    children = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss * scale / 1e6
-    return {"harness": own, "children": children, "total": own + children}
+    scale = 1.0 if platform.system() == "Darwin" else 1024.0  # macOS reports bytes, Linux KiB
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * scale / 1e6

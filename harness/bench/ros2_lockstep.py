@@ -46,6 +46,20 @@ def process_cpu_s(pid: int | None) -> float | None:
     return (int(fields[11]) + int(fields[12])) / ticks  # utime, stime: fields 14 and 15
 
 
+def process_peak_rss_mb(pid: int | None) -> float | None:
+    """Peak resident memory of a live process since its exec (VmHWM, Linux only), MB."""
+    if pid is None:
+        return None
+    try:
+        with open(f"/proc/{pid}/status", "rb") as status:
+            for line in status:
+                if line.startswith(b"VmHWM:"):
+                    return int(line.split()[1]) * 1024 / 1e6  # kB
+    except OSError:
+        pass
+    return None
+
+
 def _node_pids(link: Link) -> list[int | None]:
     """The node under test and, for a board link, its LIDAR driver."""
     return [getattr(getattr(link, attr, None), "pid", None) for attr in ("process", "driver")]
@@ -62,9 +76,13 @@ def measure_link(link_name: str, workload: Workload) -> StageResult:
         pids = _node_pids(link)
         before = [process_cpu_s(pid) for pid in pids]
         after: list[float | None] = []
-        run = run_through(
-            link, workload, at_end=lambda: after.extend(process_cpu_s(pid) for pid in pids)
-        )
+        peaks: list[float | None] = []
+
+        def at_end() -> None:  # the last tick: the processes still run
+            after.extend(process_cpu_s(pid) for pid in pids)
+            peaks.extend(process_peak_rss_mb(pid) for pid in pids)
+
+        run = run_through(link, workload, at_end=at_end)
         startup_s = getattr(link, "startup_s", opened_s)
     finally:
         started = time.perf_counter()
@@ -87,6 +105,8 @@ def measure_link(link_name: str, workload: Workload) -> StageResult:
             "cpu_ms_per_scan": run.cpu_s * 1000.0 / scans if scans else None,
             "node_cpu_ms_per_scan": node_cpu[0],
             "driver_cpu_ms_per_scan": node_cpu[1],
+            "node_peak_rss_mb": peaks[0] if peaks else None,
+            "driver_peak_rss_mb": peaks[1] if peaks else None,
             "open_s": opened_s,
             "close_s": closed_s,
             "round_trip_ms_median": median(trips) if trips else None,

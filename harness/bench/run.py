@@ -114,12 +114,9 @@ def run_bench(
             )
         if on_stage is not None:
             on_stage(name, stages.get(name), time.perf_counter() - stage_started)
-    peak = machine.peak_rss_mb()
-    values = figures(stages, peak["total"])
+    values = figures(stages, machine.peak_rss_mb())
     return {
         **values,
-        "peak_rss_mb_harness": peak["harness"],
-        "peak_rss_mb_children": peak["children"],
         "overhead_formula": OVERHEAD_FORMULA,
         "targets": check_targets(values),
         "stages": {name: _stage_summary(stage) for name, stage in stages.items()},
