@@ -23,6 +23,8 @@ import json
 import math
 import subprocess
 import sys
+from collections.abc import Callable
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -37,11 +39,15 @@ from harness.errors import LinkError
 from harness.runner import RunSettings, fault_profile
 from harness.scenario import Scenario
 
+if TYPE_CHECKING:
+    from harness.devices.revolution import Sample
+    from harness.serial_line.server import DeviceServer
+
 SCAN_READY_S = 5.0  # the reader process starts and asks for a scan within this
 READER_SLACK_S = 5.0  # beyond the streaming time, for the reader to start and report
 
 
-def _revolutions(scenario: Scenario, count: int, samples_per_rev: int) -> list[list]:
+def _revolutions(scenario: Scenario, count: int, samples_per_rev: int) -> list[list[Sample]]:
     """Device samples of the scenario's first `count` ticks (cycled if it is shorter)."""
     from harness.devices.revolution import samples_from_scan
     from harness.sim.simulation import Simulation
@@ -59,6 +65,11 @@ def _revolutions(scenario: Scenario, count: int, samples_per_rev: int) -> list[l
             if len(revs) == count:
                 break
     return [revs[k % len(revs)] for k in range(count)]
+
+
+def _started(server: DeviceServer, count: int) -> Callable[[object], bool]:
+    """'`count` revolutions have started', for ``DeviceServer.wait_until``."""
+    return lambda _device: server.stats().revolutions_sent >= count
 
 
 def measure_pacing(scenario: Scenario, seconds: float) -> StageResult:
@@ -86,9 +97,7 @@ def measure_pacing(scenario: Scenario, seconds: float) -> StageResult:
             if not server.wait_until(lambda d: d.mode == "scan", SCAN_READY_S):
                 raise LinkError(f"the line reader did not ask for a scan in {SCAN_READY_S:g} s")
             for k, rev in enumerate(revs):
-                if k and not server.wait_until(
-                    lambda _, n=k: server.stats().revolutions_sent >= n, 2 * period + 1.0
-                ):
+                if k and not server.wait_until(_started(server, k), 2 * period + 1.0):
                     raise LinkError(f"revolution {k - 1} did not start within two periods")
                 server.send_revolution(rev, k)
             if not server.wait_idle(2 * period + 1.0):

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import contextlib
 import time
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Generator, Iterator, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, TypeVar
 
@@ -104,15 +104,15 @@ class FrameStream:
         """Close the simulation still open, if the stream was not read to its end."""
         self._frames.close()
 
-    def _timed(self, action: Callable[[], T]) -> T:
+    def _timed(self, action: Callable[..., T], *args: object) -> T:
         wall, cpu = time.perf_counter(), time.process_time()
         try:
-            return action()
+            return action(*args)
         finally:
             self.setup_s += time.perf_counter() - wall
             self.setup_cpu_s += time.process_time() - cpu
 
-    def _generate(self) -> Iterator[Frame]:
+    def _generate(self) -> Generator[Frame, None, None]:
         from harness.sim.simulation import Simulation  # imports pybullet
 
         workload = self.workload
@@ -120,7 +120,7 @@ class FrameStream:
         for scenario, profile in zip(workload.runs(), workload.profiles(), strict=True):
             seed = workload.settings.seed if workload.settings.seed is not None else scenario.seed
             rng = np.random.default_rng(seed)
-            sim: Simulation = self._timed(lambda s=scenario: Simulation(s))
+            sim: Simulation = self._timed(Simulation, scenario)
             try:
                 tick = None
                 for tick in sim.ticks():
