@@ -31,7 +31,9 @@ import numpy as np
 from harness.bench.stage import StageResult
 from harness.bench.stats import (
     arrival_rate,
+    jitter_ms,
     jitter_p99_ms,
+    median,
     read_times,
     rplidar_revolution_starts,
 )
@@ -103,6 +105,7 @@ def measure_pacing(scenario: Scenario, seconds: float) -> StageResult:
             if not server.wait_idle(2 * period + 1.0):
                 raise LinkError("the last revolution did not finish within two periods")
             stats = server.stats()
+            written = [d.started_at for d in server.deliveries()]
         port.close()  # the reader sees the line close and reports
         out, err = reader.communicate(timeout=seconds + READER_SLACK_S)
     finally:
@@ -122,6 +125,9 @@ def measure_pacing(scenario: Scenario, seconds: float) -> StageResult:
     segments = [(a, b) for a, b in zip(starts, starts[1:], strict=False)]
     segments.append((starts[-1], starts[-1] + rev_bytes))
     rate = arrival_rate(reads, segments)
+    seen_starts = read_times(reads, starts)
+    reader_jitter = jitter_ms(seen_starts, period)
+    pacer_jitter = jitter_ms(written, period)
     nominal = profile.baudrate / 10.0
     pacing = stats.pacing
     assert pacing is not None
@@ -136,9 +142,11 @@ def measure_pacing(scenario: Scenario, seconds: float) -> StageResult:
             "period_ms": period * 1000.0,
             "revolution_bytes": rev_bytes,
             "reader_rate_error_pct": (rate / nominal - 1.0) * 100.0 if rate else None,
-            "reader_jitter_p99_ms": jitter_p99_ms(read_times(reads, starts), period),
+            "reader_jitter_p99_ms": jitter_p99_ms(seen_starts, period),
+            "reader_jitter_median_ms": median(reader_jitter) if reader_jitter else None,
             "pacer_rate_error_pct": pacing.mean_rate_error_pct,
             "pacer_jitter_p99_ms": pacing.period_jitter_p99_ms,
+            "pacer_jitter_median_ms": median(pacer_jitter) if pacer_jitter else None,
             "underruns": stats.underruns,
             "overrun_bytes": stats.overrun_bytes,
         },

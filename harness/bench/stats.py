@@ -14,6 +14,7 @@ __all__ = [
     "RPLIDAR_NODE_BYTES",
     "RPLIDAR_SCAN_DESCRIPTOR",
     "arrival_rate",
+    "jitter_ms",
     "jitter_p99_ms",
     "median",
     "overhead_ratio",
@@ -63,12 +64,15 @@ def overhead_ratio(scan_s: float, raycast_s: float, round_trip_s: float) -> floa
     return (scan_s - floor) / floor
 
 
+def jitter_ms(starts_s: Sequence[float], period_s: float) -> list[float]:
+    """|start-to-start interval - period| of each interval, in ms."""
+    return [abs((b - a) - period_s) * 1000.0 for a, b in pairwise(starts_s)]
+
+
 def jitter_p99_ms(starts_s: Sequence[float], period_s: float) -> float | None:
     """p99 of |start-to-start interval - period|, in ms (None for fewer than two starts)."""
-    intervals = [b - a for a, b in pairwise(starts_s)]
-    if not intervals:
-        return None
-    return percentile([abs(i - period_s) * 1000.0 for i in intervals], 99)
+    jitter = jitter_ms(starts_s, period_s)
+    return percentile(jitter, 99) if jitter else None
 
 
 def rplidar_revolution_starts(data: bytes) -> list[int]:

@@ -137,6 +137,7 @@ def figures_table(report: dict[str, Any]) -> Table:
         ("lab_suite_cli_wall_s", "lab trio, CLI from spawn", "s", 2),
         ("serial_rate_error_pct", "serial byte rate error (reader)", "%", 3),
         ("serial_jitter_p99_ms", "revolution jitter p99 (reader)", "ms", 3),
+        ("serial_jitter_median_ms", "revolution jitter median (reader)", "ms", 3),
         ("serial_pacer_rate_error_pct", "serial byte rate error (pacer)", "%", 3),
         ("serial_pacer_jitter_p99_ms", "revolution jitter p99 (pacer)", "ms", 3),
         ("peak_rss_mb", "peak memory, harness + node (+ driver)", "MB", 0),
