@@ -10,6 +10,7 @@ from harness.bench.stage import StageResult
 from harness.bench.stats import (
     RPLIDAR_SCAN_DESCRIPTOR,
     arrival_rate,
+    jitter_ms,
     jitter_p99_ms,
     median,
     overhead_ratio,
@@ -47,6 +48,7 @@ def test_overhead_is_what_is_left_over_the_floor() -> None:
 
 
 def test_jitter_against_the_period() -> None:
+    assert jitter_ms([0.0, 0.1, 0.2015, 0.3], 0.1) == pytest.approx([0.0, 1.5, 1.5], abs=1e-9)
     assert jitter_p99_ms([0.0, 0.1, 0.2015, 0.3], 0.1) == pytest.approx(1.5)
     assert jitter_p99_ms([0.0], 0.1) is None
 
