@@ -91,6 +91,7 @@ class Ros2Link(Link):
         self._bool_first_seen = 0
         self._bool_after_gap = 0.0  # longest String -> Bool gap seen, seconds
         self._silent_scans = 0
+        self._alive_until = 0.0  # perf_counter until which the node counts as running
         self._counted: Counter[str] = Counter()  # observer.heard when the last collect ended
         self._warmed_up = False
         self._recent: deque[tuple[Counter[str], float]] = deque(maxlen=FLOOD_SCANS)
@@ -286,17 +287,26 @@ class Ros2Link(Link):
         return None
 
     def _wait_for(self, done: Callable[[], bool], seconds: float) -> str | None:
-        """Spin until `done()`; None if it came, else "timeout" or why the node is gone."""
+        """Spin until `done()`; None if it came, else "timeout" or why the node is gone.
+
+        The node's liveness is checked once per POLL_S (each check is a few
+        system calls, which cost more than the spin when the answer is
+        already there) and once more when the wait runs out, so a node that
+        died is never reported as a timeout.
+        """
         assert self.observer is not None
         end = time.perf_counter() + seconds
         while not done():
             now = time.perf_counter()
-            if now >= end:
-                return "timeout"
-            gone = self._node_gone()
-            if gone:
-                self.observer.drain()
-                return None if done() else gone
+            timed_out = now >= end
+            if timed_out or now >= self._alive_until:
+                gone = self._node_gone()
+                if gone:
+                    self.observer.drain()
+                    return None if done() else gone
+                self._alive_until = now + POLL_S
+                if timed_out:
+                    return "timeout"
             self.observer.spin(min(POLL_S, end - now))
         return None
 

@@ -1,8 +1,11 @@
 """The harness's own ROS 2 node: publishes /scan and /clock, hears the answers.
 
-It lives in its own rclpy Context (domain id given explicitly), is spun by
-hand with bounded ``spin_once`` calls (no threads), and stamps everything it
-hears with the publisher's DDS source timestamp, so answers can be matched
+It lives in its own rclpy Context (domain id given explicitly), waits by hand
+with bounded waits on a bare rcl wait set over its own subscriptions (no
+executor, no threads: an executor's ``spin_once`` rebuilds its wait set and
+runs its task machinery on every call, the largest harness cost per scan),
+takes the messages itself and stamps everything it hears with the
+publisher's DDS source timestamp, so answers can be matched
 to the scan they belong to. It also reads the ROS graph, to say what a node
 that never connects offers instead (other topic names, other types, QoS).
 """
@@ -17,8 +20,8 @@ from dataclasses import dataclass
 from typing import Any
 
 import rclpy
+from rclpy._rclpy_pybind11 import WaitSet
 from rclpy.context import Context
-from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import NodeNameNonExistentError
 from rclpy.qos import QoSProfile, ReliabilityPolicy
 from rclpy.signals import SignalHandlerOptions
@@ -81,8 +84,6 @@ class Observer:
             signal_handler_options=SignalHandlerOptions.NO,
         )
         self.node = rclpy.create_node("fossbot_hil", context=self.context)
-        self.executor = SingleThreadedExecutor(context=self.context)
-        self.executor.add_node(self.node)
         self.scan_topic, self.status_topic = scan_topic, status_topic
         self.warning_topic = warning_topic
         # Either we publish the scans (ros2 link) or a board's driver does and
@@ -107,6 +108,13 @@ class Observer:
         self.warning_sub = self.node.create_subscription(
             Bool, warning_topic, self._hear("warning", lambda m: bool(m.data)), QOS
         )
+        # What spin and drain wait on and take from: (handle, message type, callback).
+        self._subs = [
+            (sub.handle, sub.msg_type, sub.callback)
+            for sub in (self.scan_sub, self.status_sub, self.warning_sub)
+            if sub is not None
+        ]
+        self._wait_set = WaitSet(len(self._subs), 0, 0, 0, 0, 0, self.context.handle)
 
     def publish_clock(self, seconds: float) -> None:
         self.clock_pub.publish(clock_message(seconds))
@@ -129,17 +137,39 @@ class Observer:
         self.scan_pub.publish(msg)
         return sent
 
-    def spin(self, timeout: float) -> None:
-        """Handle what arrived, waiting at most `timeout` seconds for something."""
-        self.executor.spin_once(timeout_sec=max(0.0, timeout))
+    def spin(self, timeout: float, limit: int = 100) -> int:
+        """Handle what arrived, waiting at most `timeout` seconds for something.
+
+        Takes at most `limit` messages in all (a flooding node cannot keep it
+        here); returns how many it took.
+        """
+        wait_set = self._wait_set
+        wait_set.clear_entities()
+        for handle, _, _ in self._subs:
+            wait_set.add_subscription(handle)
+        wait_set.wait(int(max(0.0, timeout) * 1e9))  # 0: do not wait; never negative (forever)
+        ready = wait_set.get_ready_entities("subscription")
+        if not ready:
+            return 0
+        taken = 0
+        for handle, msg_type, callback in self._subs:
+            if handle.pointer not in ready:
+                continue
+            for _ in range(limit - taken):
+                got = handle.take_message(msg_type, False)  # (message, message_info) or None
+                if got is None:
+                    break
+                callback(*got)
+                taken += 1
+        return taken
 
     def drain(self, limit: int = 100) -> None:
-        """Handle everything already queued without waiting."""
-        for _ in range(limit):
-            before = self.heard.total()
-            self.executor.spin_once(timeout_sec=0.0)
-            if self.heard.total() == before:
+        """Handle everything already queued without waiting (at most `limit` messages)."""
+        while limit > 0:
+            taken = self.spin(0.0, limit)
+            if not taken:
                 return
+            limit -= taken
 
     def heard_since(self, kind: str, source_ns: int) -> bool:
         """Has a message of `kind` published at or after `source_ns` arrived?"""
@@ -256,14 +286,14 @@ class Observer:
         return "; ".join([counts, *self.qos_mismatches(), self.node_topics()])
 
     def close(self) -> None:
-        """Tear down node, executor and context, in that order; safe to call twice.
+        """Tear down wait set, node and context, in that order; safe to call twice.
 
         The context must be destroyed too: until then its DDS participant
         lives on and a later run in the same domain can still see it.
         """
         if self.context.ok():
+            self._wait_set.destroy_when_not_in_use()
             self.node.destroy_node()
-            self.executor.shutdown(timeout_sec=1.0)
             self.context.try_shutdown()
             self.context.destroy()
 
