@@ -14,7 +14,7 @@ from collections.abc import Callable, Iterator
 from dataclasses import replace
 
 from harness.errors import ConfigError
-from harness.links.base import LinkOptions
+from harness.links.base import Link, LinkOptions
 from harness.oracle import Oracle
 from harness.record import RecordedScans
 from harness.runner import Frame, judge_frames, with_link
@@ -71,22 +71,33 @@ def replay(
     threshold = replay_threshold(recording, threshold)
     noise_sigma = _recorded_float(recording, "noise_sigma") or 0.0
     name = recording.run.get("scenario") or f"replay of {recording.source}"
-    seed = int(recording.run.get("seed", "0") or 0)
+    seed_text = recording.run.get("seed", "0")
+    seed = int(seed_text) if seed_text.isdigit() else 0  # foreign metadata: no seed
     faults = recording.run.get("faults", "recorded")
 
-    def result(**extra: object) -> RunResult:
-        return RunResult(name, link_name, seed, threshold, faults, noise_sigma, **extra)  # type: ignore[arg-type]
-
-    def body(link) -> RunResult:  # type: ignore[no-untyped-def]
+    def body(link: Link) -> RunResult:
         started = time.perf_counter()
         oracle = Oracle(threshold, noise_sigma=noise_sigma, status_pattern=status_pattern)
-        replayed = judge_frames(frames(recording), link, oracle, result(), on_tick=on_tick)
+        replayed = RunResult(name, link.name, seed, threshold, faults, noise_sigma)
+        judge_frames(frames(recording), link, oracle, replayed, on_tick=on_tick)
         replayed.wall_s = time.perf_counter() - started
         return replayed
+
+    def not_started(reason: str, diagnostics: str) -> RunResult:
+        return RunResult(
+            name,
+            link_name,
+            seed,
+            threshold,
+            faults,
+            noise_sigma,
+            error=reason,
+            diagnostics=diagnostics,
+        )
 
     return with_link(
         link_name,
         replace(options, threshold=threshold, scan_rate_hz=scan_rate_hz(recording)),
         body,
-        lambda reason, diagnostics: result(error=reason, diagnostics=diagnostics),
+        not_started,
     )
