@@ -16,6 +16,7 @@ the parent with ``preexec_fn`` is unsafe with threads.)
 from __future__ import annotations
 
 import os
+import select
 import signal
 import subprocess
 import sys
@@ -57,6 +58,41 @@ def _signal_group(popen: subprocess.Popen[bytes], sig: int) -> None:
         pass
 
 
+def _group_members(pgid: int) -> list[int]:
+    """Pids still running (not zombies) in process group `pgid`, from /proc."""
+    members = []
+    for entry in os.scandir("/proc"):
+        if not entry.name.isdigit():
+            continue
+        try:
+            with open(f"/proc/{entry.name}/stat", "rb") as stat:
+                fields = stat.read().rsplit(b")", 1)[1].split()
+        except OSError:
+            continue
+        # After the command name: state, ppid, pgrp, ...
+        if int(fields[2]) == pgid and fields[0] not in (b"Z", b"X"):
+            members.append(int(entry.name))
+    return members
+
+
+def _wait_group_gone(pgid: int, timeout: float) -> None:
+    """Wait, bounded, until nothing in the group runs: SIGKILL is delivered, not instant.
+
+    Orphans that were in the group are reaped by init, not by us, so each is
+    waited on through a pidfd, which becomes readable when it dies.
+    """
+    deadline = time.monotonic() + timeout
+    for pid in _group_members(pgid):
+        try:
+            fd = os.pidfd_open(pid)
+        except OSError:  # gone already
+            continue
+        try:
+            select.select([fd], [], [], max(0.0, deadline - time.monotonic()))
+        finally:
+            os.close(fd)
+
+
 def _stop(popen: subprocess.Popen[bytes]) -> None:
     """SIGTERM the group, then SIGKILL it after a bounded wait; reap the child."""
     for sig, grace in ((signal.SIGTERM, TERM_GRACE_S), (signal.SIGKILL, KILL_WAIT_S)):
@@ -72,6 +108,7 @@ def _stop(popen: subprocess.Popen[bytes]) -> None:
         popen.wait(timeout=KILL_WAIT_S)
     except subprocess.TimeoutExpired:  # unkillable (D state): give up on it, do not hang
         pass
+    _wait_group_gone(popen.pid, KILL_WAIT_S)
 
 
 def run_bounded(

@@ -42,7 +42,9 @@ def test_scans_follow_the_vendor_conventions_on_450_bins(pty, start_driver, scan
         assert scan.angle_max == pytest.approx(2 * math.pi - increment, rel=1e-6)
         assert (scan.range_min, scan.range_max) == (pytest.approx(0.02), pytest.approx(25.0))
         np.testing.assert_array_equal(np.frombuffer(scan.ranges, np.float32), expected)
-        assert 0.02 < scan.scan_time < 1.0
+        # Measured from packet arrival, as the vendor driver does: a busy host that
+        # reads two bursts at once shortens it, so only its bounds are certain.
+        assert 0.0 <= scan.scan_time < 1.0
         assert scan.time_increment == pytest.approx(scan.scan_time / POINTS_PER_TURN, rel=1e-5)
     assert driver.stop() == 0
 
