@@ -16,6 +16,7 @@ sees: same profile + seed gives byte-identical scans.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
@@ -25,6 +26,20 @@ import numpy as np
 
 from harness.errors import ConfigError
 from harness.lidar_spec import LidarSpec
+from harness.link_faults import (
+    LINK_KINDS,
+    Delay,
+    Drop,
+    Duplicate,
+    LineCorruption,
+    LineDrops,
+    LineNoise,
+    LinkFault,
+    LinkFaults,
+    RateDrift,
+    Reorder,
+    StaleStamps,
+)
 from harness.scan import Scan
 
 __all__ = [
@@ -38,6 +53,7 @@ __all__ = [
     "Noise",
     "Spurious",
     "build_profile",
+    "split_fault_text",
 ]
 
 # Beam classes inside the pipeline.
@@ -145,13 +161,14 @@ class Convention:
 
 
 Fault = Noise | Dropouts | Spurious
-_Item = Noise | Dropouts | Spurious | Convention
+_Item = Noise | Dropouts | Spurious | Convention | LinkFault
 _FAULT_ORDER: tuple[str, ...] = ("noise", "dropouts", "spurious")
 _KINDS: dict[str, type[Any]] = {
     "convention": Convention,
     "dropouts": Dropouts,
     "noise": Noise,
     "spurious": Spurious,
+    **LINK_KINDS,
 }
 
 
@@ -173,6 +190,7 @@ class FaultProfile:
     faults: tuple[Fault, ...] = ()
     convention: str = "rep117"
     name: str = "clean"
+    link: LinkFaults = LinkFaults()  # how scans travel (see harness.link_faults)
 
     def __post_init__(self) -> None:
         _check_convention(self.convention)
@@ -195,6 +213,8 @@ class FaultProfile:
     def describe(self) -> str:
         """One line for reports: the name and what it does."""
         parts = [f.describe() for f in self.faults] + [Convention(self.convention).describe()]
+        if self.link:
+            parts.append(self.link.describe())
         return f"{self.name}: " + "; ".join(parts)
 
     def emit(
@@ -289,6 +309,24 @@ _NAMED: dict[str, tuple[str, tuple[_Item, ...]]] = {
         Spurious(0.05),
         Convention("nan"),
     ),
+    "slow_link": _named("scans delayed 0.05 s ± 0.03 s", Delay(0.05, 0.03)),
+    "lossy_link": _named(
+        "10% of scans dropped, 5% delivered twice, 5% swapped with the next",
+        Drop(0.10),
+        Duplicate(0.05),
+        Reorder(0.05),
+    ),
+    "drifting_rate": _named(
+        "scan rate drifting between 3.3 and 6.7 Hz, as the lab robot's LIDAR", RateDrift(3.3, 6.7)
+    ),
+    "stale_stamps": _named("20% of scans stamped 1 s in the past", StaleStamps(0.2, 1.0)),
+    "noisy_line": _named(
+        "serial links: 0.01% of bytes with a flipped bit, 0.005% lost, "
+        "16-byte noise in 3% of revolutions",
+        LineCorruption(0.0001),
+        LineDrops(0.00005),
+        LineNoise(0.03, 16),
+    ),
 }
 
 
@@ -299,17 +337,15 @@ def _compose(items: Sequence[_Item], name: str) -> FaultProfile:
         by_kind[item.kind] = item
     convention = by_kind.pop("convention", Convention("rep117"))
     assert isinstance(convention, Convention)
-    faults = tuple(f for f in by_kind.values() if not isinstance(f, Convention))
-    return FaultProfile(faults=faults, convention=convention.name, name=name)
+    link = tuple(f for f in by_kind.values() if f.kind in LINK_KINDS)
+    faults = tuple(f for f in by_kind.values() if isinstance(f, (Noise, Dropouts, Spurious)))
+    return FaultProfile(faults=faults, convention=convention.name, name=name, link=LinkFaults(link))
 
 
 #: name -> (description, profile); the names a scenario's ``faults:`` list may use.
 NAMED_PROFILES: dict[str, tuple[str, FaultProfile]] = {
     name: (desc, _compose(items, name)) for name, (desc, items) in _NAMED.items()
 }
-
-
-_DEFAULTS: dict[str, dict[str, Any]] = {"dropouts": {"value": "nan"}}
 
 
 def _inline(where: str, spec: Mapping[str, Any]) -> tuple[_Item, str]:
@@ -327,8 +363,9 @@ def _inline(where: str, spec: Mapping[str, Any]) -> tuple[_Item, str]:
             raise ConfigError(
                 f"{where}: unknown key {key!r} for {kind} (known: {', '.join(cls.params)})"
             )
+    optional = {f.name for f in dataclasses.fields(cls) if f.default is not dataclasses.MISSING}
     for key in cls.params:
-        if key not in args and key not in _DEFAULTS.get(kind, {}):
+        if key not in args and key not in optional:
             raise ConfigError(f"{where}.{key}: required for {kind}")
         value = args.get(key)
         if key in ("sigma", "rate") and value is not None:
@@ -341,6 +378,13 @@ def _inline(where: str, spec: Mapping[str, Any]) -> tuple[_Item, str]:
             args[key] = float(value)
         if key in ("value", "name") and value is not None and not isinstance(value, str):
             raise ConfigError(f"{where}.{key}: must be a string, got {value!r}")
+        if key == "length" and value is not None:
+            if isinstance(value, bool) or not isinstance(value, int):
+                raise ConfigError(f"{where}.{key}: must be a whole number, got {value!r}")
+        elif key not in ("value", "name", "sigma", "rate") and value is not None:
+            if isinstance(value, bool) or not isinstance(value, (int, float)):
+                raise ConfigError(f"{where}.{key}: must be a number, got {value!r}")
+            args[key] = float(value)
     try:
         item = cls(**args)
     except ConfigError as err:
@@ -364,7 +408,11 @@ def build_profile(
     labels: list[str] = []
     for i, entry in enumerate(items):
         where = f"{field_name}[{i}]"
-        if isinstance(entry, str):
+        if isinstance(entry, str) and "(" in entry:
+            item, label = _inline(where, _call_mapping(where, entry))
+            collected.append(item)
+            labels.append(label)
+        elif isinstance(entry, str):
             if entry not in _NAMED:
                 known = ", ".join(_NAMED)
                 raise ConfigError(f"{where}: unknown fault profile {entry!r} (known: {known})")
@@ -379,3 +427,43 @@ def build_profile(
                 f"{where}: expected a profile name or a mapping with 'type', got {entry!r}"
             )
     return _compose(collected, "+".join(labels) or "clean")
+
+
+def _call_mapping(where: str, text: str) -> dict[str, Any]:
+    """ "drop(rate=0.1)" -> {"type": "drop", "rate": 0.1}: inline faults on a command line."""
+    kind, _, rest = text.strip().partition("(")
+    if not rest.endswith(")"):
+        raise ConfigError(f"{where}: {text!r}: expected KIND(KEY=VALUE,...)")
+    spec: dict[str, Any] = {"type": kind.strip()}
+    for part in filter(None, (p.strip() for p in rest[:-1].split(","))):
+        key, eq, value = part.partition("=")
+        if not eq or not key.strip():
+            raise ConfigError(f"{where}: {text!r}: expected KEY=VALUE, got {part!r}")
+        spec[key.strip()] = _value(value.strip())
+    return spec
+
+
+def _value(text: str) -> Any:
+    """A number if it reads as a finite one; words such as nan and inf stay words."""
+    for convert in (int, float):
+        try:
+            number = convert(text)
+        except ValueError:
+            continue
+        return number if math.isfinite(number) else text
+    return text
+
+
+def split_fault_text(text: str) -> list[str]:
+    """ "noisy,drop(rate=0.1),delay(mean=0.05,jitter=0.01)" -> its three items.
+
+    Commas inside parentheses belong to the item.
+    """
+    items, depth, start = [], 0, 0
+    for i, char in enumerate(text):
+        depth += {"(": 1, ")": -1}.get(char, 0)
+        if char == "," and depth == 0:
+            items.append(text[start:i])
+            start = i + 1
+    items.append(text[start:])
+    return [item.strip() for item in items if item.strip()]

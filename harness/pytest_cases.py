@@ -56,8 +56,10 @@ def _fault_items(faults: Any) -> list[str | None]:
 
 
 def split_faults(text: str) -> list[str]:
-    """ "noisy,dropouts_nan" -> ["noisy", "dropouts_nan"]."""
-    return [f.strip() for f in text.split(",") if f.strip()]
+    """ "noisy,drop(rate=0.1)" -> ["noisy", "drop(rate=0.1)"]."""
+    from harness.faults import split_fault_text
+
+    return split_fault_text(text)
 
 
 def cases_from_marker(args: Sequence[Any], kwargs: dict[str, Any]) -> list[HilCase]:

@@ -249,7 +249,8 @@ def test_fault_order_is_canonical() -> None:
         (
             ["clean", {"type": "nosie"}],
             r"faults\[1\]: unknown fault type 'nosie' "
-            r"\(known: convention, dropouts, noise, spurious\)",
+            r"\(known: convention, delay, drop, dropouts, duplicate, line_corruption, line_drops, "
+            r"line_noise, noise, rate_drift, reorder, spurious, stale_stamps\)",
         ),
         ([{"sigma": 0.1}], r"faults\[0\]: missing 'type'"),
         ([{"type": "dropouts", "rate": 1.5}], r"faults\[0\]\.rate: must be in \[0, 1\]"),

@@ -374,12 +374,6 @@ def test_link_config_errors(items: list[object], message: str) -> None:
         build_profile(items)  # type: ignore[arg-type]
 
 
-@pytest.mark.xfail(
-    reason="_call_mapping/_value turn 'nan' and 'inf' into floats, so the text form "
-    "cannot name dropouts value nan/inf or convention nan: '.value: must be a string'",
-    raises=ConfigError,
-    strict=True,
-)
 @pytest.mark.parametrize(
     "text", ["dropouts(rate=0.1,value=nan)", "dropouts(rate=0.1,value=inf)", "convention(name=nan)"]
 )
@@ -388,13 +382,6 @@ def test_inline_text_keeps_word_values(text: str) -> None:
     build_profile([text])
 
 
-@pytest.mark.xfail(
-    reason="_inline requires every key unless listed in _DEFAULTS, which holds only "
-    "dropouts; the link dataclasses' defaults (jitter, age, length, min_hz/max_hz) "
-    "are unreachable inline: 'faults[0].jitter: required for delay'",
-    raises=ConfigError,
-    strict=True,
-)
 @pytest.mark.parametrize(
     "text, expected",
     [

@@ -109,7 +109,9 @@ def check_port(option: str, path: str) -> None:
 
 def fault_list(text: str | None) -> list[str] | None:
     """`--faults a,b` as a list; None keeps the scenarios' own."""
-    return [f.strip() for f in text.split(",") if f.strip()] if text else None
+    from harness.faults import split_fault_text
+
+    return split_fault_text(text) if text else None
 
 
 def add_scenario_overrides(parser: argparse.ArgumentParser) -> None:
@@ -118,7 +120,8 @@ def add_scenario_overrides(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--faults",
         metavar="NAME[,NAME]",
-        help="fault profiles replacing the scenarios' own (see docs/faults.md)",
+        help="fault profiles or inline faults such as drop(rate=0.1), replacing the "
+        "scenarios' own (see docs/faults.md)",
     )
 
 
