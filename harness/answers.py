@@ -27,6 +27,8 @@ class Answers:
     problem: str | None = None  # link-level failure, e.g. "node exited with code 1: ..."
     late: list[Received] = field(default_factory=list)  # answers to earlier scans, by tick
     seen: Scan | None = None  # the scan the node received, when a device and driver made it
+    lost: str | None = None  # why the node never got this scan (e.g. damaged on the line)
+    extra_scans: int = 0  # further driver scans made of this one (a damaged line split it)
 
     def take_late(self, late: list[Received], tick: int) -> list[Received]:
         """Adopt the late answers that belong to `tick`; return the others.

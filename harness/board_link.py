@@ -24,6 +24,7 @@ from typing import Any, ClassVar
 from harness.answers import Answers
 from harness.devices.profiles import DeviceProfile
 from harness.errors import ConfigError, LinkError
+from harness.link_faults import LineDamage
 from harness.links.base import LinkOptions
 from harness.links.ros2 import CATCH_UP_S, POLL_S, Ros2Link
 from harness.node_process import NodeCommand, NodeProcess, ros_arguments
@@ -36,6 +37,7 @@ class BoardLink(Ros2Link):
     """A LIDAR device emulated on a serial line, read by the board's own driver."""
 
     profile: ClassVar[DeviceProfile]
+    serial_line = True
     publishes_scans = False  # the board's driver publishes /scan; the harness listens
 
     def __init__(self, options: LinkOptions) -> None:
@@ -56,6 +58,8 @@ class BoardLink(Ros2Link):
         self.driver: NodeProcess | None = None
         self._seen: Scan | None = None
         self._delivery_problem: str | None = None
+        self._lost: str | None = None  # line faults: why the driver made no scan of it
+        self._line_damage: LineDamage | None = None
 
     # -- processes and ports ----------------------------------------------
     def _start_processes(self, env: dict[str, str]) -> None:
@@ -117,14 +121,24 @@ class BoardLink(Ros2Link):
             return f"the board's LIDAR driver {self.driver.exit_summary(when)}"
         return None if self.physical else super()._node_gone(when)
 
+    def damage_line(self, damage: LineDamage) -> None:
+        """Line faults: the device's revolutions reach the driver damaged from now on.
+
+        A revolution the driver then publishes no scan of is lost, not a
+        broken link: the node had nothing to answer.
+        """
+        assert self.server is not None, "open() the link first"
+        self.server.damage = damage
+        self._line_damage = damage
+
     # -- delivery ---------------------------------------------------------
-    def _deliver(self, scan: Scan, tick: int) -> int:
+    def _deliver(self, scan: Scan, tick: int, *, clock: float | None = None) -> int:
         """Send the revolution down the line; wait (bounded) for the driver's /scan of it."""
         from harness.devices.revolution import samples_from_scan
 
         assert self.observer is not None and self.server is not None
         obs = self.observer
-        obs.publish_clock(scan.stamp)
+        obs.publish_clock(scan.stamp if clock is None else clock)
         rate = 1.0 / scan.scan_time if scan.scan_time > 0 else self.options.scan_rate_hz
         samples = samples_from_scan(
             scan,
@@ -132,8 +146,8 @@ class BoardLink(Ros2Link):
             max_range_m=scan.range_max,
         )
         pushed = time.time_ns()
-        self.server.send_revolution(samples, tick)
-        self._seen, self._delivery_problem = None, None
+        self.server.send_revolution(samples, tick, 1.0 / rate)  # real time: its own period
+        self._seen, self._delivery_problem, self._lost = None, None, None
 
         def driver_scan() -> Any:
             return next((h for h in obs.inbox if h.kind == "scan" and h.source_ns >= pushed), None)
@@ -142,19 +156,28 @@ class BoardLink(Ros2Link):
         while (heard := driver_scan()) is None:
             gone = self._node_gone()
             if gone or time.perf_counter() >= deadline:
-                self._delivery_problem = gone or (
+                missing = (
                     f"the board's driver published no {self.options.scan_topic} for this "
                     "revolution in time"
                 )
+                if not gone and self._line_damage is not None:
+                    self._lost = f"{missing} (damaged on the line)"
+                else:
+                    self._delivery_problem = gone or missing
                 return time.time_ns()
             obs.spin(min(POLL_S, deadline - time.perf_counter()))
         obs.inbox.remove(heard)
         self._seen = heard.value
         return heard.source_ns
 
-    def collect(self, scan: Scan, tick: int) -> Answers:
-        answers = super().collect(scan, tick)
+    def collect(self, scan: Scan, tick: int, *, may_be_ignored: bool = False) -> Answers:
+        if self._lost is not None:
+            # The node never got this revolution: nothing to wait for. What it
+            # publishes meanwhile is sorted by the next exchange, by send time.
+            return Answers(lost=self._lost)
+        answers = super().collect(scan, tick, may_be_ignored=may_be_ignored)
         answers.seen = self._seen
+        answers.lost = self._lost
         if self._delivery_problem and answers.problem is None:
             answers.problem = self._delivery_problem
         return answers

@@ -25,6 +25,7 @@ import numpy as np
 
 from harness.answers import Answers
 from harness.errors import ConfigError
+from harness.link_faults import ON_TIME, Delivery
 from harness.scan import Scan
 from harness.status import StatusClaim, compile_status_pattern, half_unit, parse_status
 
@@ -194,8 +195,15 @@ class Oracle:
 
     # -- judgement ---------------------------------------------------------
 
-    def judge(self, tick: int, t: float, scan: Scan, answers: Answers) -> Verdict:
-        """Judge one tick; failures accumulate so one verdict names every problem."""
+    def judge(
+        self, tick: int, t: float, scan: Scan, answers: Answers, delivery: Delivery = ON_TIME
+    ) -> Verdict:
+        """Judge one tick; failures accumulate so one verdict names every problem.
+
+        `delivery` says how the link carried the scan: a dropped scan (or one
+        the line lost) expects no answer, and a duplicate, an out-of-order or
+        a stale one may go unanswered; an answer that does come must be right.
+        """
         exp = self.expect(scan)
         failures: list[str] = []
         if answers.problem:
@@ -203,6 +211,11 @@ class Oracle:
 
         texts = [str(r.value) for r in answers.statuses]
         claim: StatusClaim | None = None
+        skipped = not texts and not answers.warnings and not answers.problem
+        if not delivery.delivered or answers.lost is not None:
+            return Verdict(tick, t, not failures, exp, None, None, tuple(failures), "")
+        if skipped and delivery.may_be_ignored:
+            return Verdict(tick, t, True, exp, None, None, (), "")
         if not texts:
             if answers.timed_out:
                 came = [r for r in answers.late if r.tick == tick and isinstance(r.value, str)]
@@ -211,7 +224,7 @@ class Oracle:
             else:
                 failures.append("no status arrived")
         else:
-            if len(texts) > 1:
+            if len(texts) > 1 + answers.extra_scans:
                 quoted = ", ".join(repr(x) for x in texts[:4])
                 times = "twice" if len(texts) == 2 else f"{len(texts)} times"
                 failures.append(f"answered {times} (one status per scan expected): {quoted}")
@@ -224,9 +237,12 @@ class Oracle:
 
         explanation = ""
         if failures:
-            explanation = f"t={t:.2f} s tick {tick}: {self._context(scan, exp)}; " + "; ".join(
-                failures
-            )
+            how = delivery.describe()
+            if answers.extra_scans:
+                n = 1 + answers.extra_scans
+                how = ", ".join(filter(None, [how, f"the driver made {n} scans of it"]))
+            where = f"t={t:.2f} s tick {tick}" + (f" ({how})" if how else "")
+            explanation = f"{where}: {self._context(scan, exp)}; " + "; ".join(failures)
         return Verdict(
             tick=tick,
             t=t,

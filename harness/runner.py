@@ -14,13 +14,21 @@ from typing import Any
 
 import numpy as np
 
-from harness.answers import Answers
+from harness.answers import Answers, Received
 from harness.errors import ConfigError, LinkError
 from harness.faults import FaultProfile, build_profile
+from harness.link_faults import (
+    NO_LINK_FAULTS,
+    Delivery,
+    LineDamage,
+    LinkFaults,
+    plan_deliveries,
+    scan_periods,
+)
 from harness.links.base import Link, LinkOptions, create_link
 from harness.oracle import Oracle
 from harness.scan import Scan
-from harness.scenario import Scenario
+from harness.scenario import Scenario, check_run_length
 from harness.trace import RunResult, TickRecord
 
 
@@ -44,7 +52,10 @@ def fault_profile(scenario: Scenario, settings: RunSettings) -> FaultProfile:
 
     items = settings.faults if settings.faults is not None else scenario.faults
     try:
-        return build_profile(items)
+        profile = build_profile(items)
+        if settings.faults is not None:  # a faster drifting rate may make the run too long
+            check_run_length(scenario, profile)
+        return profile
     except ConfigError as err:
         where = "--faults" if settings.faults is not None else scenario.source
         raise ConfigError(f"{where}: {err}") from None
@@ -88,14 +99,39 @@ def run_scenario(
         faults=profile.name,
         noise_sigma=profile.noise_sigma,
     )
+    check_link_faults(profile.link, link)
+    drift = profile.link.get("rate_drift")
+    periods = scan_periods(drift, scenario.lidar_spec.rate_hz, seed) if drift else None
     with Simulation(scenario, gui=settings.gui) as sim:
         frames = (
-            Frame(s.tick, s.t, s.x, s.y, s.yaw, profile.emit(s.truth, sim.spec, rng, stamp=s.t))
-            for s in sim.ticks()
+            Frame(s.tick, s.t, s.x, s.y, s.yaw, _emit(profile, s, sim.spec, rng, drift is not None))
+            for s in sim.ticks(periods)
         )
-        judge_frames(frames, link, oracle, result, on_tick=on_tick)
+        judge_frames(frames, link, oracle, result, on_tick=on_tick, link_faults=profile.link)
     result.wall_s = time.perf_counter() - started
     return result
+
+
+def _emit(profile: FaultProfile, tick: Any, spec: Any, rng: Any, drifting: bool) -> Scan:
+    """The scan a driver publishes for one tick; a drifting rate also sets its timing fields."""
+    scan = profile.emit(tick.truth, spec, rng, stamp=tick.t)
+    if drifting:
+        scan = replace(scan, scan_time=tick.period, time_increment=tick.period / spec.samples)
+    return scan
+
+
+def check_link_faults(faults: LinkFaults, link: Link) -> None:
+    """Refuse link faults this link cannot carry (before any scan is sent)."""
+    if faults.on_line and not link.serial_line:
+        kinds = ", ".join(f.kind for f in faults.items if f.kind.startswith("line_"))
+        raise ConfigError(
+            f"faults {kinds}: need a serial link (rplidar or ldlidar), not {link.name!r}"
+        )
+    if faults.stale_stamps and link.serial_line:
+        raise ConfigError(
+            f"faults stale_stamps: on the {link.name!r} link the board's driver stamps the "
+            "scans, not the harness"
+        )
 
 
 def judge_frames(
@@ -105,47 +141,76 @@ def judge_frames(
     result: RunResult,
     *,
     on_tick: Callable[[TickRecord], None] | None = None,
+    link_faults: LinkFaults = NO_LINK_FAULTS,
 ) -> RunResult:
     """Deliver each frame's scan through an opened `link`; judge and record every tick.
 
     Simulated runs and replayed recordings share this loop, so both are
-    judged the same way.
+    judged the same way. `link_faults` decide how each scan travels (late,
+    dropped, twice, out of order, stale); the oracle is told, so a dropped
+    scan expects no answer and a late one is timed from when it went out.
     """
-    pending: tuple[Frame, Answers] | None = None
+    pending: list[tuple[Frame, Answers, Delivery]] = []  # frames carry the scans as sent
+    if link_faults.on_line:
+        link.damage_line(LineDamage(link_faults, result.seed))
 
-    def judge(frame: Frame, answers: Answers) -> None:
+    def judge(frame: Frame, answers: Answers, delivery: Delivery) -> None:
         # Judge against what the node saw: over a serial link that is the
         # board driver's scan, quantised and re-binned, not ours.
         seen = answers.seen if answers.seen is not None else frame.scan
-        verdict = oracle.judge(frame.tick, frame.t, seen, answers)
+        verdict = oracle.judge(frame.tick, frame.t, seen, answers, delivery)
         record = TickRecord(
-            frame.tick, frame.t, frame.x, frame.y, frame.yaw, frame.scan, answers, verdict
+            frame.tick,
+            frame.t,
+            frame.x,
+            frame.y,
+            frame.yaw,
+            frame.scan,
+            answers,
+            verdict,
+            delivery,
         )
         result.records.append(record)
         if on_tick is not None:
             on_tick(record)
 
+    def judge_pending(late: list[Received]) -> list[Received]:
+        for frame, answers, delivery in pending:
+            if delivery.delivered:
+                late = answers.take_late(late, frame.tick)
+            judge(frame, answers, delivery)
+        pending.clear()
+        return late
+
     # Each tick is judged once the next scan's exchange is over: answers to
     # scan k that arrive after scan k+1 was sent (a Bool published after the
     # String, a second String) still count for scan k.
-    for index, frame in enumerate(frames):
-        if index == 0:
-            link.warm_up(frame.scan)
+    warmed = False
+    for frame, delivery in plan_deliveries(frames, link_faults, result.seed):
+        if not delivery.delivered:
+            pending.append((frame, Answers(), delivery))
+            continue
+        scan = frame.scan
+        if delivery.stamp_age_s:
+            scan = replace(scan, stamp=max(0.0, frame.t - delivery.stamp_age_s))
         try:
-            answers = link.exchange(frame.scan, frame.tick)
+            if not warmed:
+                link.warm_up(frame.scan)
+                warmed = True
+            if delivery.delay_s:
+                link.hold(delivery.delay_s)
+            answers = link.exchange(
+                scan, frame.tick, clock=frame.t, may_be_ignored=delivery.may_be_ignored
+            )
         except LinkError as err:  # the line or graph broke: end here, keep what we have
             result.error = f"t={frame.t:.2f} s tick {frame.tick}: {err}"
             break
-        if pending is not None:
-            answers.late = pending[1].take_late(answers.late, pending[0].tick)
-            judge(*pending)
-        pending = (frame, answers)
+        answers.late = judge_pending(answers.late)
+        pending.append((replace(frame, scan=scan), answers, delivery))
         if answers.problem is not None:  # the node died or went silent: nothing more to judge
             result.error = f"t={frame.t:.2f} s tick {frame.tick}: {answers.problem}"
             break
-    if pending is not None:
-        pending[1].take_late(link.settle(), pending[0].tick)
-        judge(*pending)
+    judge_pending(link.settle())
     result.diagnostics = link.diagnostics()
     return result
 

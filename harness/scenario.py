@@ -32,7 +32,7 @@ from pydantic import (
 )
 
 from harness.errors import ConfigError
-from harness.faults import build_profile
+from harness.faults import FaultProfile, build_profile
 from harness.lidar_spec import PRESETS, LidarSpec, preset
 from harness.messages import shown
 from harness.model_files import check_model_file, find_model_file, robot_models_dir
@@ -322,17 +322,22 @@ def _first_error(err: ValidationError) -> str:
     return f"{_field_path(first['loc'])}: {shown(msg, 300)}"
 
 
-def _check_run_length(scenario: Scenario) -> None:
-    """Refuse runs too long or too costly to simulate (see MAX_* above); pure arithmetic."""
+def check_run_length(scenario: Scenario, faults: FaultProfile | None = None) -> None:
+    """Refuse runs too long or too costly to simulate (see MAX_* above); pure arithmetic.
+
+    A drifting scan rate (a link fault) counts at its highest rate.
+    """
     segments = scenario.motion.segments
     seconds = sum(segment.worst_case_seconds() for segment in segments)
     spec = scenario.lidar_spec
-    scans = math.ceil(seconds * spec.rate_hz - 1e-9) + 1
+    drift = faults.link.get("rate_drift") if faults is not None else None
+    rate_hz = max(spec.rate_hz, drift.max_hz) if drift is not None else spec.rate_hz
+    scans = math.ceil(seconds * rate_hz - 1e-9) + 1
     if seconds > MAX_RUN_SECONDS or scans > MAX_SCANS:
         waits = any(s.until.obstacle_ahead_below or s.until.obstacle_ahead_above for s in segments)
         raise ConfigError(
             f"motion: the run could last {seconds:g} s of simulated time ({scans} scans at "
-            f"{spec.rate_hz:g} Hz); at most {MAX_RUN_SECONDS:g} s and {MAX_SCANS} scans"
+            f"{rate_hz:g} Hz); at most {MAX_RUN_SECONDS:g} s and {MAX_SCANS} scans"
             + (" (segments waiting for an obstacle count at their until.timeout)" if waits else "")
         )
     if scans * spec.samples > MAX_RAYS:
@@ -376,8 +381,7 @@ def parse_scenario(data: Any, *, source: str = "<scenario>") -> Scenario:
     except RecursionError:
         raise ConfigError(f"{where}: nested too deeply (or refers to itself)") from None
     try:
-        build_profile(scenario.faults)
-        _check_run_length(scenario)
+        check_run_length(scenario, build_profile(scenario.faults))
     except ConfigError as err:
         raise ConfigError(f"{where}: {err}") from None
     if not scenario.name:

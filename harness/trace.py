@@ -5,6 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from harness.answers import Answers
+from harness.link_faults import ON_TIME, Delivery
 from harness.oracle import Verdict
 from harness.scan import Scan
 
@@ -21,6 +22,7 @@ class TickRecord:
     scan: Scan
     answers: Answers
     verdict: Verdict
+    delivery: Delivery = ON_TIME  # how the link carried it (link faults)
 
 
 @dataclass

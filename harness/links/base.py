@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import importlib
 import pkgutil
+import time
 from abc import ABC, abstractmethod
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -11,6 +12,7 @@ from typing import ClassVar, TypeVar
 
 from harness.answers import Answers, Received
 from harness.errors import ConfigError
+from harness.link_faults import LineDamage
 from harness.scan import Scan
 
 
@@ -42,6 +44,7 @@ class Link(ABC):
     """Deliver one scan at a time and gather what the software under test says."""
 
     name: ClassVar[str]
+    serial_line: ClassVar[bool] = False  # scans travel as device bytes on a serial line
 
     def __init__(self, options: LinkOptions) -> None:
         self.options = options
@@ -53,17 +56,32 @@ class Link(ABC):
         """Before tick 0: make sure answers to `scan` can reach us (answers discarded)."""
 
     @abstractmethod
-    def send(self, scan: Scan, tick: int) -> None:
-        """Deliver one scan."""
+    def send(self, scan: Scan, tick: int, *, clock: float | None = None) -> None:
+        """Deliver one scan; `clock` is the time it is now (default: its stamp)."""
 
     @abstractmethod
-    def collect(self, scan: Scan, tick: int) -> Answers:
-        """Wait (bounded by options.scan_timeout) for the answers to the last scan."""
+    def collect(self, scan: Scan, tick: int, *, may_be_ignored: bool = False) -> Answers:
+        """Wait (bounded by options.scan_timeout) for the answers to the last scan.
 
-    def exchange(self, scan: Scan, tick: int) -> Answers:
+        `may_be_ignored`: silence is a right answer (a duplicate, an old
+        scan), so do not wait beyond the deadline or count it as the node
+        going quiet.
+        """
+
+    def exchange(
+        self, scan: Scan, tick: int, *, clock: float | None = None, may_be_ignored: bool = False
+    ) -> Answers:
         """Lockstep: send a scan, then collect its answers."""
-        self.send(scan, tick)
-        return self.collect(scan, tick)
+        self.send(scan, tick, clock=clock)
+        return self.collect(scan, tick, may_be_ignored=may_be_ignored)
+
+    def hold(self, seconds: float) -> None:
+        """Let `seconds` pass before the next scan goes out (a delayed scan)."""
+        time.sleep(seconds)
+
+    def damage_line(self, damage: LineDamage) -> None:
+        """Serial links: damage the device's bytes from now on."""
+        raise ConfigError(f"line faults need a serial link, not {self.name!r}")
 
     def settle(self) -> list[Received]:
         """After the last scan: answers still on their way, each tagged with its tick."""

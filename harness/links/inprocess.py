@@ -68,7 +68,7 @@ class InprocessLink(Link):
         )
         self._pending: Answers | None = None
 
-    def send(self, scan: Scan, tick: int) -> None:
+    def send(self, scan: Scan, tick: int, *, clock: float | None = None) -> None:
         started = time.perf_counter()
         try:
             text, warning = self._process(scan, self.options.threshold)
@@ -85,6 +85,6 @@ class InprocessLink(Link):
             answers.warnings.append(Received(bool(warning), after))
         self._pending = answers
 
-    def collect(self, scan: Scan, tick: int) -> Answers:
+    def collect(self, scan: Scan, tick: int, *, may_be_ignored: bool = False) -> Answers:
         answers, self._pending = self._pending, None
         return answers if answers is not None else Answers(timed_out=True)

@@ -88,6 +88,7 @@ class Ros2Link(Link):
         self._sent_at: float = 0.0
         self._sends: list[tuple[int, int]] = []  # (tick, sent_ns) of recent scans
         self._started_at: float | None = None  # real time: when scan 0 went out
+        self._delay = 0.0  # seconds the next scan is held (link fault)
         self._bool_first_seen = 0
         self._bool_after_gap = 0.0  # longest String -> Bool gap seen, seconds
         self._silent_scans = 0
@@ -161,10 +162,10 @@ class Ros2Link(Link):
         assert self.observer is not None
         return self.observer.ready()
 
-    def _deliver(self, scan: Scan, tick: int) -> int:
+    def _deliver(self, scan: Scan, tick: int, *, clock: float | None = None) -> int:
         """Put the scan in front of the node; return its send time (system-clock ns)."""
         assert self.observer is not None
-        return self.observer.publish(scan)
+        return self.observer.publish(scan, clock=clock)
 
     def warm_up(self, scan: Scan) -> None:
         """Exchange the first scan until the node's answer reaches us, then forget it.
@@ -250,23 +251,32 @@ class Ros2Link(Link):
         return notes
 
     # -- lockstep ---------------------------------------------------------
-    def send(self, scan: Scan, tick: int) -> None:
+    def send(self, scan: Scan, tick: int, *, clock: float | None = None) -> None:
         assert self.observer is not None, "open() the link first"
+        now = scan.stamp if clock is None else clock
         if self.options.realtime:
-            self._pace(scan, tick)
-        self._sent_ns = self._deliver(scan, tick)
+            self._pace(now)
+        if self._delay:  # a delayed scan: its time (paced or not) plus the delay
+            delay, self._delay = self._delay, 0.0
+            self._wait_for(lambda: False, delay)
+        self._sent_ns = self._deliver(scan, tick, clock=now)
         self._sent_at = time.perf_counter()
         self._sends = [*self._sends[-7:], (tick, self._sent_ns)]
 
-    def _pace(self, scan: Scan, tick: int) -> None:
-        """Real time: scan k goes out k * scan_time after scan 0, hearing answers meanwhile."""
+    def _pace(self, clock: float) -> None:
+        """Real time: a scan taken at `clock` goes out that long after the first one,
+        hearing answers meanwhile (a drifting rate keeps its own spacing)."""
         assert self.observer is not None
-        if tick == 0 or self._started_at is None:
-            self._started_at = time.perf_counter()
+        if self._started_at is None:
+            self._started_at = time.perf_counter() - clock
             return
-        due = self._started_at + tick * scan.scan_time
+        due = self._started_at + clock
         while (left := due - time.perf_counter()) > 0:
             self.observer.spin(min(POLL_S, left))
+
+    def hold(self, seconds: float) -> None:
+        """Delay the next scan; the node is heard while the delay passes (in `send`)."""
+        self._delay = seconds
 
     def _deadline(self, scan: Scan) -> float:
         """Seconds a scan's answers may take: in real time, also before the next scan."""
@@ -310,7 +320,7 @@ class Ros2Link(Link):
             self.observer.spin(min(POLL_S, end - now))
         return None
 
-    def collect(self, scan: Scan, tick: int) -> Answers:
+    def collect(self, scan: Scan, tick: int, *, may_be_ignored: bool = False) -> Answers:
         assert self.observer is not None
         obs = self.observer
         answers = Answers()
@@ -329,7 +339,7 @@ class Ros2Link(Link):
         if outcome == "timeout":
             answers.timed_out = True
             outcome = None
-            if not self.options.realtime:
+            if not (self.options.realtime or may_be_ignored):
                 # The node is behind. Let it catch up before the next scan, or its
                 # answer to this scan would be taken for an answer to the next one.
                 outcome = self._wait_for(status_in, max(CATCH_UP_S, 3 * timeout))
@@ -348,7 +358,8 @@ class Ros2Link(Link):
             answers.waited = timeout
         else:
             answers.waited = time.perf_counter() - self._sent_at
-        self._watch_silence(answers, tick)
+        if not (may_be_ignored and answers.timed_out):  # a node may skip such a scan
+            self._watch_silence(answers, tick)
         self._watch_flood(answers)
         return answers
 
@@ -376,8 +387,9 @@ class Ros2Link(Link):
         """Split what arrived into this scan's answers and late ones; learn the Bool order."""
         first_status = next((h for h in heard if h.kind == "status" and mine(h)), None)
         for h in heard:
-            if h.kind == "scan":
-                continue  # a driver's scan (serial links): not an answer
+            if h.kind == "scan":  # a driver's scan (serial links): not an answer
+                answers.extra_scans += 1  # a second scan of one revolution (a damaged line)
+                continue
             item = Received(h.value, h.arrived - self._sent_at)
             if not mine(h):
                 answers.late.append(Received(h.value, item.after, self._tick_of(h.source_ns)))

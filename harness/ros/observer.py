@@ -128,11 +128,12 @@ class Observer:
 
         return callback
 
-    def publish(self, scan: Scan) -> int:
-        """Publish /clock then the scan; return the send time in system-clock ns."""
+    def publish(self, scan: Scan, *, clock: float | None = None) -> int:
+        """Publish /clock (`clock`, default the scan's stamp) then the scan;
+        return the send time in system-clock ns."""
         assert self.scan_pub is not None, "this observer watches a driver's scans"
         msg = scan_message(scan)
-        self.clock_pub.publish(clock_message(scan.stamp))
+        self.clock_pub.publish(clock_message(scan.stamp if clock is None else clock))
         sent = time.time_ns()
         self.scan_pub.publish(msg)
         return sent

@@ -167,12 +167,13 @@ class DeviceServer:
         self.request_gap_s = request_gap_s  # line quiet this long: a partial request is dropped
         self.poll_s = poll_s
         self._unit_override = unit_samples
+        self.damage: Any = None  # a harness.link_faults.LineDamage, set before the run starts
         self._encode = self._encoder(device)
         self._ld_style = "start_ms" in self._encode_params
         self.pacer = LinePacer(baudrate, bits_per_byte) if mode == "realtime" else None
 
         self._lock = threading.Lock()
-        self._inbox: deque[tuple[Sequence[Any], int]] = deque()
+        self._inbox: deque[tuple[Sequence[Any], int, float]] = deque()  # samples, tick, period
         self._idle = threading.Event()
         self._idle.set()
         self._changed = threading.Event()  # device state may have changed
@@ -259,8 +260,14 @@ class DeviceServer:
         """Samples in the last start marker: what "replace" takes off the next revolution."""
         return self._marker_size
 
-    def send_revolution(self, samples: Sequence[Any], tick: int) -> None:
-        """Queue one revolution; it goes out on the server thread."""
+    def send_revolution(
+        self, samples: Sequence[Any], tick: int, period_s: float | None = None
+    ) -> None:
+        """Queue one revolution; it goes out on the server thread.
+
+        `period_s`: in real time, how long this revolution lasts before the
+        next is due (a drifting rate); default the server's period.
+        """
         self._check()
         with self._lock:
             if self.mode == "realtime" and self._inbox:
@@ -268,7 +275,7 @@ class DeviceServer:
                 # waiting for its slot is replaced by the newer one.
                 self._inbox.popleft()
                 self._n["revolutions_superseded"] += 1
-            self._inbox.append((list(samples), tick))
+            self._inbox.append((list(samples), tick, period_s or self.period_s))
             self._idle.clear()
         self._wake()
 
@@ -512,7 +519,7 @@ class DeviceServer:
             due = self.mode == "lockstep" or self._next_due is None or now >= self._next_due
             item = self._inbox.popleft() if self._inbox and due else None
         if item is not None:
-            self._begin(item[0], item[1], now)
+            self._begin(*item, now)
         elif (
             self.mode == "realtime"
             and due
@@ -523,7 +530,7 @@ class DeviceServer:
             self._n["underruns"] += 1
             self._append_marker(self._last_samples, self._last_tick + 1, now)
 
-    def _begin(self, samples: Sequence[Any], tick: int, now: float) -> None:
+    def _begin(self, samples: Sequence[Any], tick: int, period: float, now: float) -> None:
         ms = self._stamp_ms(tick, now)
         skip = self._marker_size if self._marker_sent and self.next_start == "replace" else 0
         if self._ld_style:
@@ -534,6 +541,8 @@ class DeviceServer:
             data = self._encode(samples, ms)
             if skip:  # stateless nodes: drop the replaced nodes' bytes (and the start flag)
                 data = data[len(self._encode(samples[:skip], ms)) :]
+        if self.damage is not None:  # line faults: the bytes as the far end gets them
+            data = self.damage.damage(data)
         if not data:
             self._n["revolutions_dropped"] += 1
             return
@@ -546,9 +555,9 @@ class DeviceServer:
         self._n["revolutions_sent"] += 1
         if self.mode == "realtime":
             nominal = self._next_due if self._next_due is not None else now
-            if now - nominal > self.period_s:  # more than a period late: a new schedule
+            if now - nominal > period:  # more than a period late: a new schedule
                 nominal = now
-            self._next_due = nominal + self.period_s
+            self._next_due = nominal + period
         else:
             self._append_marker(samples, tick + 1, now)
 

@@ -32,11 +32,12 @@ class SimTick:
     """One LIDAR revolution: when, where the robot was, and what is really there."""
 
     tick: int  # 0, 1, 2, ...
-    t: float  # simulation time of this scan, s (= tick * spec.scan_time)
+    t: float  # simulation time of this scan, s (= tick * spec.scan_time at a steady rate)
     x: float  # robot base pose at this scan: m, m, rad
     y: float
     yaw: float
     truth: np.ndarray  # float64 ranges from LidarModel.truth()
+    period: float = 0.0  # seconds from this scan to the next (the revolution's scan_time)
 
 
 class Simulation:
@@ -60,9 +61,11 @@ class Simulation:
             self.world.close()
             raise
 
-    def ticks(self) -> Iterator[SimTick]:
+    def ticks(self, periods: Iterator[float] | None = None) -> Iterator[SimTick]:
         """One tick per revolution from t = 0 until the script ends, end pose included.
 
+        `periods` gives the time from each scan to the next (a LIDAR whose
+        rate drifts); by default every revolution takes the spec's scan_time.
         Obstacle conditions are judged on each tick's scan before it is
         yielded; a condition that times out raises ConfigError. Runs once.
         """
@@ -70,16 +73,19 @@ class Simulation:
             raise RuntimeError("Simulation.ticks() runs once; build a new Simulation")
         self._started = True
         scan_time = self.spec.scan_time
-        tick = 0
+        tick, t = 0, 0.0
         while True:
+            period = next(periods) if periods is not None else scan_time
             pose = self._driver.pose()
             truth = self.lidar.truth()
             self._script.observe(nearest_ahead(truth, self._ahead))
-            yield SimTick(tick, tick * scan_time, pose.x, pose.y, pose.yaw, truth)
+            yield SimTick(tick, t, pose.x, pose.y, pose.yaw, truth, period)
             if self._script.done:
                 return
             tick += 1
-            self._driver.run_until(self._script, tick * scan_time)
+            # A steady rate keeps tick * scan_time exactly, as before drift existed.
+            t = tick * scan_time if periods is None else t + period
+            self._driver.run_until(self._script, t)
 
     def close(self) -> None:
         """Release the physics client (idempotent)."""
