@@ -16,6 +16,8 @@ import numpy as np
 
 from harness.devices.profiles import DeviceProfile
 from harness.devices.revolution import samples_from_scan
+from harness.errors import ConfigError
+from harness.link_faults import LINE_KINDS, LineDamage, LinkFaults, scan_periods
 from harness.runner import RunSettings, fault_profile
 from harness.scenario import Scenario
 
@@ -34,6 +36,17 @@ class EmulationSummary:
     period_jitter_p99_ms: float | None
 
 
+def check_device_faults(faults: LinkFaults) -> None:
+    """A device on a line can drift and have its bytes damaged; the rest is not its doing."""
+    other = [f.kind for f in faults.items if f.kind != "rate_drift" and f.kind not in LINE_KINDS]
+    if other:
+        raise ConfigError(
+            f"faults {', '.join(other)}: emulate plays a LIDAR device, which cannot "
+            "drop, repeat, reorder, delay or restamp the board's scans (rate_drift and "
+            "line faults apply)"
+        )
+
+
 def emulate(
     profile: DeviceProfile,
     scenario: Scenario,
@@ -50,10 +63,13 @@ def emulate(
 
     spec = scenario.lidar_spec
     faults = fault_profile(scenario, settings)  # a mistake here opens nothing
+    seed = settings.seed if settings.seed is not None else scenario.seed
+    check_device_faults(faults.link)
+    drift = faults.link.get("rate_drift")
     device = profile.make_device(spec.rate_hz)
     line = SerialPort(port, profile.baudrate) if port else PtyPort()
     announce(f"port: {port or line.slave_path}")
-    rng = np.random.default_rng(settings.seed if settings.seed is not None else scenario.seed)
+    rng = np.random.default_rng(seed)
     revolutions = 0
     server = DeviceServer(
         device,
@@ -62,10 +78,13 @@ def emulate(
         baudrate=profile.baudrate,
         revolution_period_s=spec.scan_time,
     )
+    if faults.link.on_line:
+        server.damage = LineDamage(faults.link, seed)
+    periods = scan_periods(drift, spec.rate_hz, seed) if drift is not None else None
     try:
         with server, Simulation(scenario) as sim:
             started = time.monotonic()
-            for tick in sim.ticks():
+            for tick in sim.ticks(periods):
                 due = started + tick.t
                 while (left := due - time.monotonic()) > 0:
                     time.sleep(min(left, 0.05))  # pacing the scenario clock, not syncing
@@ -73,10 +92,10 @@ def emulate(
                 scan = faults.emit(tick.truth, spec, rng, stamp=tick.t)
                 samples = samples_from_scan(
                     scan,
-                    samples_per_rev=profile.samples_per_rev(device, spec.rate_hz),
+                    samples_per_rev=profile.samples_per_rev(device, 1.0 / tick.period),
                     max_range_m=spec.range_max,
                 )
-                server.send_revolution(samples, tick.tick)
+                server.send_revolution(samples, tick.tick, tick.period)
                 revolutions += 1
             server.wait_idle(IDLE_WAIT_S)
             stats = server.stats()

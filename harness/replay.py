@@ -14,10 +14,11 @@ from collections.abc import Callable, Iterator
 from dataclasses import replace
 
 from harness.errors import ConfigError
+from harness.link_faults import NO_LINK_FAULTS, LinkFaults
 from harness.links.base import Link, LinkOptions
 from harness.oracle import Oracle
 from harness.record import RecordedScans
-from harness.runner import Frame, judge_frames, with_link
+from harness.runner import Frame, check_link_faults, judge_frames, with_link
 from harness.trace import RunResult, TickRecord
 
 
@@ -66,20 +67,33 @@ def replay(
     threshold: float | None = None,
     status_pattern: str | None = None,
     on_tick: Callable[[TickRecord], None] | None = None,
+    link_faults: LinkFaults = NO_LINK_FAULTS,
+    seed: int | None = None,
 ) -> RunResult:
-    """Send every recorded scan through the named link, in lockstep, and judge each."""
+    """Send every recorded scan through the named link, in lockstep, and judge each.
+
+    `link_faults` (delay, drop, duplicate, reorder, stale stamps, line
+    faults) act on the recorded scans as on simulated ones, drawn from
+    `seed` (default: the recording's).
+    """
     threshold = replay_threshold(recording, threshold)
     noise_sigma = _recorded_float(recording, "noise_sigma") or 0.0
     name = recording.run.get("scenario") or f"replay of {recording.source}"
-    seed_text = recording.run.get("seed", "0")
-    seed = int(seed_text) if seed_text.isdigit() else 0  # foreign metadata: no seed
+    if seed is None:
+        seed_text = recording.run.get("seed", "0")
+        seed = int(seed_text) if seed_text.isdigit() else 0  # foreign metadata: no seed
     faults = recording.run.get("faults", "recorded")
+    if link_faults:
+        faults = f"{faults}; link: {link_faults.describe()}"
 
     def body(link: Link) -> RunResult:
         started = time.perf_counter()
         oracle = Oracle(threshold, noise_sigma=noise_sigma, status_pattern=status_pattern)
         replayed = RunResult(name, link.name, seed, threshold, faults, noise_sigma)
-        judge_frames(frames(recording), link, oracle, replayed, on_tick=on_tick)
+        check_link_faults(link_faults, link)
+        judge_frames(
+            frames(recording), link, oracle, replayed, on_tick=on_tick, link_faults=link_faults
+        )
         replayed.wall_s = time.perf_counter() - started
         return replayed
 

@@ -14,9 +14,12 @@ from harness.commands.arguments import (
     add_node_options,
     check_link_options,
     check_status_regex,
+    fault_list,
     link_options,
+    seed,
 )
 from harness.errors import ConfigError
+from harness.link_faults import NO_LINK_FAULTS, LinkFaults
 
 NAME = "replay"
 HELP = "re-inject a recorded /scan stream (ours or a robot's rosbag2) and judge the node"
@@ -35,10 +38,38 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     add_judging_options(parser)
     parser.add_argument("--junit-xml", metavar="FILE", help="write a JUnit XML report")
     parser.add_argument(
+        "--faults",
+        metavar="FAULT[,FAULT]",
+        help="link faults on the replayed scans, e.g. lossy_link,delay(mean=0.05) "
+        "(see docs/faults.md); the scans themselves are sent as recorded",
+    )
+    parser.add_argument("--seed", type=seed, help="seed of the link faults (default recorded)")
+    parser.add_argument(
         "--record", metavar="FILE", help="write the replayed run as a new MCAP recording"
     )
     add_node_options(parser)
     add_device_options(parser)
+
+
+def replay_link_faults(text: str | None) -> LinkFaults:
+    """--faults for a replay: link faults only, and no re-timing of recorded scans."""
+    from harness.faults import build_profile
+
+    items = fault_list(text)
+    if not items:
+        return NO_LINK_FAULTS
+    try:
+        profile = build_profile(items)
+    except ConfigError as err:
+        raise ConfigError(f"--faults: {err}") from None
+    if profile.faults or profile.convention != "rep117":
+        raise ConfigError(
+            f"--faults: {', '.join(f.kind for f in profile.faults) or 'convention'}: a replay "
+            "sends the recorded scans as they are; only link faults apply"
+        )
+    if profile.link.get("rate_drift") is not None:
+        raise ConfigError("--faults: rate_drift: a replay keeps the recorded scan times")
+    return profile.link
 
 
 def run(args: argparse.Namespace, console: Console) -> int:
@@ -51,6 +82,7 @@ def run(args: argparse.Namespace, console: Console) -> int:
     for option, path in (("--junit-xml", args.junit_xml), ("--record", args.record)):
         if path and not Path(path).resolve().parent.is_dir():
             raise ConfigError(f"{option} {path}: its folder does not exist")
+    link_faults = replay_link_faults(args.faults)
     recording = read_scans(args.recording, args.topic)
     result = replay(
         recording,
@@ -58,6 +90,8 @@ def run(args: argparse.Namespace, console: Console) -> int:
         link_options(args),
         threshold=args.threshold,
         status_pattern=args.status_regex,
+        link_faults=link_faults,
+        seed=args.seed,
     )
     print_results(console, [result])
     if args.record:

@@ -65,8 +65,9 @@ def _tick_messages(record: TickRecord, topics: RecordTopics) -> list[tuple[int, 
     out: list[tuple[int, str, Any, str]] = [
         (_ns(t), topics.clock, msg.clock(t), msg.CLOCK),
         (_ns(t), topics.pose, msg.pose(t, record.x, record.y, record.yaw), msg.POSE),
-        (_ns(t), topics.scan, msg.laser_scan(record.scan), msg.LASER_SCAN),
     ]
+    if record.delivery.delivered:  # a scan the link dropped was never injected
+        out.append((_ns(t), topics.scan, msg.laser_scan(record.scan), msg.LASER_SCAN))
     answers = record.answers
     if answers.seen is not None:
         out.append((_ns(t), topics.seen_scan, msg.laser_scan(answers.seen), msg.LASER_SCAN))

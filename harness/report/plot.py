@@ -38,6 +38,7 @@ class PlotSeries:
     warning_expected: np.ndarray  # 1 True, 0 False, NaN either (within the band)
     warning_got: np.ndarray  # 1 True, 0 False, NaN no Bool
     failed: np.ndarray  # bool
+    not_delivered: np.ndarray  # bool: a link fault dropped it, or the line lost it
 
 
 def _nearest_valid(ranges: np.ndarray, range_min: float, range_max: float) -> float:
@@ -55,7 +56,9 @@ def _flag(value: bool | None) -> float:
 def plot_series(result: RunResult) -> PlotSeries:
     """The arrays a plot of `result` shows (the scan judged is the one the node saw)."""
     nearest, claimed, odd = [], [], []
-    for r in result.records:
+    # In time order: a reordered scan was judged after the next one.
+    records = sorted(result.records, key=lambda r: r.t)
+    for r in records:
         seen = r.answers.seen if r.answers.seen is not None else r.scan
         nearest.append(_nearest_valid(seen.ranges, seen.range_min, seen.range_max))
         claim = r.verdict.claim
@@ -63,7 +66,6 @@ def plot_series(result: RunResult) -> PlotSeries:
         finite = d is not None and math.isfinite(d)
         claimed.append(d if finite else math.nan)
         odd.append(d is not None and not finite)
-    records = result.records
     failed = len(result.failed_ticks)
     counted = f"{failed} of {len(records)} ticks failed" if failed else f"{len(records)} ticks"
     title = f"{result.scenario} · {result.link} · {verdict_of(result)} ({counted})"
@@ -77,6 +79,9 @@ def plot_series(result: RunResult) -> PlotSeries:
         warning_expected=np.array([_flag(r.verdict.expected.warning) for r in records]),
         warning_got=np.array([_flag(r.verdict.warning_got) for r in records]),
         failed=np.array([not r.verdict.ok for r in records], dtype=bool),
+        not_delivered=np.array(
+            [not r.delivery.delivered or r.answers.lost is not None for r in records], dtype=bool
+        ),
     )
 
 
@@ -131,6 +136,17 @@ def render_plot(series: PlotSeries) -> bytes:
             color="#e07b00",
             clip_on=False,
             label="node's distance off the scale (or inf/nan)",
+        )
+    gone = series.not_delivered
+    if gone.any():
+        top.plot(
+            t[gone],
+            np.zeros(int(gone.sum())),
+            "x",
+            ms=4,
+            color="#777777",
+            clip_on=False,
+            label="scan not delivered (link fault)",
         )
     if series.failed.any():
         top.plot([], [], "s", color=FAILED_COLOUR, label="failed tick")

@@ -100,6 +100,13 @@ def tick_entry(record: TickRecord) -> dict[str, Any]:
         "waited_s": round(answers.waited, 4),
         "timed_out": answers.timed_out,
         "scan_seen_from_device": answers.seen is not None,
+        "delivery": {
+            "kind": record.delivery.kind,
+            "delay_s": round(record.delivery.delay_s, 4),
+            "stamp_age_s": _number(record.delivery.stamp_age_s),
+            "lost_on_line": answers.lost,
+            "driver_scans": 1 + answers.extra_scans if answers.seen is not None else None,
+        },
         "failures": list(v.failures),
     }
 
