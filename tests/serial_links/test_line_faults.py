@@ -1,0 +1,271 @@
+"""Serial line faults through the virtual board: damaged bytes on the pty, real drivers.
+
+The harness plays the LIDAR on a pty, its LineDamage flips, loses or adds
+bytes on the way, and the board's own driver (a real process) reads what
+is left and publishes /scan for the reference node (another process).
+A revolution the driver makes no scan of is lost on the line: no answer
+is expected for it, and none is judged.
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pytest
+from command_line import fossbot_hil
+
+from harness.answers import Answers, Received
+from harness.link_faults import LineCorruption, LineDamage, LineDrops, LineNoise, LinkFaults
+from harness.links.base import Link, LinkOptions
+from harness.oracle import Oracle
+from harness.report.summary import tick_entry
+from harness.runner import RunSettings, run_scenario, with_link
+from harness.scan import Scan
+from harness.scenario import resolve_scenario
+from harness.trace import RunResult
+
+STUDENT = Path(__file__).resolve().parents[1] / "ros" / "student_node.py"
+SCENARIO = "approach_wall"  # ~95 revolutions, crossing the 0.5 m threshold
+
+
+@dataclass
+class LineRun:
+    """A run through a serial link, and what the server's LineDamage did to its bytes."""
+
+    result: RunResult
+    flipped: int
+    dropped: int
+    noise_bytes: int
+
+    @property
+    def lost(self) -> list[int]:
+        return [r.tick for r in self.result.records if r.answers.lost is not None]
+
+    def describe(self) -> str:
+        return (
+            f"flipped {self.flipped}, dropped {self.dropped}, noise bytes {self.noise_bytes}; "
+            f"lost revolutions {self.lost}; error {self.result.error}; "
+            f"first failure {self.result.first_failure}\n{self.result.diagnostics}"
+        )
+
+
+def run_on_line(
+    link_name: str, faults: list[str], *, seed: int | None = None, node: str | None = None
+) -> LineRun:
+    """`harness.runner.run`, opened by hand to read the server's LineDamage counters."""
+    scenario = resolve_scenario(SCENARIO)
+    options = LinkOptions(
+        node=node, threshold=scenario.threshold, scan_rate_hz=scenario.lidar_spec.rate_hz
+    )
+    damage: list[LineDamage] = []
+
+    def body(link: Link) -> RunResult:
+        result = run_scenario(scenario, link, RunSettings(seed=seed, faults=faults))
+        damage.append(link.server.damage)  # type: ignore[attr-defined]  # a BoardLink
+        return result
+
+    def not_started(reason: str, diagnostics: str) -> RunResult:
+        return RunResult(
+            scenario.name, link_name, 0, 0.5, "", error=reason, diagnostics=diagnostics
+        )
+
+    result = with_link(link_name, options, body, not_started)
+    assert damage, f"the run never started: {result.error}\n{result.diagnostics}"
+    line = damage[0]
+    assert isinstance(line, LineDamage), "the server carried no LineDamage"
+    return LineRun(result, line.flipped, line.dropped, line.noise_bytes)
+
+
+# Rates that keep a run short and right. ldlidar's driver checks each packet's
+# CRC and loses only the damaged packet; the bundled rplidar driver restarts
+# the scan after damage (1-2 revolutions lost, each waiting out the 1 s
+# deadline) and gives up after 3 restarts in a row, so its rates stay low.
+CASES = {
+    ("ldlidar", "line_corruption"): ("line_corruption(rate=0.001)", "flipped", 1),
+    ("ldlidar", "line_drops"): ("line_drops(rate=0.001)", "dropped", 1),
+    ("ldlidar", "line_noise"): ("line_noise(rate=0.1,length=16)", "noise_bytes", 16),
+    ("rplidar", "line_corruption"): ("line_corruption(rate=0.0002)", "flipped", 1),
+    ("rplidar", "line_drops"): ("line_drops(rate=0.00003)", "dropped", 1),
+    ("rplidar", "line_noise"): ("line_noise(rate=0.05,length=16)", "noise_bytes", 16),
+}
+
+
+@pytest.mark.ros
+@pytest.mark.timeout(90)
+@pytest.mark.parametrize(("link", "kind"), list(CASES), ids=[f"{a}-{b}" for a, b in CASES])
+def test_reference_node_passes_a_damaged_line(link: str, kind: str) -> None:
+    """The line is damaged (counted), the reference node still passes, and every
+    revolution the driver lost is judged ok, with nothing answered for it."""
+    fault, counter, bytes_per_event = CASES[(link, kind)]
+    run = run_on_line(link, [fault])
+    result = run.result
+    assert result.error is None, run.describe()
+    assert result.ok, run.describe()
+    assert len(result.records) > 90, run.describe()
+
+    # Only the named fault acted, and it did act.
+    counts = {"flipped": run.flipped, "dropped": run.dropped, "noise_bytes": run.noise_bytes}
+    assert counts.pop(counter) > 0, run.describe()
+    assert set(counts.values()) == {0}, run.describe()
+    if kind == "line_noise":
+        assert run.noise_bytes % 16 == 0, run.describe()  # whole bursts
+
+    # Lost revolutions: no answer, ok verdict, said so in the report; the rest came
+    # from the driver. Each damage event costs at most 2 revolutions, and most get through.
+    events = getattr(run, counter) // bytes_per_event
+    assert len(run.lost) <= 2 * events, run.describe()
+    assert len(run.lost) <= len(result.records) // 5, run.describe()
+    for record in result.records:
+        entry = tick_entry(record)["delivery"]
+        if record.answers.lost is not None:
+            assert record.verdict.ok and not record.verdict.failures
+            assert not record.answers.statuses and not record.answers.warnings
+            assert entry["lost_on_line"] == record.answers.lost
+            assert "damaged on the line" in record.answers.lost
+            assert entry["driver_scans"] is None
+        else:
+            assert record.answers.seen is not None and record.answers.statuses
+            assert entry["lost_on_line"] is None
+            assert entry["driver_scans"] >= 1
+
+
+# -- determinism ---------------------------------------------------------------
+
+
+def test_same_seed_damages_the_same_bytes() -> None:
+    """Two LineDamage objects with one seed turn one byte stream into the same
+    bytes, revolution after revolution; another seed damages others."""
+    faults = LinkFaults((LineCorruption(0.01), LineDrops(0.01), LineNoise(0.5, 16)))
+    stream = [np.random.default_rng(i).bytes(2000) for i in range(20)]
+
+    def damaged(seed: int) -> tuple[list[bytes], tuple[int, int, int]]:
+        line = LineDamage(faults, seed)
+        out = [line.damage(revolution) for revolution in stream]
+        return out, (line.flipped, line.dropped, line.noise_bytes)
+
+    first, counts = damaged(7)
+    assert damaged(7) == (first, counts)
+    assert all(c > 0 for c in counts), counts
+    assert first != stream
+    assert damaged(8)[0] != first
+
+
+DETERMINISM_FAULTS = [
+    "line_corruption(rate=0.001)",
+    "line_drops(rate=0.001)",
+    "line_noise(rate=0.1,length=32)",
+]
+
+
+@pytest.mark.ros
+@pytest.mark.timeout(120)
+def test_same_seed_same_verdicts_through_ldlidar() -> None:
+    """Two ldlidar runs, one seed: the same bytes damaged, the same scans from
+    the driver, the same verdict (and loss) tick by tick."""
+
+    def digest(run: LineRun) -> list[tuple[object, ...]]:
+        return [
+            (r.tick, r.verdict.ok, r.answers.lost is not None, r.verdict.expected)
+            for r in run.result.records
+        ]
+
+    def seen(run: LineRun) -> list[bytes | None]:
+        return [
+            r.answers.seen.ranges.tobytes() if r.answers.seen is not None else None
+            for r in run.result.records
+        ]
+
+    first = run_on_line("ldlidar", DETERMINISM_FAULTS, seed=3)
+    second = run_on_line("ldlidar", DETERMINISM_FAULTS, seed=3)
+    for run in (first, second):
+        assert run.result.error is None, run.describe()
+    assert first.flipped and first.dropped and first.noise_bytes, first.describe()
+    counts = (first.flipped, first.dropped, first.noise_bytes)
+    assert (second.flipped, second.dropped, second.noise_bytes) == counts
+    assert digest(second) == digest(first)
+    assert seen(second) == seen(first)  # the driver read the same bytes
+
+
+# -- a wrong node is still caught --------------------------------------------------
+
+
+@pytest.mark.ros
+@pytest.mark.timeout(90)
+def test_inverted_bool_is_caught_on_a_noisy_ldlidar_line() -> None:
+    """Line faults never turn a wrong answer into a pass."""
+    run = run_on_line("ldlidar", ["noisy_line"], node=f"{sys.executable} {STUDENT} inverted_bool")
+    result = run.result
+    assert run.flipped + run.dropped + run.noise_bytes > 0, run.describe()
+    assert result.error is None, run.describe()
+    assert not result.ok
+    assert "expected warning" in (result.first_failure or ""), run.describe()
+    failed = result.failed_ticks
+    assert all(r.answers.lost is None for r in failed)
+    assert len(failed) > len(result.records) // 2, run.describe()  # every Bool is wrong
+
+
+# -- a known misjudgement -------------------------------------------------------------
+
+
+def driver_scan(nearest_m: float) -> Scan:
+    """A scan as the ldlidar driver publishes it: 450 bins from angle 0, one return."""
+    ranges = np.full(450, np.inf, np.float32)
+    ranges[0] = nearest_m
+    step = 2 * math.pi / 450
+    return Scan(0.0, 449 * step, step, 0.1 / 450, 0.1, 0.02, 12.0, ranges)
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="With two driver scans in one exchange (answers.extra_scans), the oracle judges "
+    "the first status but the LAST Bool, both against the first scan (`seen`): a node that "
+    "answered each scan right fails where they straddle the threshold. Seen end to end: "
+    "ldlidar line_drops(rate=0.005) on approach_wall loses tick 73; the driver publishes it "
+    "late, BoardLink._deliver takes it as tick 74's `seen` (0.508 m) and tick 74's own scan "
+    "(0.486 m) becomes the extra one; the reference node fails 'expected warning False "
+    "(or none); got True' in most runs (which tick gets the extra scan depends on timing).",
+)
+def test_two_driver_scans_in_one_exchange_judge_each_answer_on_its_own_scan() -> None:
+    """The answers the virtual board gave at tick 74 of that run: both right."""
+    seen = driver_scan(0.508)
+    answers = Answers(
+        statuses=[
+            Received("Min distance: 0.508 m, angle: 0.000 rad", 0.01),  # to the first scan
+            Received("Min distance: 0.486 m, angle: 0.000 rad", 0.05),  # to the second
+        ],
+        warnings=[Received(False, 0.01), Received(True, 0.05)],
+        waited=0.05,
+        seen=seen,
+        extra_scans=1,
+    )
+    verdict = Oracle(0.5).judge(74, 7.4, seen, answers)
+    assert verdict.ok, verdict.explanation
+
+
+# -- refusals -----------------------------------------------------------------------
+
+
+def test_line_faults_need_a_serial_link() -> None:
+    """`--link inprocess --faults noisy_line`: exit 2, one line naming the faults."""
+    done = fossbot_hil("run", SCENARIO, "--link", "inprocess", "--faults", "noisy_line", timeout=60)
+    assert done.returncode == 2, done.stdout + done.stderr
+    lines = done.stderr.strip().splitlines()
+    assert len(lines) == 1, done.stderr
+    assert "line_corruption, line_drops, line_noise" in lines[0]
+    assert "need a serial link (rplidar or ldlidar)" in lines[0]
+
+
+@pytest.mark.ros
+@pytest.mark.timeout(60)
+def test_stale_stamps_are_refused_on_a_serial_link() -> None:
+    """On a serial link the board's driver stamps the scans: exit 2, one line."""
+    done = fossbot_hil("run", SCENARIO, "--link", "rplidar", "--faults", "stale_stamps", timeout=60)
+    assert done.returncode == 2, done.stdout + done.stderr
+    lines = done.stderr.strip().splitlines()
+    assert len(lines) == 1, done.stderr
+    assert "stale_stamps" in lines[0] and "'rplidar'" in lines[0]
+    assert "driver stamps the scans" in lines[0]
