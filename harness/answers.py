@@ -14,6 +14,7 @@ class Received:
     value: str | bool
     after: float  # seconds between sending the scan and this message arriving
     tick: int | None = None  # the scan it answers, when it arrived late (see Answers.late)
+    source_ns: int = 0  # when the node published it (DDS source timestamp), when known
 
 
 @dataclass
@@ -28,7 +29,13 @@ class Answers:
     late: list[Received] = field(default_factory=list)  # answers to earlier scans, by tick
     seen: Scan | None = None  # the scan the node received, when a device and driver made it
     lost: str | None = None  # why the node never got this scan (e.g. damaged on the line)
-    extra_scans: int = 0  # further driver scans made of this one (a damaged line split it)
+    # Earlier driver scans the node answered during this exchange (a revolution the
+    # line made late, or split), each with its own answers: judged on their own.
+    earlier: list[tuple[Scan, Answers]] = field(default_factory=list)
+
+    @property
+    def extra_scans(self) -> int:
+        return len(self.earlier)
 
     def take_late(self, late: list[Received], tick: int) -> list[Received]:
         """Adopt the late answers that belong to `tick`; return the others.

@@ -28,8 +28,12 @@ from harness.link_faults import LineDamage
 from harness.links.base import LinkOptions
 from harness.links.ros2 import CATCH_UP_S, POLL_S, Ros2Link
 from harness.node_process import NodeCommand, NodeProcess, ros_arguments
+from harness.ros.observer import Heard
 from harness.scan import Scan
 
+SCAN_CATCH_UP_S = 0.05  # a driver scan published before its answer reaches us within this
+LATE_SCAN_WAIT_S = 0.2  # after a lost revolution: how long a second driver scan may follow
+LOST_IN_A_ROW = 5  # line faults: this many revolutions without a driver scan is a failure
 DRIVER_READY_S = 10.0  # the driver connects to the device (info, health, scan request)
 
 
@@ -59,6 +63,9 @@ class BoardLink(Ros2Link):
         self._seen: Scan | None = None
         self._delivery_problem: str | None = None
         self._lost: str | None = None  # line faults: why the driver made no scan of it
+        self._scans_from = 0  # source time of the first driver scan of this revolution
+        self._lost_in_a_row = 0
+        self._heard_scans: list[Heard] = []
         self._line_damage: LineDamage | None = None
 
     # -- processes and ports ----------------------------------------------
@@ -160,27 +167,72 @@ class BoardLink(Ros2Link):
                     f"the board's driver published no {self.options.scan_topic} for this "
                     "revolution in time"
                 )
+                self._lost_in_a_row += 1
                 if not gone and self._line_damage is not None:
-                    self._lost = f"{missing} (damaged on the line)"
-                else:
-                    self._delivery_problem = gone or missing
+                    if self._lost_in_a_row < LOST_IN_A_ROW:
+                        self._lost = f"{missing} (damaged on the line)"
+                        return time.time_ns()
+                    missing = (
+                        f"the board's driver published no {self.options.scan_topic} for "
+                        f"{self._lost_in_a_row} revolutions in a row (line faults lose some, "
+                        "not all)"
+                    )
+                self._delivery_problem = gone or missing
                 return time.time_ns()
             obs.spin(min(POLL_S, deadline - time.perf_counter()))
-        obs.inbox.remove(heard)
         self._seen = heard.value
+        self._scans_from = heard.source_ns
+        if self._lost_in_a_row:
+            # The last revolution made no scan in time: this one may be it, late (the
+            # line ate what closed it), with this revolution's own scan just behind.
+            self._wait_for(lambda: len(self._driver_scans()) >= 2, LATE_SCAN_WAIT_S)
+        self._lost_in_a_row = 0
         return heard.source_ns
+
+    def _driver_scans(self) -> list[Heard]:
+        """The driver's scans since this revolution went down the line, oldest first."""
+        assert self.observer is not None
+        since = self._scans_from
+        return [h for h in self.observer.inbox if h.kind == "scan" and h.source_ns >= since]
+
+    def _statuses(self) -> int:
+        assert self.observer is not None
+        since = self._sent_ns
+        return sum(1 for h in self.observer.inbox if h.kind == "status" and h.source_ns >= since)
+
+    def _answered(self) -> bool:
+        """One status for each driver scan this exchange brought (usually one)."""
+        return self._statuses() >= max(len(self._driver_scans()), 1)
+
+    def _settle_answers(self) -> None:
+        """Line faults: more statuses than driver scans heard may mean a late scan's
+        answer overtook the scan on its way to us (two topics, two readers). Wait a
+        moment for it; a node that simply answers twice costs that moment."""
+        if self._line_damage is not None and self._statuses() > len(self._driver_scans()):
+            self._wait_for(lambda: len(self._driver_scans()) >= self._statuses(), SCAN_CATCH_UP_S)
 
     def collect(self, scan: Scan, tick: int, *, may_be_ignored: bool = False) -> Answers:
         if self._lost is not None:
             # The node never got this revolution: nothing to wait for. What it
             # publishes meanwhile is sorted by the next exchange, by send time.
             return Answers(lost=self._lost)
+        assert self.observer is not None
+        self._heard_scans: list[Heard] = []
         answers = super().collect(scan, tick, may_be_ignored=may_be_ignored)
-        answers.seen = self._seen
+        _pair_with_driver_scans(answers, self._heard_scans)
+        if answers.seen is None:
+            answers.seen = self._seen
         answers.lost = self._lost
         if self._delivery_problem and answers.problem is None:
             answers.problem = self._delivery_problem
         return answers
+
+    def _sort(self, answers: Answers, heard: Any, mine: Any) -> None:
+        """Keep the driver's scans of this exchange, in order, for pairing."""
+        self._heard_scans = [
+            h for h in heard if h.kind == "scan" and h.source_ns >= self._scans_from
+        ]
+        super()._sort(answers, heard, mine)
 
     # -- reporting and teardown ---------------------------------------------
     def diagnostics(self) -> str:
@@ -203,3 +255,34 @@ class BoardLink(Ros2Link):
             self.driver.stop()
         if self.port is not None:
             self.port.close()
+
+
+def _pair_with_driver_scans(answers: Answers, scans: list[Heard]) -> None:
+    """Give each answer the driver scan it answered.
+
+    Usually the driver made one scan of the revolution. When the line made
+    a revolution late (its scan came with the next one) or split one in
+    two, several came, often published back to back, before the node
+    answered any. The node answers scans in order, so the i-th status
+    answers the i-th scan; a Bool goes with the status published nearest
+    to it (a node publishes both in one callback). The newest scan is this
+    tick's; the earlier ones go with their answers into
+    ``answers.earlier``, each judged on its own.
+    """
+    if len(scans) < 2:
+        return
+    groups = [Answers(seen=h.value, waited=answers.waited) for h in scans]
+    statuses = sorted(answers.statuses, key=lambda r: r.source_ns)
+    for i, item in enumerate(statuses):
+        groups[min(i, len(groups) - 1)].statuses.append(item)
+    for item in answers.warnings:
+        if not statuses:
+            groups[-1].warnings.append(item)
+            continue
+        nearest = min(
+            range(len(statuses)), key=lambda i: abs(statuses[i].source_ns - item.source_ns)
+        )
+        groups[min(nearest, len(groups) - 1)].warnings.append(item)
+    answers.statuses, answers.warnings = groups[-1].statuses, groups[-1].warnings
+    answers.seen = scans[-1].value
+    answers.earlier = [(g.seen, g) for g in groups[:-1]]

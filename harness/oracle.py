@@ -224,7 +224,7 @@ class Oracle:
             else:
                 failures.append("no status arrived")
         else:
-            if len(texts) > 1 + answers.extra_scans:
+            if len(texts) > 1:
                 quoted = ", ".join(repr(x) for x in texts[:4])
                 times = "twice" if len(texts) == 2 else f"{len(texts)} times"
                 failures.append(f"answered {times} (one status per scan expected): {quoted}")
@@ -234,13 +234,18 @@ class Oracle:
         bools = [r.value for r in answers.warnings if isinstance(r.value, bool)]
         warning_got = bools[-1] if bools else None
         failures.extend(self._judge_warning(exp, warning_got))
+        for earlier_scan, earlier in answers.earlier:  # each answer against the scan it answered
+            sub = self.judge(tick, t, earlier_scan, earlier)
+            failures.extend(f"answering an earlier driver scan: {f}" for f in sub.failures)
 
         explanation = ""
         if failures:
             how = delivery.describe()
             if answers.extra_scans:
                 n = 1 + answers.extra_scans
-                how = ", ".join(filter(None, [how, f"the driver made {n} scans of it"]))
+                how = ", ".join(
+                    filter(None, [how, f"the driver published {n} scans in this exchange"])
+                )
             where = f"t={t:.2f} s tick {tick}" + (f" ({how})" if how else "")
             explanation = f"{where}: {self._context(scan, exp)}; " + "; ".join(failures)
         return Verdict(

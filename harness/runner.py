@@ -99,7 +99,11 @@ def run_scenario(
         faults=profile.name,
         noise_sigma=profile.noise_sigma,
     )
-    check_link_faults(profile.link, link)
+    try:
+        check_link_faults(profile.link, link)
+    except ConfigError as err:
+        where = "--faults" if settings.faults is not None else scenario.source
+        raise ConfigError(f"{where}: {err}") from None
     drift = profile.link.get("rate_drift")
     periods = scan_periods(drift, scenario.lidar_spec.rate_hz, seed) if drift else None
     with Simulation(scenario, gui=settings.gui) as sim:
@@ -151,8 +155,6 @@ def judge_frames(
     scan expects no answer and a late one is timed from when it went out.
     """
     pending: list[tuple[Frame, Answers, Delivery]] = []  # frames carry the scans as sent
-    if link_faults.on_line:
-        link.damage_line(LineDamage(link_faults, result.seed))
 
     def judge(frame: Frame, answers: Answers, delivery: Delivery) -> None:
         # Judge against what the node saw: over a serial link that is the
@@ -197,6 +199,8 @@ def judge_frames(
             if not warmed:
                 link.warm_up(frame.scan)
                 warmed = True
+                if link_faults.on_line:  # after the warm-up, whose retries vary in number
+                    link.damage_line(LineDamage(link_faults, result.seed))
             if delivery.delay_s:
                 link.hold(delivery.delay_s)
             answers = link.exchange(

@@ -85,6 +85,9 @@ class InprocessLink(Link):
             answers.warnings.append(Received(bool(warning), after))
         self._pending = answers
 
+    def hold(self, seconds: float) -> None:
+        """A delay changes nothing for a function called in lockstep: no wall time is spent."""
+
     def collect(self, scan: Scan, tick: int, *, may_be_ignored: bool = False) -> Answers:
         answers, self._pending = self._pending, None
         return answers if answers is not None else Answers(timed_out=True)

@@ -329,7 +329,7 @@ class Ros2Link(Link):
             return h.source_ns >= self._sent_ns
 
         def status_in() -> bool:
-            return obs.heard_since("status", self._sent_ns)
+            return self._answered()
 
         def warning_in() -> bool:
             return obs.heard_since("warning", self._sent_ns)
@@ -347,6 +347,7 @@ class Ros2Link(Link):
         answers.problem = outcome
         if status_in():
             self._wait_for(warning_in, self._grace())
+            self._settle_answers()
             obs.drain()
         self._sort(answers, obs.inbox, mine)
         obs.inbox.clear()
@@ -362,6 +363,14 @@ class Ros2Link(Link):
             self._watch_silence(answers, tick)
         self._watch_flood(answers)
         return answers
+
+    def _settle_answers(self) -> None:
+        """Hook: once the answers are in, anything else to wait (briefly) for."""
+
+    def _answered(self) -> bool:
+        """Has the status answering the scan just sent arrived?"""
+        assert self.observer is not None
+        return self.observer.heard_since("status", self._sent_ns)
 
     def _watch_flood(self, answers: Answers) -> None:
         """End the run when the node publishes far more than one message a scan on a topic."""
@@ -387,10 +396,9 @@ class Ros2Link(Link):
         """Split what arrived into this scan's answers and late ones; learn the Bool order."""
         first_status = next((h for h in heard if h.kind == "status" and mine(h)), None)
         for h in heard:
-            if h.kind == "scan":  # a driver's scan (serial links): not an answer
-                answers.extra_scans += 1  # a second scan of one revolution (a damaged line)
-                continue
-            item = Received(h.value, h.arrived - self._sent_at)
+            if h.kind == "scan":
+                continue  # a driver's scan (serial links): not an answer
+            item = Received(h.value, h.arrived - self._sent_at, source_ns=h.source_ns)
             if not mine(h):
                 answers.late.append(Received(h.value, item.after, self._tick_of(h.source_ns)))
             elif h.kind == "status":

@@ -97,6 +97,27 @@ inline_faults = st.one_of(
     st.fixed_dictionaries(
         {"type": st.just("convention"), "name": st.sampled_from(sorted(CONVENTIONS))}
     ),
+    # Link faults, some out of range (refused) and line faults (refused off serial links).
+    st.fixed_dictionaries(
+        {"type": st.just("delay"), "mean": floats(-0.1, 0.01)},
+        optional={"jitter": floats(0, 0.01)},
+    ),
+    st.fixed_dictionaries(
+        {
+            "type": st.sampled_from(["drop", "duplicate", "reorder", "stale_stamps"]),
+            "rate": floats(-0.1, 1.1),
+        }
+    ),
+    st.fixed_dictionaries(
+        {"type": st.just("rate_drift")},
+        optional={"min_hz": floats(0.1, 25), "max_hz": floats(0.1, 25)},
+    ),
+    st.fixed_dictionaries(
+        {
+            "type": st.sampled_from(["line_corruption", "line_drops", "line_noise"]),
+            "rate": floats(0, 0.01),
+        }
+    ),
 )
 faults = st.lists(st.one_of(st.sampled_from(sorted(NAMED_PROFILES)), inline_faults), max_size=4)
 
