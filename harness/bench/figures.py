@@ -119,6 +119,7 @@ def figures(stages: Mapping[str, StageResult], harness_peak_rss_mb: float) -> di
     out["serial_pacer_rate_error_pct"] = _extra(pacing, "pacer_rate_error_pct")
     out["serial_pacer_jitter_p99_ms"] = _extra(pacing, "pacer_jitter_p99_ms")
     out["serial_jitter_median_ms"] = _extra(pacing, "reader_jitter_median_ms")
+    out["serial_jitter_max_ms"] = _extra(pacing, "reader_jitter_max_ms")
     out["serial_pacer_jitter_median_ms"] = _extra(pacing, "pacer_jitter_median_ms")
     children = _children_peak_mb(stages)
     out["peak_rss_mb"] = harness_peak_rss_mb + children

@@ -138,6 +138,7 @@ def figures_table(report: dict[str, Any]) -> Table:
         ("serial_rate_error_pct", "serial byte rate error (reader)", "%", 3),
         ("serial_jitter_p99_ms", "revolution jitter p99 (reader)", "ms", 3),
         ("serial_jitter_median_ms", "revolution jitter median (reader)", "ms", 3),
+        ("serial_jitter_max_ms", "revolution jitter max (reader)", "ms", 3),
         ("serial_pacer_rate_error_pct", "serial byte rate error (pacer)", "%", 3),
         ("serial_pacer_jitter_p99_ms", "revolution jitter p99 (pacer)", "ms", 3),
         ("peak_rss_mb", "peak memory, harness + node (+ driver)", "MB", 0),
