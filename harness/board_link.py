@@ -217,7 +217,7 @@ class BoardLink(Ros2Link):
             # publishes meanwhile is sorted by the next exchange, by send time.
             return Answers(lost=self._lost)
         assert self.observer is not None
-        self._heard_scans: list[Heard] = []
+        self._heard_scans = []
         answers = super().collect(scan, tick, may_be_ignored=may_be_ignored)
         _pair_with_driver_scans(answers, self._heard_scans)
         if answers.seen is None:
@@ -271,7 +271,8 @@ def _pair_with_driver_scans(answers: Answers, scans: list[Heard]) -> None:
     """
     if len(scans) < 2:
         return
-    groups = [Answers(seen=h.value, waited=answers.waited) for h in scans]
+    seen = [h.value for h in scans if isinstance(h.value, Scan)]
+    groups = [Answers(seen=scan, waited=answers.waited) for scan in seen]
     statuses = sorted(answers.statuses, key=lambda r: r.source_ns)
     for i, item in enumerate(statuses):
         groups[min(i, len(groups) - 1)].statuses.append(item)
@@ -284,5 +285,5 @@ def _pair_with_driver_scans(answers: Answers, scans: list[Heard]) -> None:
         )
         groups[min(nearest, len(groups) - 1)].warnings.append(item)
     answers.statuses, answers.warnings = groups[-1].statuses, groups[-1].warnings
-    answers.seen = scans[-1].value
-    answers.earlier = [(g.seen, g) for g in groups[:-1]]
+    answers.seen = seen[-1]
+    answers.earlier = list(zip(seen[:-1], groups[:-1], strict=True))

@@ -337,7 +337,9 @@ def _compose(items: Sequence[_Item], name: str) -> FaultProfile:
         by_kind[item.kind] = item
     convention = by_kind.pop("convention", Convention("rep117"))
     assert isinstance(convention, Convention)
-    link = tuple(f for f in by_kind.values() if f.kind in LINK_KINDS)
+    link_types = (Delay, Drop, Duplicate, Reorder, RateDrift, StaleStamps)
+    line_types = (LineCorruption, LineDrops, LineNoise)
+    link = tuple(f for f in by_kind.values() if isinstance(f, link_types + line_types))
     faults = tuple(f for f in by_kind.values() if isinstance(f, (Noise, Dropouts, Spurious)))
     return FaultProfile(faults=faults, convention=convention.name, name=name, link=LinkFaults(link))
 
