@@ -441,6 +441,8 @@ def _call_mapping(where: str, text: str) -> dict[str, Any]:
         key, eq, value = part.partition("=")
         if not eq or not key.strip():
             raise ConfigError(f"{where}: {text!r}: expected KEY=VALUE, got {part!r}")
+        if key.strip() in spec:
+            raise ConfigError(f"{where}: {text!r}: {key.strip()} given twice")
         spec[key.strip()] = _value(value.strip())
     return spec
 

@@ -98,6 +98,8 @@ def test_the_command_line_takes_inline_link_faults_and_reports_deliveries(tmp_pa
         ("delay(mean=0.1", "expected KIND(KEY=VALUE,...)"),
         ("delay(mean=3)", "delay mean must be in [0, 2] s, got 3"),
         ("rate_drift(min_hz=7)", "rate_drift min_hz (7) is above max_hz (6.7)"),
+        ("delay(mean=0.1,mean=0.2)", "'delay(mean=0.1,mean=0.2)': mean given twice"),
+        ("delay(mean=nan)", "faults[0].mean: must be a number, got 'nan'"),
         ("line_drops(rate=0.01)", "need a serial link (rplidar or ldlidar), not 'inprocess'"),
     ],
 )
