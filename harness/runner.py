@@ -10,7 +10,7 @@ from __future__ import annotations
 import time
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, replace
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -30,6 +30,10 @@ from harness.oracle import Oracle
 from harness.scan import Scan
 from harness.scenario import Scenario, check_run_length
 from harness.trace import RunResult, TickRecord
+
+if TYPE_CHECKING:
+    from harness.lidar_spec import LidarSpec
+    from harness.sim.simulation import SimTick
 
 
 @dataclass(frozen=True)
@@ -116,7 +120,13 @@ def run_scenario(
     return result
 
 
-def _emit(profile: FaultProfile, tick: Any, spec: Any, rng: Any, drifting: bool) -> Scan:
+def _emit(
+    profile: FaultProfile,
+    tick: SimTick,
+    spec: LidarSpec,
+    rng: np.random.Generator,
+    drifting: bool,
+) -> Scan:
     """The scan a driver publishes for one tick; a drifting rate also sets its timing fields."""
     scan = profile.emit(tick.truth, spec, rng, stamp=tick.t)
     if drifting:
