@@ -229,9 +229,7 @@ class BoardLink(Ros2Link):
 
     def _sort(self, answers: Answers, heard: Any, mine: Any) -> None:
         """Keep the driver's scans of this exchange, in order, for pairing."""
-        self._heard_scans = [
-            h for h in heard if h.kind == "scan" and h.source_ns >= self._scans_from
-        ]
+        self._heard_scans = self._driver_scans()  # `heard` is the inbox they are read from
         super()._sort(answers, heard, mine)
 
     # -- reporting and teardown ---------------------------------------------

@@ -61,8 +61,12 @@ def fault_profile(scenario: Scenario, settings: RunSettings) -> FaultProfile:
             check_run_length(scenario, profile)
         return profile
     except ConfigError as err:
-        where = "--faults" if settings.faults is not None else scenario.source
-        raise ConfigError(f"{where}: {err}") from None
+        raise ConfigError(f"{_faults_origin(scenario, settings)}: {err}") from None
+
+
+def _faults_origin(scenario: Scenario, settings: RunSettings) -> str:
+    """Where the run's faults were named, for error messages."""
+    return "--faults" if settings.faults is not None else scenario.source
 
 
 @dataclass(frozen=True)
@@ -106,8 +110,7 @@ def run_scenario(
     try:
         check_link_faults(profile.link, link)
     except ConfigError as err:
-        where = "--faults" if settings.faults is not None else scenario.source
-        raise ConfigError(f"{where}: {err}") from None
+        raise ConfigError(f"{_faults_origin(scenario, settings)}: {err}") from None
     drift = profile.link.get("rate_drift")
     periods = scan_periods(drift, scenario.lidar_spec.rate_hz, seed) if drift else None
     with Simulation(scenario, gui=settings.gui) as sim:
