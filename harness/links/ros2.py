@@ -114,8 +114,9 @@ class Ros2Link(Link):
             gone = self._node_gone("before it was ready")
             if gone:
                 raise LinkError(gone)
-            self._check_types()
-            if time.monotonic() >= deadline:
+            expired = time.monotonic() >= deadline
+            self._check_types(named_only=not expired)
+            if expired:
                 raise LinkError(
                     f"node {self.command.description} never became ready within "
                     f"{opts.ready_timeout:g} s: it must subscribe to {opts.scan_topic} and "
@@ -125,11 +126,15 @@ class Ros2Link(Link):
             self.observer.inbox.clear()  # nothing heard before it is ready is an answer
         self.startup_s = time.perf_counter() - started
 
-    def _check_types(self) -> None:
+    def _check_types(self, *, named_only: bool = False) -> None:
         """Fail at once, naming it, when the node publishes what can never reach the harness:
-        another message type on a topic, or best-effort where the harness needs reliable."""
+        another message type on a topic, or best-effort where the harness needs reliable.
+
+        With `named_only`, a wrong type waits until discovery has told which
+        node owns the endpoint, so the explanation can name it.
+        """
         assert self.observer is not None
-        wrong = self.observer.wrong_types()
+        wrong = self.observer.wrong_types(named_only=named_only)
         if wrong:
             raise LinkError(
                 f"node {self.command.description} uses the wrong message type: "
@@ -196,7 +201,13 @@ class Ros2Link(Link):
                 )
         if obs.node.count_publishers(opts.warning_topic) > 0:
             self._wait_for(lambda: obs.warning_publishers() > 0, WARM_UP_RETRY_S)
-        self._check_types()  # by now the node's other publishers are known too
+        # By now the node's other publishers are known too; give discovery a
+        # moment to tie a wrongly typed one to its node, so the error names it.
+        self._wait_for(
+            lambda: not obs.wrong_types() or bool(obs.wrong_types(named_only=True)),
+            WARM_UP_RETRY_S,
+        )
+        self._check_types()
         self._wait_for(lambda: False, self._grace())  # the answer's Bool, if any
         obs.drain()
         obs.inbox.clear()

@@ -38,6 +38,7 @@ INBOX_LIMIT = 10_000  # messages kept between two collects: more is a flood, not
 SCAN_TYPE = "sensor_msgs/msg/LaserScan"
 STATUS_TYPE = "std_msgs/msg/String"
 WARNING_TYPE = "std_msgs/msg/Bool"
+UNKNOWN_NODE_NAME = "_NODE_NAME_UNKNOWN_"  # what discovery says before it knows an endpoint's node
 PLUMBING = {"/rosout", "/parameter_events", "/clock"}  # every node has these; not worth naming
 
 
@@ -204,7 +205,9 @@ class Observer:
         me = (self.node.get_name(), self.node.get_namespace())
         return [i for i in infos if (i.node_name, i.node_namespace) != me]
 
-    def _wrong_type(self, topic: str, want: str, *, publishers: bool) -> str | None:
+    def _wrong_type(
+        self, topic: str, want: str, *, publishers: bool, named_only: bool
+    ) -> str | None:
         """'NODE publishes TOPIC as TYPE' when others use `topic` only with other types."""
         infos = self._others(
             self.node.get_publishers_info_by_topic(topic)
@@ -213,6 +216,8 @@ class Observer:
         )
         if not infos or any(i.topic_type == want for i in infos):
             return None
+        if named_only and any(i.node_name == UNKNOWN_NODE_NAME for i in infos):
+            return None  # discovery has the endpoint but not its node yet
         who = sorted(
             {
                 f"{_full_name(i)} {'publishes' if publishers else 'subscribes to'} "
@@ -224,19 +229,28 @@ class Observer:
             f"{', '.join(who)}, but the harness {'expects' if publishers else 'publishes'} {want}"
         )
 
-    def wrong_types(self) -> list[str]:
+    def wrong_types(self, *, named_only: bool = False) -> list[str]:
         """Topics the node under test uses with another message type than the harness.
 
         DDS connects a publisher and a subscription only if their types are
         the same, so nothing on such a topic ever crosses: say it, rather
-        than "never ready" or "no answer".
+        than "never ready" or "no answer". With `named_only`, a topic whose
+        endpoints discovery has not tied to a node yet is left for later.
         """
         checks = [
-            self._wrong_type(self.status_topic, STATUS_TYPE, publishers=True),
-            self._wrong_type(self.warning_topic, WARNING_TYPE, publishers=True),
+            self._wrong_type(
+                self.status_topic, STATUS_TYPE, publishers=True, named_only=named_only
+            ),
+            self._wrong_type(
+                self.warning_topic, WARNING_TYPE, publishers=True, named_only=named_only
+            ),
         ]
         if self.scan_pub is not None:
-            checks.append(self._wrong_type(self.scan_topic, SCAN_TYPE, publishers=False))
+            checks.append(
+                self._wrong_type(
+                    self.scan_topic, SCAN_TYPE, publishers=False, named_only=named_only
+                )
+            )
         return [c for c in checks if c is not None]
 
     def qos_mismatches(self) -> list[str]:
@@ -301,7 +315,7 @@ class Observer:
 
 def _full_name(info: TopicEndpointInfo) -> str:
     """The endpoint's node, e.g. /fossbot_lidar_node (DDS may know the endpoint first)."""
-    if info.node_name == "_NODE_NAME_UNKNOWN_":
+    if info.node_name == UNKNOWN_NODE_NAME:
         return "the node"
     return f"{info.node_namespace.rstrip('/')}/{info.node_name}"
 
