@@ -20,7 +20,7 @@ if it had to be killed.
 from __future__ import annotations
 
 import time
-from collections import Counter, deque
+from collections import deque
 from collections.abc import Callable, Iterable
 
 from harness.answers import Answers, Received
@@ -93,9 +93,10 @@ class Ros2Link(Link):
         self._bool_after_gap = 0.0  # longest String -> Bool gap seen, seconds
         self._silent_scans = 0
         self._alive_until = 0.0  # perf_counter until which the node counts as running
-        self._counted: Counter[str] = Counter()  # observer.heard when the last collect ended
+        self._counted = (0, 0)  # statuses and Bools heard, all told, when the last collect ended
         self._warmed_up = False
-        self._recent: deque[tuple[Counter[str], float]] = deque(maxlen=FLOOD_SCANS)
+        # (statuses, Bools, seconds) of each recent exchange, for flood checks
+        self._recent: deque[tuple[int, int, float]] = deque(maxlen=FLOOD_SCANS)
         self.startup_s = 0.0
 
     # -- life cycle -------------------------------------------------------
@@ -211,7 +212,7 @@ class Ros2Link(Link):
         self._wait_for(lambda: False, self._grace())  # the answer's Bool, if any
         obs.drain()
         obs.inbox.clear()
-        self._counted = Counter(obs.heard)
+        self._counted = (obs.heard["status"], obs.heard["warning"])
         self._warmed_up = True
 
     def close(self) -> None:
@@ -386,15 +387,22 @@ class Ros2Link(Link):
     def _watch_flood(self, answers: Answers) -> None:
         """End the run when the node publishes far more than one message a scan on a topic."""
         assert self.observer is not None
-        heard = Counter(self.observer.heard)
-        self._recent.append((heard - self._counted, time.perf_counter() - self._sent_at))
-        self._counted = heard
+        heard = self.observer.heard
+        statuses, bools = heard["status"], heard["warning"]
+        self._recent.append(
+            (
+                statuses - self._counted[0],
+                bools - self._counted[1],
+                time.perf_counter() - self._sent_at,
+            )
+        )
+        self._counted = (statuses, bools)
         if answers.problem is not None:
             return
-        topics = {"status": self.options.status_topic, "warning": self.options.warning_topic}
-        for kind, topic in topics.items():
-            count = sum(counts[kind] for counts, _ in self._recent)
-            seconds = sum(s for _, s in self._recent)
+        seconds = sum(recent[2] for recent in self._recent)
+        topics = (self.options.status_topic, self.options.warning_topic)
+        for which, topic in enumerate(topics):
+            count = sum(recent[which] for recent in self._recent)
             many = count >= FLOOD_MIN and count > FLOOD_PER_SCAN * len(self._recent)
             if many and count >= FLOOD_RATE_HZ * seconds:
                 answers.problem = (

@@ -34,8 +34,8 @@ def scan_message(scan: Scan) -> LaserScan:
     msg.scan_time = float(scan.scan_time)
     msg.range_min = float(scan.range_min)
     msg.range_max = float(scan.range_max)
-    msg.ranges = array.array("f", scan.ranges.astype(np.float32).tobytes())
-    msg.intensities = array.array("f", scan.intensities.astype(np.float32).tobytes())
+    msg.ranges = array.array("f", scan.ranges.astype(np.float32, copy=False).tobytes())
+    msg.intensities = array.array("f", scan.intensities.astype(np.float32, copy=False).tobytes())
     return msg
 
 
