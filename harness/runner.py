@@ -159,6 +159,7 @@ def judge_frames(
     *,
     on_tick: Callable[[TickRecord], None] | None = None,
     link_faults: LinkFaults = NO_LINK_FAULTS,
+    diagnose: bool = True,
 ) -> RunResult:
     """Deliver each frame's scan through an opened `link`; judge and record every tick.
 
@@ -166,8 +167,17 @@ def judge_frames(
     judged the same way. `link_faults` decide how each scan travels (late,
     dropped, twice, out of order, stale); the oracle is told, so a dropped
     scan expects no answer and a late one is timed from when it went out.
+    With `diagnose`, the link's diagnostics end the run (which stops a node
+    process); without, the link stays usable for another run.
     """
+    # A tick waits in `pending` until the next scan's exchange is over:
+    # answers to scan k that arrive after scan k+1 was sent (a Bool published
+    # after the String, a second String) still count for scan k. Its answers
+    # then complete, it moves to `ready` and is judged while the node works
+    # on the scan after (the script never depends on verdicts, so lockstep is
+    # unchanged and the oracle's time is off the round trip).
     pending: list[tuple[Frame, Answers, Delivery]] = []  # frames carry the scans as sent
+    ready: list[tuple[Frame, Answers, Delivery]] = []
 
     def judge(frame: Frame, answers: Answers, delivery: Delivery) -> None:
         # Judge against what the node saw: over a serial link that is the
@@ -189,17 +199,20 @@ def judge_frames(
         if on_tick is not None:
             on_tick(record)
 
-    def judge_pending(late: list[Received]) -> list[Received]:
+    def judge_ready() -> None:
+        for held in ready:
+            judge(*held)
+        ready.clear()
+
+    def complete_pending(late: list[Received]) -> list[Received]:
+        """Give the pending ticks their late answers; they are ready to judge."""
         for frame, answers, delivery in pending:
             if delivery.delivered:
                 late = answers.take_late(late, frame.tick)
-            judge(frame, answers, delivery)
+        ready.extend(pending)
         pending.clear()
         return late
 
-    # Each tick is judged once the next scan's exchange is over: answers to
-    # scan k that arrive after scan k+1 was sent (a Bool published after the
-    # String, a second String) still count for scan k.
     warmed = False
     planned = iter(plan_deliveries(frames, link_faults, result.seed))
     upcoming = next(planned, None)
@@ -221,20 +234,24 @@ def judge_frames(
             if delivery.delay_s:
                 link.hold(delivery.delay_s)
             link.send(scan, frame.tick, clock=frame.t)
-            # While the node works on this scan, simulate the next one (the
-            # script never depends on answers, so lockstep is unchanged).
+            # While the node works on this scan, judge the ticks that are
+            # complete and simulate the next one.
+            judge_ready()
             upcoming = next(planned, None)
             answers = link.collect(scan, frame.tick, may_be_ignored=delivery.may_be_ignored)
         except LinkError as err:  # the line or graph broke: end here, keep what we have
             result.error = f"t={frame.t:.2f} s tick {frame.tick}: {err}"
             break
-        answers.late = judge_pending(answers.late)
+        answers.late = complete_pending(answers.late)
         pending.append((replace(frame, scan=scan), answers, delivery))
         if answers.problem is not None:  # the node died or went silent: nothing more to judge
             result.error = f"t={frame.t:.2f} s tick {frame.tick}: {answers.problem}"
             break
-    judge_pending(link.settle())
-    result.diagnostics = link.diagnostics()
+    judge_ready()
+    complete_pending(link.settle())
+    judge_ready()
+    if diagnose:
+        result.diagnostics = link.diagnostics()
     return result
 
 
