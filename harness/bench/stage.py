@@ -63,9 +63,10 @@ def run_through(
 
     The first scan is exchanged once as a warm-up before the clock starts
     (judge_frames warms up again: one more exchange, inside the timing, as
-    in every run). The clock stops at the last judged tick, before the link
-    reports its diagnostics (which stops a node process); `at_end` is
-    called then, e.g. to read the node's CPU time while it still runs.
+    in every run). The clock stops at the last judged tick; `at_end` is
+    called then, e.g. to read the node's CPU time. The link's diagnostics
+    are not asked for (they stop a node process), so the link can run the
+    workload again.
     Building and closing worlds between runs is taken out. CPU time is
     taken over the same stretch: on a shared machine it moves less than
     wall time.
@@ -102,7 +103,7 @@ def run_through(
         setup, setup_cpu = frames.setup_s, frames.setup_cpu_s
         cpu_started = time.process_time()
         started = time.perf_counter()
-        judge_frames(all_frames(), link, oracle, result, on_tick=on_tick)
+        judge_frames(all_frames(), link, oracle, result, on_tick=on_tick, diagnose=False)
     if not judged_at:
         return LinkRun(result, 0.0, judged_at)
     seconds = judged_at[-1] - started - (end["setup"] - setup)
