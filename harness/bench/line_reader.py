@@ -3,9 +3,13 @@
 Run as ``python -m harness.bench.line_reader PTY SECONDS``: opens the pty's
 slave, sends an RPLIDAR SCAN request, and reads until the line closes or
 SECONDS pass, recording the monotonic time and size of every read. Prints
-one JSON object: ``{"reads": [[t, n], ...], "data": "<hex>"}``. A separate
-process, as the board's driver is: the harness's threads (and its GIL)
-do not delay the reads it times. Standard library only, so it starts fast.
+one JSON object: ``{"reads": [[t, n], ...], "data": "<hex>", "realtime": bool}``.
+A separate process, as the board's driver is: the harness's threads (and its
+GIL) do not delay the reads it times. Where the system allows it, the
+reader runs under SCHED_FIFO (``harness.realtime_priority``), as a board's
+UART interrupt would: then its read times are the line's, not the moments
+the scheduler got round to waking it; ``realtime`` says whether it did.
+Standard library only, so it starts fast.
 """
 
 from __future__ import annotations
@@ -15,6 +19,8 @@ import os
 import select
 import sys
 import time
+
+from harness.realtime_priority import raise_to_realtime
 
 SCAN_REQUEST = bytes((0xA5, 0x20))
 POLL_S = 0.05
@@ -50,8 +56,9 @@ def main(argv: list[str]) -> int:
     if len(argv) != 2:
         print("usage: python -m harness.bench.line_reader PTY SECONDS", file=sys.stderr)
         return 2
+    realtime = raise_to_realtime()
     reads, data = read_line(argv[0], float(argv[1]))
-    json.dump({"reads": reads, "data": data.hex()}, sys.stdout)
+    json.dump({"reads": reads, "data": data.hex(), "realtime": realtime}, sys.stdout)
     return 0
 
 

@@ -106,6 +106,7 @@ def measure_pacing(scenario: Scenario, seconds: float) -> StageResult:
                 raise LinkError("the last revolution did not finish within two periods")
             stats = server.stats()
             written = [d.started_at for d in server.deliveries()]
+            pacer_realtime = bool(server.realtime_priority)
         port.close()  # the reader sees the line close and reports
         out, err = reader.communicate(timeout=seconds + READER_SLACK_S)
     finally:
@@ -141,6 +142,8 @@ def measure_pacing(scenario: Scenario, seconds: float) -> StageResult:
             "baudrate": profile.baudrate,
             "period_ms": period * 1000.0,
             "revolution_bytes": rev_bytes,
+            "reader_realtime": bool(seen.get("realtime")),
+            "pacer_realtime": pacer_realtime,
             "reader_rate_error_pct": (rate / nominal - 1.0) * 100.0 if rate else None,
             "reader_jitter_p99_ms": jitter_p99_ms(seen_starts, period),
             "reader_jitter_median_ms": median(reader_jitter) if reader_jitter else None,

@@ -61,6 +61,7 @@ from dataclasses import dataclass
 from typing import Any, Literal
 
 from harness.errors import LinkError
+from harness.realtime_priority import raise_to_realtime
 from harness.serial_line.pacing import LinePacer, PacingReport
 from harness.serial_line.ports import DevicePort
 
@@ -184,6 +185,8 @@ class DeviceServer:
         self._thread = threading.Thread(target=self._run, name="serial-device-server", daemon=True)
         self._started = False
         self._closed = False
+        # Realtime mode: whether the server thread got SCHED_FIFO (None until it runs).
+        self.realtime_priority: bool | None = None
         self._error: LinkError | None = None
         self._error_raised = False
         if port.paced_by_hardware:
@@ -402,6 +405,8 @@ class DeviceServer:
 
     def _run(self) -> None:
         try:
+            if self.mode == "realtime":
+                self.realtime_priority = raise_to_realtime()
             set_motor = getattr(self.device, "set_motor", None)
             if set_motor is not None and self.motor_on_without_dtr:
                 if not self.follow_dtr or self.port.dtr_asserted() is None:

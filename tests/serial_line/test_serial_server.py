@@ -435,3 +435,20 @@ def test_close_is_bounded_and_idempotent(pty: PtyPort, board: Board) -> None:
     server.close()
     with pytest.raises(LinkError, match="closed"):
         server.send_revolution(revolution(1, 1), 1)
+
+
+def test_realtime_server_thread_asks_for_sched_fifo(pty: PtyPort) -> None:
+    """Where Linux allows it, only the server thread runs SCHED_FIFO; the caller stays ordinary."""
+    with DeviceServer(StandIn(), pty, mode="realtime", revolution_period_s=0.1) as server:
+        deadline = time.monotonic() + 2.0
+        while server.realtime_priority is None and time.monotonic() < deadline:
+            time.sleep(0.01)
+        granted = server.realtime_priority
+        thread_id = server._thread.native_id
+        policy = os.sched_getscheduler(thread_id) if thread_id else None
+    assert granted is not None, "the server thread never ran"
+    assert (policy == os.SCHED_FIFO) is granted
+    assert os.sched_getscheduler(0) == os.SCHED_OTHER
+    with DeviceServer(StandIn(), pty, mode="lockstep") as server:
+        pass
+    assert server.realtime_priority is None  # lockstep has no line timing to protect
