@@ -10,7 +10,7 @@ every read. Figures, at the reader (what the board sees):
   stretch, over the nominal 115200 / 10 bytes per second, minus 1, in %;
 - period jitter p99: nearest-rank p99 of |start-to-start interval - period|
   of the revolutions' start nodes, in ms (with under 100 intervals, the
-  maximum: the full bench streams 150 revolutions), and the maximum beside it.
+  maximum: the full bench streams 300 revolutions), and the maximum beside it.
 
 The pacer's own view (write times) is reported beside them. Revolutions are
 handed over one period ahead of their slot, as a real-time producer should,
