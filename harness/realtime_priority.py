@@ -5,9 +5,10 @@ millisecond, but an ordinary thread on a busy two-core machine can wait
 several milliseconds for a core: with two CPU hogs beside it, revolution
 starts came up to 10 ms late. A SCHED_FIFO thread runs as soon as it is
 woken. The priority is low among real-time ones (above every ordinary
-process, below the kernel's own threads), and the threads that ask for it
-spend their time blocked in select, so they cannot starve the machine
-(Linux also caps real-time threads at 95 % of a core by default).
+thread, below the kernel's real-time threads such as migration and the
+watchdog), and the threads that ask for it spend their time blocked in
+select, so they cannot starve the machine (Linux also caps real-time
+threads at 95 % of a core by default).
 
 Standard library only: the bench's line reader imports it at start.
 """
