@@ -8,17 +8,20 @@ harness (``Received.after`` of the first status), measured on its own by
 exchanging one scan 100 times before the timed run (in a run, the harness
 simulates the next scan while the node answers, which hides part of the
 round trip and delays taking the answer; that in-run figure is reported
-beside it).
+beside it). Three rounds on one open link, each measuring the ray-casting
+floor again just before it, so the overhead compares costs measured at
+the same moment.
 """
 
 from __future__ import annotations
 
 import os
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 
 from harness.bench.stage import LinkRun, StageResult, run_through, simulated_seconds
-from harness.bench.stats import median, percentile
+from harness.bench.stats import median, overhead_ratio, percentile
 from harness.bench.workload import Workload, prepared_frames
 from harness.links.base import Link, LinkOptions, create_link
 
@@ -97,13 +100,27 @@ class _Round:
     pings: list[float]
     run: LinkRun
     node_cpu_s: list[float | None]  # per process in _node_pids, over the run
+    floor_s: float | None = None  # ray casting per scan, measured just before the round
 
     @property
     def scan_s(self) -> float:
         return self.run.seconds / max(1, len(self.run.result.records))
 
+    @property
+    def overhead(self) -> float | None:
+        """The round's time per scan beyond its own floor and its own median round trip."""
+        if self.floor_s is None or not self.pings:
+            return None
+        return overhead_ratio(self.scan_s, self.floor_s, median(self.pings))
 
-def _measure_round(link: Link, workload: Workload, pids: list[int | None]) -> _Round:
+
+def _measure_round(
+    link: Link,
+    workload: Workload,
+    pids: list[int | None],
+    floor: Callable[[], float] | None,
+) -> _Round:
+    floor_s = floor() if floor is not None else None
     pings = ping_pong_s(link, workload)
     before = [process_cpu_s(pid) for pid in pids]
     after: list[float | None] = []
@@ -116,16 +133,24 @@ def _measure_round(link: Link, workload: Workload, pids: list[int | None]) -> _R
         b - a if a is not None and b is not None else None
         for a, b in zip(before, after or [None] * len(before), strict=True)
     ]
-    return _Round(pings, run, cpu)
+    return _Round(pings, run, cpu, floor_s)
 
 
-def measure_link(link_name: str, workload: Workload, rounds: int = 1) -> StageResult:
+def measure_link(
+    link_name: str,
+    workload: Workload,
+    rounds: int = 1,
+    floor: Callable[[], float] | None = None,
+) -> StageResult:
     """Open `link_name` with the reference node, run the workload through it, close it.
 
     With several `rounds` (each: the ping-pong, then the timed run, on the
     same open link), the round whose time per scan is the median is
     reported and the round trip is the median of all the exchanges: one
-    round slowed by the machine's other work then moves neither.
+    round slowed by the machine's other work then moves neither. With
+    `floor` (seconds of ray casting per scan), each round first measures
+    its floor, and the overhead is each round's own figure, the median
+    kept: floor, round trip and lockstep then share the machine's moment.
     """
     options = LinkOptions(threshold=workload.threshold, scan_rate_hz=workload.scan_rate_hz)
     link = create_link(link_name, options)
@@ -136,7 +161,7 @@ def measure_link(link_name: str, workload: Workload, rounds: int = 1) -> StageRe
         opened_s = time.perf_counter() - started
         pids = _node_pids(link)
         for _ in range(rounds):
-            done.append(_measure_round(link, workload, pids))
+            done.append(_measure_round(link, workload, pids, floor))
         peaks = [process_peak_rss_mb(pid) for pid in pids]
         startup_s = getattr(link, "startup_s", opened_s)
     finally:
@@ -153,6 +178,8 @@ def measure_link(link_name: str, workload: Workload, rounds: int = 1) -> StageRe
     trips = [t * 1000.0 for r in done for t in r.pings]
     in_run = [t * 1000.0 for t in round_trips_s(run)]
     waits = [w * 1000.0 for w in waits_s(run)]
+    overheads = [r.overhead for r in done if r.overhead is not None]
+    floors = [r.floor_s * 1000.0 for r in done if r.floor_s is not None]
     return StageResult(
         link_name,
         scans,
@@ -169,6 +196,9 @@ def measure_link(link_name: str, workload: Workload, rounds: int = 1) -> StageRe
             "close_s": closed_s,
             "rounds": rounds,
             "round_scans_per_s": ", ".join(f"{1.0 / r.scan_s:.0f}" for r in done),
+            "round_raycast_ms": ", ".join(f"{f:.3f}" for f in floors) or None,
+            "round_overhead_ratios": ", ".join(f"{o:.3f}" for o in overheads) or None,
+            "overhead_ratio": median(overheads) if overheads else None,
             "round_trip_ms_median": median(trips) if trips else None,
             "round_trip_ms_p99": percentile(trips, 99) if trips else None,
             "round_trip_in_run_ms_median": median(in_run) if in_run else None,
@@ -182,5 +212,7 @@ def measure_link(link_name: str, workload: Workload, rounds: int = 1) -> StageRe
 
 
 def measure_ros2(workload: Workload, rounds: int = ROUNDS) -> StageResult:
-    """The ros2 link: the harness publishes /scan to the node."""
-    return measure_link("ros2", workload, rounds)
+    """The ros2 link: the harness publishes /scan to the node; each round measures its floor."""
+    from harness.bench.raycast import measure_raycast
+
+    return measure_link("ros2", workload, rounds, floor=lambda: measure_raycast(workload).scan_s)

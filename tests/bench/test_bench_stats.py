@@ -85,13 +85,20 @@ def test_figures_ratios_and_targets() -> None:
     stages = {
         "raycast": stage("raycast", 100, 0.05, truth_ms=0.6),
         "inprocess": stage("inprocess", 100, 0.1),
-        "ros2": stage("ros2", 100, 0.3, round_trip_ms_median=1.0, round_trip_ms_p99=2.0),
+        "ros2": stage(
+            "ros2",
+            100,
+            0.3,
+            round_trip_ms_median=1.0,
+            round_trip_ms_p99=2.0,
+            overhead_ratio=overhead_ratio(0.003, 0.0005, 0.001),
+        ),
     }
     values = figures(stages, 300.0)
     assert values["raycast_scans_per_s"] == pytest.approx(2000.0)
     assert values["ratio_to_raycast"]["ros2_lockstep"] == pytest.approx(6.0)
     assert values["real_time_factor"]["inprocess"] == pytest.approx(100.0)
-    # 3 ms a scan, 0.5 ms ray casting, 1 ms round trip: (3 - 1.5) / 1.5.
+    # 3 ms a scan, 0.5 ms ray casting, 1 ms round trip: (3 - 1.5) / 1.5, as the stage said.
     assert values["overhead_ratio"] == pytest.approx(1.0)
     assert values["serial_lockstep_scans_per_s"] is None
     targets = {t["key"]: t["met"] for t in check_targets(values)}
