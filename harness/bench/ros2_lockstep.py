@@ -106,6 +106,10 @@ class _Round:
     def scan_s(self) -> float:
         return self.run.seconds / max(1, len(self.run.result.records))
 
+    def describe_rate(self) -> str:
+        """Scans per second, or 'none' for a round that judged no scan."""
+        return f"{1.0 / self.scan_s:.0f}" if self.scan_s > 0 else "none"
+
     @property
     def overhead(self) -> float | None:
         """The round's time per scan beyond its own floor and its own median round trip."""
@@ -195,7 +199,7 @@ def measure_link(
             "open_s": opened_s,
             "close_s": closed_s,
             "rounds": rounds,
-            "round_scans_per_s": ", ".join(f"{1.0 / r.scan_s:.0f}" for r in done),
+            "round_scans_per_s": ", ".join(r.describe_rate() for r in done),
             "round_raycast_ms": ", ".join(f"{f:.3f}" for f in floors) or None,
             "round_overhead_ratios": ", ".join(f"{o:.3f}" for o in overheads) or None,
             "overhead_ratio": median(overheads) if overheads else None,
