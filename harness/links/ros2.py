@@ -414,6 +414,7 @@ class Ros2Link(Link):
     def _sort(self, answers: Answers, heard: Iterable[Heard], mine) -> None:
         """Split what arrived into this scan's answers and late ones; learn the Bool order."""
         first_status = next((h for h in heard if h.kind == "status" and mine(h)), None)
+        string_first = self._bool_after_gap > 0 and not self._bool_first_seen
         for h in heard:
             if h.kind == "scan":
                 continue  # a driver's scan (serial links): not an answer
@@ -422,6 +423,16 @@ class Ros2Link(Link):
                 answers.late.append(Received(h.value, item.after, self._tick_of(h.source_ns)))
             elif h.kind == "status":
                 answers.statuses.append(item)
+            elif (
+                string_first
+                and first_status is not None
+                and h.source_ns < first_status.source_ns
+                and len(self._sends) > 1
+            ):
+                # A node that publishes its Bool after its String, caught
+                # between the two (a busy thread holding its GIL) until this
+                # scan had gone out: the Bool answers the scan before.
+                answers.late.append(Received(h.value, item.after, self._sends[-2][0]))
             else:
                 answers.warnings.append(item)
                 if first_status is not None:

@@ -156,6 +156,24 @@ def flood_output(pids: Path | None) -> Node:
     return Answering()
 
 
+def bool_held_up(pids: Path | None) -> Node:
+    """String first, then the Bool; every fifth scan the Bool comes 50 ms after the String
+    (a busy thread in the node), by which time the harness has sent the next scan."""
+    node = Answering()
+    count = 0
+
+    def answer(text: str, warning: bool) -> None:
+        nonlocal count
+        count += 1
+        node.status_pub.publish(String(data=text))
+        if count % 5 == 0:
+            time.sleep(0.05)
+        node.warning_pub.publish(Bool(data=warning))
+
+    node.answer = answer
+    return node
+
+
 def status_as_bool(pids: Path | None) -> Node:
     """Publishes a Bool on the status topic (and no String anywhere)."""
     node = Answering(status_type=Bool)
@@ -264,6 +282,7 @@ VARIANTS: dict[str, Callable[[Path | None], Node]] = {
         flood_output,
         status_as_bool,
         warning_as_int32,
+        bool_held_up,
         best_effort,
         status_topic_wrong,
         status_parameter_ignored,

@@ -168,6 +168,16 @@ def test_output_flood_is_drained_and_only_its_tail_kept(pids: Path) -> None:
     assert survivors(pids) == []
 
 
+def test_a_bool_held_up_in_the_node_still_answers_its_scan(pids: Path) -> None:
+    """A Bool published after the next scan went out, but before the node's next String,
+    answers the scan before: no 'got no Bool' here and two Bools there."""
+    result = hostile_api("bool_held_up", pids)
+    assert result.ok, result.first_failure
+    assert len(result.records) >= 15
+    assert [len(r.answers.warnings) for r in result.records] == [1] * len(result.records)
+    assert survivors(pids) == []
+
+
 @pytest.mark.parametrize(
     ("variant", "wrong"),
     [
