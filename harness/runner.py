@@ -247,8 +247,7 @@ def judge_frames(
         if answers.problem is not None:  # the node died or went silent: nothing more to judge
             result.error = f"t={frame.t:.2f} s tick {frame.tick}: {answers.problem}"
             break
-    judge_ready()
-    complete_pending(link.settle())
+    complete_pending(link.settle())  # ready ticks stay ahead of the pending ones
     judge_ready()
     if diagnose:
         result.diagnostics = link.diagnostics()
