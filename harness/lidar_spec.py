@@ -12,6 +12,11 @@ from dataclasses import dataclass, replace
 
 from harness.errors import ConfigError
 
+# rad: how far a layout may pass one turn (or +-2 pi) by rounding: an
+# angle_increment taken from a float32 LaserScan, times 16383 beams, is off by
+# well under this; a typed increment of 6 significant digits may be more.
+ANGLE_TOLERANCE = 1e-5
+
 
 @dataclass(frozen=True)
 class LidarSpec:
@@ -45,7 +50,13 @@ class LidarSpec:
         return spec
 
     def check(self) -> None:
-        """Refuse layouts no real sensor has."""
+        """Refuse layouts no real sensor has.
+
+        The beams cover at most one turn ((samples - 1) x angle_increment
+        <= 2 pi: Gazebo's closed layout, first and last beam at the same
+        angle, is the most), and every beam angle lies within +-2 pi, where
+        the oracle's "any wrap" comparison of angles holds.
+        """
         if not 1 <= self.samples <= 16383:
             raise ConfigError(f"lidar samples must be 1..16383, got {self.samples}")
         if not (0 < self.range_min < self.range_max):
@@ -56,6 +67,22 @@ class LidarSpec:
             raise ConfigError(f"lidar rate_hz must be positive, got {self.rate_hz}")
         if not self.angle_increment > 0:
             raise ConfigError(f"lidar angle_increment must be positive, got {self.angle_increment}")
+        turn = 2 * math.pi
+        span = (self.samples - 1) * self.angle_increment
+        if span > turn + ANGLE_TOLERANCE:
+            raise ConfigError(
+                f"the beams span (samples - 1) x angle_increment = {self.samples - 1} x "
+                f"{self.angle_increment:.6g} = {span:.6g} rad, more than one turn "
+                f"(2 pi = {turn:.6g} rad): fewer samples or a smaller angle_increment"
+            )
+        if not -turn - ANGLE_TOLERANCE <= self.angle_min <= turn + ANGLE_TOLERANCE:
+            raise ConfigError(f"angle_min must be within +-2 pi, got {self.angle_min:.6g} rad")
+        if self.angle_max > turn + ANGLE_TOLERANCE:
+            raise ConfigError(
+                f"the last beam's angle, angle_min + (samples - 1) x angle_increment = "
+                f"{self.angle_min:.6g} + {span:.6g} = {self.angle_max:.6g} rad, is beyond 2 pi "
+                f"({turn:.6g}); beam angles must stay within +-2 pi (a smaller angle_min)"
+            )
 
 
 def _full_circle(samples: int, *, closed: bool) -> float:

@@ -35,7 +35,8 @@ from harness.errors import ConfigError
 from harness.faults import FaultProfile, build_profile
 from harness.lidar_spec import PRESETS, LidarSpec, preset
 from harness.messages import shown
-from harness.model_files import check_model_file, find_model_file, robot_models_dir
+from harness.model_files import _parse_xml, check_model_file, find_model_file, robot_models_dir
+from harness.sim.footprint import Outline, disc, overlap, rectangle, robot_outlines
 from harness.sim.geometry import cylinder_segments
 
 SCENARIO_SUFFIXES = (".yaml", ".yml")
@@ -57,6 +58,7 @@ MAX_COORDINATE = 1000.0  # m, |x| and |y| of anything placed in the world
 MIN_SIZE, MAX_SIZE = 0.001, 100.0  # m, sizes of walls, boxes and cylinders
 MAX_RANGE = 100.0  # m, LIDAR range_max, the threshold and obstacle conditions
 MAX_PATH = 1024  # characters of a model path
+START_OVERLAP = 0.005  # m the robot may overlap an obstacle where it starts (touching, rounding)
 WHEEL_JOINTS = ("left_wheel_joint", "right_wheel_joint")  # what wheels mode drives
 
 
@@ -74,29 +76,76 @@ def _printable(value: str) -> str:
     return value
 
 
-def _not_bool(value: Any) -> Any:
-    """YAML's true/false are not numbers, though Python's bool is an int."""
-    if isinstance(value, bool):
+# Text that looks like a number: `"0.5"`, or YAML 1.1 forms YAML 1.2 reads as text (`1_000`).
+_NUMERIC_TEXT = re.compile(r"\s*[-+]?\.?[0-9]")
+
+
+def _text_hint(text: str) -> str:
+    """Why `text`, which looks like a number, is text."""
+    if "_" in text:
+        return "YAML 1.2 numbers have no _"
+    if ":" in text:
+        return "YAML 1.2 reads 1:20 as text, not 80"
+    if re.match(r"\s*[-+]?0[0-9]", text) and _INT_1_2.match(text.strip().lstrip("+-0") or "0"):
+        return "a leading 0 is octal in YAML 1.1, not in 1.2: write 10, or 0o12 for octal"
+    if _INT_1_2.match(text) or _FLOAT_1_2.match(text):
+        return "quoted, so text: write it without quotes"
+    return "not a number as YAML 1.2 writes one"
+
+
+def _number(value: Any) -> Any:
+    """A number as YAML 1.2 writes it: not true/false, not text however much it looks like one.
+
+    An int is a number (`threshold: 1`); a float field then takes it as 1.0.
+    """
+    if isinstance(value, bool):  # Python's bool is an int
         raise ValueError(f"must be a number, got {str(value).lower()}")
+    if isinstance(value, str):
+        if _NUMERIC_TEXT.match(value):
+            raise ValueError(f"must be a number, got text {value[:40]!r} ({_text_hint(value)})")
+        raise ValueError("Input should be a valid number, unable to parse string as a number")
     return value
 
 
-_NotBool = BeforeValidator(_not_bool)
-Finite = Annotated[float, _NotBool, Field(allow_inf_nan=False)]
-Positive = Annotated[float, _NotBool, Field(gt=0, allow_inf_nan=False)]
+def _whole(value: Any) -> Any:
+    """A whole number written as one: `360`, not `360.0`, `3.6e2` or `"360"`."""
+    if isinstance(value, bool):
+        raise ValueError(f"must be a whole number, got {str(value).lower()}")
+    if isinstance(value, float):
+        raise ValueError(f"must be a whole number, got {value!r}")
+    if isinstance(value, str):
+        if _NUMERIC_TEXT.match(value):
+            hint = _text_hint(value)
+            raise ValueError(f"must be a whole number, got text {value[:40]!r} ({hint})")
+        raise ValueError("Input should be a valid integer, unable to parse string as an integer")
+    return value
+
+
+# Strict: pydantic converts nothing (no text to number, no 360.0 to 360); the
+# validators before it say what is wrong in words.
+_Number = BeforeValidator(_number)
+_Whole = BeforeValidator(_whole)
+Finite = Annotated[float, _Number, Field(strict=True, allow_inf_nan=False)]
+Positive = Annotated[float, _Number, Field(strict=True, gt=0, allow_inf_nan=False)]
 Coordinate = Annotated[
-    float, _NotBool, Field(ge=-MAX_COORDINATE, le=MAX_COORDINATE, allow_inf_nan=False)
+    float,
+    _Number,
+    Field(strict=True, ge=-MAX_COORDINATE, le=MAX_COORDINATE, allow_inf_nan=False),
 ]
-Size = Annotated[float, _NotBool, Field(ge=MIN_SIZE, le=MAX_SIZE, allow_inf_nan=False)]
-Range = Annotated[float, _NotBool, Field(gt=0, le=MAX_RANGE, allow_inf_nan=False)]
-Angle = Annotated[float, _NotBool, Field(ge=-2 * math.pi, le=2 * math.pi, allow_inf_nan=False)]
-Increment = Annotated[float, _NotBool, Field(gt=0, le=2 * math.pi, allow_inf_nan=False)]
-Rate = Annotated[float, _NotBool, Field(ge=1, le=100, allow_inf_nan=False)]
-Timeout = Annotated[float, _NotBool, Field(gt=0, le=MAX_SEGMENT_SECONDS, allow_inf_nan=False)]
-Linear = Annotated[float, _NotBool, Field(ge=-2.0, le=2.0, allow_inf_nan=False)]
-Angular = Annotated[float, _NotBool, Field(ge=-10.0, le=10.0, allow_inf_nan=False)]
-Samples = Annotated[int, _NotBool, Field(ge=1, le=16383)]
-Seed = Annotated[int, _NotBool, Field(ge=0, le=2**32 - 1)]
+Size = Annotated[float, _Number, Field(strict=True, ge=MIN_SIZE, le=MAX_SIZE, allow_inf_nan=False)]
+Range = Annotated[float, _Number, Field(strict=True, gt=0, le=MAX_RANGE, allow_inf_nan=False)]
+Angle = Annotated[
+    float, _Number, Field(strict=True, ge=-2 * math.pi, le=2 * math.pi, allow_inf_nan=False)
+]
+Increment = Annotated[float, _Number, Field(strict=True, gt=0, le=2 * math.pi, allow_inf_nan=False)]
+Rate = Annotated[float, _Number, Field(strict=True, ge=1, le=100, allow_inf_nan=False)]
+Timeout = Annotated[
+    float, _Number, Field(strict=True, gt=0, le=MAX_SEGMENT_SECONDS, allow_inf_nan=False)
+]
+Linear = Annotated[float, _Number, Field(strict=True, ge=-2.0, le=2.0, allow_inf_nan=False)]
+Angular = Annotated[float, _Number, Field(strict=True, ge=-10.0, le=10.0, allow_inf_nan=False)]
+Samples = Annotated[int, _Whole, Field(strict=True, ge=1, le=16383)]
+Seed = Annotated[int, _Whole, Field(strict=True, ge=0, le=2**32 - 1)]
 Point2 = tuple[Coordinate, Coordinate]
 Text = Annotated[str, AfterValidator(_printable)]
 ModelPath = Annotated[str, Field(min_length=1, max_length=MAX_PATH), AfterValidator(_printable)]
@@ -155,6 +204,10 @@ class LidarConfig(_Strict):
         )
 
 
+def _xy(point: Sequence[float]) -> str:
+    return f"({point[0]:.2f}, {point[1]:.2f})"
+
+
 class Wall(_Strict):
     """A straight wall between two floor points."""
 
@@ -170,6 +223,16 @@ class Wall(_Strict):
             raise ValueError("start and end must differ")
         return self
 
+    def outline(self) -> Outline:
+        (x0, y0), (x1, y1) = self.start, self.end
+        half = math.dist(self.start, self.end) / 2.0
+        centre = ((x0 + x1) / 2.0, (y0 + y1) / 2.0)
+        yaw = math.atan2(y1 - y0, x1 - x0)
+        return rectangle(centre, half, self.thickness / 2.0, yaw, self.height)
+
+    def describe(self) -> str:
+        return f"wall from {_xy(self.start)} to {_xy(self.end)}"
+
 
 class Box(_Strict):
     """A box standing on the floor, centred at `position`, turned by `yaw`."""
@@ -179,6 +242,13 @@ class Box(_Strict):
     size: tuple[Size, Size, Size]
     yaw: Finite = 0.0
 
+    def outline(self) -> Outline:
+        sx, sy, sz = self.size
+        return rectangle(self.position, sx / 2.0, sy / 2.0, self.yaw, sz)
+
+    def describe(self) -> str:
+        return f"box at {_xy(self.position)}"
+
 
 class Cylinder(_Strict):
     """An upright cylinder standing on the floor (a post, a table leg)."""
@@ -187,6 +257,12 @@ class Cylinder(_Strict):
     position: Point2
     radius: Size
     height: Size = 0.5
+
+    def outline(self) -> Outline:
+        return disc(self.position, self.radius, self.height)
+
+    def describe(self) -> str:
+        return f"cylinder at {_xy(self.position)}, radius {self.radius:g} m"
 
 
 class Model(_Strict):
@@ -382,11 +458,44 @@ def parse_scenario(data: Any, *, source: str = "<scenario>") -> Scenario:
         raise ConfigError(f"{where}: nested too deeply (or refers to itself)") from None
     try:
         check_run_length(scenario, build_profile(scenario.faults))
+        check_lidar_fits(scenario)
     except ConfigError as err:
         raise ConfigError(f"{where}: {err}") from None
     if not scenario.name:
         scenario = scenario.model_copy(update={"name": Path(source).stem[:100]})
     return scenario
+
+
+def check_lidar_fits(scenario: Scenario) -> None:
+    """The threshold and the obstacle conditions ask what this LIDAR can answer.
+
+    A threshold beyond range_max would expect a warning for a driver's
+    range_max "no return" reading, which the oracle also lets a node call
+    "no obstacle": no answer could be right. An ``obstacle_ahead_*``
+    condition looks at the beams within +-10 deg of straight ahead; without
+    any, it could never hold (below) or would always hold (above).
+    """
+    from harness.sim.motion import AHEAD_HALF_WIDTH, ahead_mask  # imports this module
+
+    spec = scenario.lidar_spec
+    if scenario.threshold > spec.range_max:
+        raise ConfigError(
+            f"threshold: {scenario.threshold:g} m is beyond lidar.range_max "
+            f"({spec.range_max:g} m); a warning threshold must be within the LIDAR's range"
+        )
+    waits = [
+        (index, name)
+        for index, segment in enumerate(scenario.motion.segments)
+        for name in ("obstacle_ahead_below", "obstacle_ahead_above")
+        if getattr(segment.until, name) is not None
+    ]
+    if waits and not ahead_mask(spec).any():
+        index, name = waits[0]
+        raise ConfigError(
+            f"motion.segments[{index}].until: {name} looks at the beams within "
+            f"+-{math.degrees(AHEAD_HALF_WIDTH):g} deg of straight ahead, and this LIDAR "
+            f"has none (beams from {spec.angle_min:.4g} to {spec.angle_max:.4g} rad)"
+        )
 
 
 def check_reachable(scenario: Scenario) -> None:
@@ -410,12 +519,12 @@ def check_reachable(scenario: Scenario) -> None:
                 )
 
 
-def check_model_files(scenario: Scenario) -> None:
+def check_model_files(scenario: Scenario) -> Path:
     """The robot URDF and every model obstacle: found where allowed and loadable.
 
     The same check ``harness.sim.world.World`` runs before PyBullet sees a
     file; here it runs when the scenario file is loaded, before any node
-    or board is started.
+    or board is started. Returns the robot URDF's resolved path.
     """
     folders = [scenario.base_dir, robot_models_dir()]
     where = shown(scenario.source or "<scenario>")
@@ -424,12 +533,14 @@ def check_model_files(scenario: Scenario) -> None:
         for i, o in enumerate(scenario.obstacles)
         if isinstance(o, Model)
     ]
-    robot = None
+    robot = robot_path = None
     for field, ref in refs:
         what = f"{where}: {field}: cannot load {ref!r}"
-        parts = check_model_file(find_model_file(ref, folders, what=what), what=what)
-        robot = parts if robot is None else robot
-    assert robot is not None
+        found = find_model_file(ref, folders, what=what)
+        parts = check_model_file(found, what=what)
+        if robot is None:
+            robot, robot_path = parts, found.path
+    assert robot is not None and robot_path is not None
     urdf = scenario.robot.urdf
     if scenario.robot.lidar_link not in robot.links:
         raise ConfigError(
@@ -445,13 +556,60 @@ def check_model_files(scenario: Scenario) -> None:
                     f"{where}: motion.mode: wheels mode needs a revolute joint {name!r} in "
                     f"{urdf!r} ({kind}; joints: {', '.join(joints) or 'none'})"
                 )
+    return robot_path
+
+
+def check_start_clear(scenario: Scenario, robot_urdf: Path | None = None) -> None:
+    """A robot that starts inside a wall, box or cylinder, or overlapping one, is refused.
+
+    The robot's origin (its root link, on the floor) must lie outside each
+    of them, and the collision shapes of its rigid body (read from
+    `robot_urdf`, a URDF already checked by ``check_model_files``; see
+    ``harness.sim.footprint``) may overlap one by at most START_OVERLAP.
+    Model obstacles are not checked.
+    """
+    where = shown(scenario.source or "<scenario>")
+    start = scenario.robot.start
+    parts: list[Outline] = []
+    if robot_urdf is not None:
+        what = f"{where}: robot.urdf: cannot load {scenario.robot.urdf!r}"
+        body = robot_outlines(_parse_xml(robot_urdf, what))
+        parts = [part.placed(start.x, start.y, start.yaw) for part in body]
+    at = _xy((start.x, start.y))
+    for index, obstacle in enumerate(scenario.obstacles):
+        if isinstance(obstacle, Model):
+            continue
+        outline = obstacle.outline()
+        if outline.contains((start.x, start.y)) > START_OVERLAP:
+            raise ConfigError(
+                f"{where}: robot.start: {at} is inside obstacles[{index}] ({obstacle.describe()})"
+            )
+        for part in parts:
+            depth = overlap(part, outline)
+            if depth > START_OVERLAP:
+                raise ConfigError(
+                    f"{where}: robot.start: the robot at {at}, yaw {start.yaw:.2f}, overlaps "
+                    f"obstacles[{index}] ({obstacle.describe()}) by {depth * 1000:.1f} mm "
+                    f"({shown(part.label, 100)} of {shown(scenario.robot.urdf, 100)!r})"
+                )
 
 
 # -- reading YAML, bounded ----------------------------------------------------
 
 
-# YAML 1.2 floats: PyYAML (YAML 1.1) reads `1e-3` and `5e2`, without a dot, as text.
-_FLOAT_1_2 = re.compile(r"^[-+]?(\.[0-9]+|[0-9]+(\.[0-9]*)?)[eE][-+]?[0-9]+$")
+# YAML 1.2 core schema scalars. PyYAML implements YAML 1.1, which also reads
+# `1_000` and `1:20` (= 80) as integers, `010` as octal 8, `0b11`, `yes`/`no`/
+# `on`/`off` as booleans and `2024-01-01` as a date, but `1e-3` as text. Here
+# those are text (a numeric field then refuses them), except a leading zero,
+# which YAML 1.1 and 1.2 read differently (8 or 10): that is text too.
+_BOOL_1_2 = re.compile(r"^(?:true|True|TRUE|false|False|FALSE)$")
+_INT_1_2 = re.compile(r"^(?:[-+]?(?:0|[1-9][0-9]*)|0o[0-7]+|0x[0-9a-fA-F]+)$")
+_FLOAT_1_2 = re.compile(
+    r"^(?:[-+]?(?:\.[0-9]+|[0-9]+\.[0-9]*|[0-9]+(?=[eE]))(?:[eE][-+]?[0-9]+)?"
+    r"|[-+]?\.(?:inf|Inf|INF)|\.(?:nan|NaN|NAN))$"
+)
+_YAML = "tag:yaml.org,2002:"
+_CORE_TAGS = {f"{_YAML}{kind}" for kind in ("null", "bool", "int", "float", "str", "seq", "map")}
 
 
 class _ScenarioLoader(yaml.SafeLoader):
@@ -501,7 +659,47 @@ class _ScenarioLoader(yaml.SafeLoader):
         return super().construct_mapping(node, deep)
 
 
-_ScenarioLoader.add_implicit_resolver("tag:yaml.org,2002:float", _FLOAT_1_2, list("-+0123456789."))
+def _core_scalar(loader: yaml.SafeLoader, node: yaml.ScalarNode) -> bool | int | float:
+    """A bool, int or float as YAML 1.2 writes it, also under an explicit `!!int` etc. tag."""
+    kind = node.tag.removeprefix(_YAML)
+    pattern = {"bool": _BOOL_1_2, "int": _INT_1_2, "float": _FLOAT_1_2}[kind]
+    text = str(loader.construct_scalar(node))
+    if not pattern.match(text) and not (kind == "float" and _INT_1_2.match(text)):
+        raise yaml.constructor.ConstructorError(
+            None, None, f"{text[:40]!r} is not a YAML 1.2 {kind}", node.start_mark
+        )
+    if kind == "bool":
+        return text.lower() == "true"
+    if kind == "int" or (kind == "float" and _INT_1_2.match(text)):
+        value = int(text, 0)
+        if kind == "int":
+            return value
+        return float(value) if abs(value) < 2**1024 else math.copysign(math.inf, value)
+    special = text.lower().lstrip("+")
+    if special in (".inf", "-.inf", ".nan"):
+        return float(special.replace(".", ""))
+    return float(text)
+
+
+# Only the YAML 1.2 core schema: implicit types as it resolves them, and no
+# other tags (`!!binary`, `!!set` in an arbitrary order, `!!timestamp`, ...).
+_ScenarioLoader.yaml_implicit_resolvers = {
+    first: [(tag, rx) for tag, rx in resolvers if tag in (f"{_YAML}null", f"{_YAML}merge")]
+    for first, resolvers in yaml.SafeLoader.yaml_implicit_resolvers.items()
+}
+for _tag, _pattern, _first in (
+    ("bool", _BOOL_1_2, "tTfF"),
+    ("int", _INT_1_2, "-+0123456789"),
+    ("float", _FLOAT_1_2, "-+0123456789."),
+):
+    _ScenarioLoader.add_implicit_resolver(f"{_YAML}{_tag}", _pattern, list(_first))
+_ScenarioLoader.yaml_constructors = {
+    tag: construct
+    for tag, construct in yaml.SafeLoader.yaml_constructors.items()
+    if tag in _CORE_TAGS or tag is None
+}
+for _tag in ("bool", "int", "float"):
+    _ScenarioLoader.add_constructor(f"{_YAML}{_tag}", _core_scalar)
 
 
 def _check_expanded(root: yaml.Node) -> None:
@@ -638,7 +836,7 @@ def load_scenario_file(path: str | Path) -> Scenario:
         raise ConfigError(f"{name}: YAML error: {' '.join(str(err).split())[:200]}") from None
     scenario = parse_scenario(data, source=str(path))
     check_reachable(scenario)
-    check_model_files(scenario)
+    check_start_clear(scenario, check_model_files(scenario))
     return scenario
 
 

@@ -174,3 +174,245 @@ def test_unreachable_segment_is_refused_at_load(tmp_path: Path, segment: str, re
     path = write(tmp_path, f"description: x\nmotion:\n  segments:\n    - {segment}\n")
     with pytest.raises(ConfigError, match=rf"^{path}: motion\.segments\[0\]\.until: {reason}"):
         load_scenario_file(path)
+
+
+# -- issue 12 item 9: files that cannot be what they say ------------------------
+
+STILL = "description: x\nmotion:\n  segments:\n    - until: {duration: 0.5}\n"
+
+
+@pytest.mark.parametrize(
+    ("obstacle", "shown"),
+    [
+        ("{type: wall, start: [0, -1], end: [0, 1], thickness: 0.2}", "wall from (0.00, -1.00)"),
+        ("{type: box, position: [0.3, 0.2], size: [1, 1, 0.4], yaw: 0.3}", "box at (0.30, 0.20)"),
+        ("{type: cylinder, position: [1.0, 1.0], radius: 1.5}", "cylinder at (1.00, 1.00)"),
+    ],
+)
+def test_robot_starting_inside_an_obstacle_is_refused(
+    tmp_path: Path, obstacle: str, shown: str
+) -> None:
+    """The robot's origin inside a wall, box or cylinder: one line naming the obstacle."""
+    obstacles = f"obstacles:\n  - {{type: wall, start: [5, -1], end: [5, 1]}}\n  - {obstacle}\n"
+    path = write(tmp_path, STILL + obstacles)
+    with pytest.raises(ConfigError) as info:
+        load_scenario_file(path)
+    assert str(info.value).startswith(
+        f"{path}: robot.start: (0.00, 0.00) is inside obstacles[1] ({shown}"
+    ), str(info.value)
+
+
+@pytest.mark.parametrize(
+    ("start", "obstacle", "part"),
+    [
+        # The chassis box spans x -0.12..0.06, y +-0.075 (robot_models/README.md).
+        ("{x: 0, y: 0}", "{type: wall, start: [0.1, -1], end: [0.1, 1], thickness: 0.1}", "box"),
+        ("{x: 0, y: 0}", "{type: cylinder, position: [-0.2, 0.0], radius: 0.1}", "box"),
+        (
+            "{x: 0, y: 0, yaw: 3.14159}",
+            "{type: box, position: [0.16, 0], size: [0.1, 1, 1]}",
+            "box",
+        ),
+        # The caster sphere (radius 0.015 at x = -0.095) under a low box.
+        ("{x: 0, y: 0}", "{type: box, position: [-0.095, 0], size: [0.02, 0.02, 0.02]}", "sphere"),
+    ],
+)
+def test_robot_overlapping_an_obstacle_is_refused(
+    tmp_path: Path, start: str, obstacle: str, part: str
+) -> None:
+    """The robot's body, not just its origin, must be clear of walls, boxes and cylinders."""
+    path = write(tmp_path, STILL + f"robot: {{start: {start}}}\nobstacles:\n  - {obstacle}\n")
+    with pytest.raises(
+        ConfigError,
+        match=rf"^{path}: robot\.start: the robot at \(0\.00, 0\.00\), yaw .* overlaps "
+        rf"obstacles\[0\] \(.*\) by \d+\.\d mm "
+        rf"\(link '\w+' collision {part} of 'fossbot_v2.urdf'\)$",
+    ):
+        load_scenario_file(path)
+
+
+@pytest.mark.parametrize(
+    "obstacle",
+    [
+        # touching the chassis front (x = 0.06) and within the 5 mm tolerance
+        "{type: wall, start: [0.085, -1], end: [0.085, 1], thickness: 0.05}",
+        "{type: wall, start: [0.083, -1], end: [0.083, 1], thickness: 0.05}",
+        # under the chassis (its bottom is 0.025 m up), between caster and wheels
+        "{type: box, position: [0.03, 0], size: [0.04, 0.1, 0.02]}",
+        # beside the chassis, inside the wheel: wheels turn, so they are not counted
+        # (as out_of_range.yaml's post at (-0.016, 0.10))
+        "{type: cylinder, position: [0.0, 0.09], radius: 0.01}",
+        # diagonal to the chassis corner (0.06, 0.075), 6.6 mm away: a corner is not an edge
+        "{type: cylinder, position: [0.10, 0.115], radius: 0.05}",
+        # models are not checked (docs/scenarios.md)
+        "{type: model, path: fossbot_v2.urdf}",
+    ],
+)
+def test_robot_next_to_an_obstacle_loads(tmp_path: Path, obstacle: str) -> None:
+    """Touching, tolerance, height and moving parts: what the start check leaves alone."""
+    load_scenario_file(write(tmp_path, STILL + f"obstacles:\n  - {obstacle}\n"))
+
+
+def test_robot_footprint_comes_from_its_urdf(tmp_path: Path) -> None:
+    """Another URDF's body (a rotated box on a fixed joint) is what is checked."""
+    (tmp_path / "wide.urdf").write_text(
+        '<?xml version="1.0"?><robot name="wide">'
+        '<link name="base"/><link name="deck"><collision><origin xyz="0 0 0.1" rpy="0 0 0.5"/>'
+        '<geometry><box size="1.0 0.2 0.1"/></geometry></collision></link>'
+        '<link name="laser"/>'
+        '<joint name="a" type="fixed"><parent link="base"/><child link="deck"/></joint>'
+        '<joint name="b" type="fixed"><parent link="deck"/><child link="laser"/></joint>'
+        "</robot>"
+    )
+    robot = "robot: {urdf: wide.urdf, lidar_link: laser}\n"
+    # 0.5 rad to the left, the deck reaches (0.44, 0.24); the post at (0.4, 0.3) is hit.
+    hit = write(
+        tmp_path,
+        STILL + robot + "obstacles: [{type: cylinder, position: [0.4, 0.3], radius: 0.05}]\n",
+    )
+    with pytest.raises(
+        ConfigError, match=r"overlaps obstacles\[0\].*link 'deck' collision box of 'wide.urdf'"
+    ):
+        load_scenario_file(hit)
+    clear = write(
+        tmp_path,
+        STILL + robot + "obstacles: [{type: cylinder, position: [0.4, -0.3], radius: 0.05}]\n",
+        "clear.yaml",
+    )
+    load_scenario_file(clear)
+
+
+@pytest.mark.parametrize(
+    ("change", "field", "message"),
+    [
+        ('threshold: "0.5"\n', "threshold", "must be a number, got text '0.5' (quoted"),
+        ("threshold: 1_0.5\n", "threshold", "must be a number, got text '1_0.5'"),
+        (
+            "seed: 1_0\n",
+            "seed",
+            "must be a whole number, got text '1_0' (YAML 1.2 numbers have no _)",
+        ),
+        ("seed: 1:20\n", "seed", "must be a whole number, got text '1:20'"),
+        ("seed: 010\n", "seed", "must be a whole number, got text '010' (a leading 0 is octal"),
+        ("seed: 0b11\n", "seed", "must be a whole number, got text '0b11'"),
+        ("seed: '7'\n", "seed", "must be a whole number, got text '7' (quoted"),
+        ("seed: 7.0\n", "seed", "must be a whole number, got 7.0"),
+        ("lidar: {samples: 360.0}\n", "lidar.samples", "must be a whole number, got 360.0"),
+        ("lidar: {samples: 3.6e2}\n", "lidar.samples", "must be a whole number, got 360.0"),
+        ("lidar: {samples: true}\n", "lidar.samples", "must be a whole number, got true"),
+        ("lidar: {range_max: '8'}\n", "lidar.range_max", "must be a number, got text '8'"),
+        ("robot: {start: {x: '0.1'}}\n", "robot.start.x", "must be a number, got text '0.1'"),
+        ("threshold: !!str 0.5\n", "threshold", "must be a number, got text '0.5'"),
+    ],
+)
+def test_numbers_are_strict(tmp_path: Path, change: str, field: str, message: str) -> None:
+    """Nothing is coerced: text, YAML 1.1 forms and floats for counts are refused by field."""
+    path = write(tmp_path, changed(change))
+    with pytest.raises(ConfigError) as info:
+        load_scenario_file(path)
+    assert str(info.value).startswith(f"{path}: {field}: {message}"), str(info.value)
+
+
+@pytest.mark.parametrize(
+    ("change", "reason"),
+    [
+        ("seed: !!int 1_0\n", "'1_0' is not a YAML 1.2 int"),
+        ("name: !!bool yes\n", "'yes' is not a YAML 1.2 bool"),
+        ("faults: !!set {noisy: null}\n", "a constructor for the tag 'tag:yaml.org,2002:set'"),
+        ("description: !!binary aGVsbG8=\n", "tag 'tag:yaml.org,2002:binary'"),
+        ("description: !!timestamp 2024-01-01\n", "tag 'tag:yaml.org,2002:timestamp'"),
+    ],
+)
+def test_only_yaml_1_2_core_types(tmp_path: Path, change: str, reason: str) -> None:
+    """Explicit tags beyond YAML 1.2's core schema (a !!set has no order) are refused."""
+    path = write(tmp_path, changed(change))
+    with pytest.raises(ConfigError, match=rf"^{path}: YAML error at line \d+: .*{reason}"):
+        load_scenario_file(path)
+
+
+@pytest.mark.parametrize(
+    ("change", "attribute", "value"),
+    [
+        ("threshold: 1\n", "threshold", 1.0),  # an int where a float is meant is fine
+        ("threshold: 1e-1\n", "threshold", 0.1),
+        ("seed: 0x10\n", "seed", 16),  # YAML 1.2 core hex and octal
+        ("seed: 0o17\n", "seed", 15),
+        ("seed: +5\n", "seed", 5),
+        ("name: no\n", "name", "no"),  # YAML 1.1's booleans are text in YAML 1.2
+        ("name: on\n", "name", "on"),
+        ("description: 2024-01-01\n", "description", "2024-01-01"),  # and so are dates
+    ],
+)
+def test_yaml_1_2_numbers_and_text_load(
+    tmp_path: Path, change: str, attribute: str, value: object
+) -> None:
+    """What YAML 1.2 reads as a number is one; what it reads as text stays text."""
+    scenario = load_scenario_file(write(tmp_path, changed(change)))
+    got = getattr(scenario, attribute)
+    assert got == value and type(got) is type(value)
+
+
+@pytest.mark.parametrize(
+    ("lidar", "reason"),
+    [
+        (
+            "{samples: 720, angle_increment: 0.0175}",
+            r"lidar: the beams span \(samples - 1\) x angle_increment = 719 x 0\.0175 = 12\.5825 "
+            r"rad, more than one turn",
+        ),
+        ("{preset: rplidar_a1, samples: 362}", r"lidar: the beams span .* = 361 x 0\.0174533"),
+        (
+            "{preset: gazebo, angle_min: 3.2}",
+            r"lidar: the last beam's angle, angle_min \+ \(samples - 1\) x angle_increment = "
+            r"3\.2 \+ 6\.28319 = 9\.48319 rad, is beyond 2 pi",
+        ),
+    ],
+)
+def test_scan_wider_than_one_turn_is_refused(tmp_path: Path, lidar: str, reason: str) -> None:
+    """At most one revolution of beams, every beam angle within +-2 pi."""
+    path = write(tmp_path, changed(f"lidar: {lidar}\n"))
+    with pytest.raises(ConfigError, match=rf"^{path}: {reason}"):
+        load_scenario_file(path)
+
+
+@pytest.mark.parametrize(
+    "lidar",
+    [
+        "{preset: gazebo}",  # closed layout: (360 - 1) x 2 pi / 359 = 2 pi, first beam = last
+        "{preset: rplidar_a1, samples: 361}",  # 0 .. 2 pi inclusive
+        "{preset: ld19}",
+        "{preset: gazebo, samples: 360, angle_increment: 0.01750192}",  # float32 rounding
+        "{preset: rplidar_a1, angle_min: -6.28}",
+    ],
+)
+def test_scans_of_one_turn_load(tmp_path: Path, lidar: str) -> None:
+    """The presets, a full closed turn and float rounding pass."""
+    load_scenario_file(write(tmp_path, changed(f"lidar: {lidar}\n")))
+
+
+def test_threshold_beyond_range_max_is_refused(tmp_path: Path) -> None:
+    """A warning due for every return, even a driver's range_max 'no return', cannot be judged."""
+    path = write(tmp_path, changed("lidar: {range_max: 4.0}\nthreshold: 5\n"))
+    with pytest.raises(
+        ConfigError, match=rf"^{path}: threshold: 5 m is beyond lidar\.range_max \(4 m\)"
+    ):
+        load_scenario_file(path)
+    load_scenario_file(
+        write(tmp_path, changed("lidar: {range_max: 4.0}\nthreshold: 4\n"), "ok.yaml")
+    )
+
+
+@pytest.mark.parametrize("condition", ["obstacle_ahead_below", "obstacle_ahead_above"])
+def test_obstacle_condition_without_a_beam_ahead_is_refused(tmp_path: Path, condition: str) -> None:
+    """A LIDAR with no beam within +-10 deg of straight ahead cannot judge `obstacle_ahead_*`."""
+    text = (
+        "description: x\nlidar: {preset: rplidar_a1, angle_min: 1.0, samples: 90}\n"
+        f"motion:\n  segments:\n    - until: {{{condition}: 0.5}}\n"
+    )
+    path = write(tmp_path, text)
+    with pytest.raises(
+        ConfigError,
+        match=rf"^{path}: motion\.segments\[0\]\.until: {condition} looks at the beams within "
+        r"\+-10 deg of straight ahead, and this LIDAR has none \(beams from 1 to 2\.553 rad\)$",
+    ):
+        load_scenario_file(path)

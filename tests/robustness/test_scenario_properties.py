@@ -3,7 +3,11 @@
 Hypothesis builds scenarios that are valid or nearly so (every field, fault
 profiles and inline faults from harness/faults.py), then mutates some of
 them: wrong types, missing and extra keys, extreme numbers, random text,
-and corrupted YAML text. Each is written to a file and loaded; a scenario
+and corrupted YAML text. Some are hostile in ways a loader may quietly get
+wrong: numbers written as text, YAML 1.1 number forms (`1_0`, `1:20`,
+`010`), floats where a count is meant, other YAML tags, a robot placed in
+or against an obstacle, a scan wider than one turn, a threshold beyond
+range_max. Each is written to a file and loaded; a scenario
 the loader accepts is then really simulated and judged over the inprocess
 link. The only exception allowed anywhere is ConfigError, whose message is
 one line naming the file. A smaller sample runs through the real
@@ -58,26 +62,51 @@ def floats(lo: float, hi: float) -> st.SearchStrategy[float]:
     return st.floats(lo, hi, allow_nan=False, allow_infinity=False)
 
 
-def point(span: float = 5.0) -> st.SearchStrategy[list[float]]:
-    return st.lists(floats(-span, span), min_size=2, max_size=2)
+# Obstacles stand on one side of the square (+-1 m) robots start in, CLEAR + their
+# reach beyond its edge, so the robot (0.15 m from its origin at most) starts
+# clear of them; `crowded` puts one at the start on purpose.
+CLEAR = 1.2
+SIDES = [(1.0, 0.0), (-1.0, 0.0), (0.0, 1.0), (0.0, -1.0)]
 
 
-walls = st.fixed_dictionaries(
-    {"type": st.just("wall"), "start": point(), "end": point()},
-    optional={"thickness": floats(0.01, 0.5), "height": floats(0.05, 2.0)},
-)
-boxes = st.fixed_dictionaries(
-    {
-        "type": st.just("box"),
-        "position": point(),
-        "size": st.lists(floats(0.01, 2.0), min_size=3, max_size=3),
-    },
-    optional={"yaw": floats(-7, 7)},
-)
-cylinders = st.fixed_dictionaries(
-    {"type": st.just("cylinder"), "position": point(), "radius": floats(0.005, 1.0)},
-    optional={"height": floats(0.05, 2.0)},
-)
+def beside(draw: st.DrawFn, side: tuple[float, float], reach: float) -> list[float]:
+    """A floor point on `side`, far enough out for an obstacle that reaches `reach` around it."""
+    (nx, ny), u, v = side, draw(floats(CLEAR + reach, 5.0 + reach)), draw(floats(-5, 5))
+    return [nx * u - ny * v, ny * u + nx * v]
+
+
+@st.composite
+def walls(draw: st.DrawFn) -> dict[str, Any]:
+    side, thickness = draw(st.sampled_from(SIDES)), draw(floats(0.01, 0.5))
+    wall = {"type": "wall", "start": beside(draw, side, thickness), "end": None}
+    wall["end"] = beside(draw, side, thickness)
+    if draw(st.booleans()):
+        wall["thickness"] = thickness
+    if draw(st.booleans()):
+        wall["height"] = draw(floats(0.05, 2.0))
+    return wall
+
+
+@st.composite
+def boxes(draw: st.DrawFn) -> dict[str, Any]:
+    size = draw(st.lists(floats(0.01, 2.0), min_size=3, max_size=3))
+    where = beside(draw, draw(st.sampled_from(SIDES)), math.hypot(size[0], size[1]) / 2)
+    box = {"type": "box", "position": where, "size": size}
+    if draw(st.booleans()):
+        box["yaw"] = draw(floats(-7, 7))
+    return box
+
+
+@st.composite
+def cylinders(draw: st.DrawFn) -> dict[str, Any]:
+    radius = draw(floats(0.005, 1.0))
+    where = beside(draw, draw(st.sampled_from(SIDES)), radius)
+    cylinder = {"type": "cylinder", "position": where, "radius": radius}
+    if draw(st.booleans()):
+        cylinder["height"] = draw(floats(0.05, 2.0))
+    return cylinder
+
+
 models = st.fixed_dictionaries(
     {
         "type": st.just("model"),
@@ -85,7 +114,7 @@ models = st.fixed_dictionaries(
     },
     optional={"position": st.lists(floats(-5, 5), min_size=3, max_size=3), "yaw": floats(-4, 4)},
 )
-obstacles = st.lists(st.one_of(walls, walls, boxes, cylinders, models), max_size=4)
+obstacles = st.lists(st.one_of(walls(), walls(), boxes(), cylinders(), models), max_size=4)
 
 inline_faults = st.one_of(
     st.fixed_dictionaries({"type": st.just("noise"), "sigma": floats(0, 0.05)}),
@@ -159,12 +188,23 @@ segments = st.one_of(
     ),
 )
 
+TURN = 2 * math.pi
 lidar = st.fixed_dictionaries(
     {"preset": st.sampled_from(sorted(PRESETS))},
     optional={
-        "samples": st.integers(1, 720),
-        "angle_min": floats(-math.pi, math.pi),
-        "angle_increment": floats(0.002, 0.1),
+        # counts as floats (360.0) are refused; spans of about one turn either side of 2 pi
+        "samples": st.one_of(
+            st.integers(1, 720),
+            st.sampled_from([359, 360, 361, 362, 450, 451]),
+            st.builds(float, st.integers(1, 720)),
+        ),
+        "angle_min": st.one_of(
+            floats(-math.pi, math.pi), st.sampled_from([-TURN, TURN, 3.2, -3.2, 0.0])
+        ),
+        "angle_increment": st.one_of(
+            floats(0.002, 0.1),
+            st.sampled_from([TURN / 360, TURN / 359, TURN / 358, TURN / 450, TURN / 449]),
+        ),
         "range_min": floats(0.01, 0.3),
         "range_max": floats(1.0, 20.0),
         "rate_hz": floats(1.0, 50.0),
@@ -195,10 +235,37 @@ scenarios = st.fixed_dictionaries(
         ),
         "obstacles": obstacles,
         "faults": faults,
-        "threshold": floats(0.05, 3.0),
+        "threshold": st.one_of(floats(0.05, 3.0), st.sampled_from([12.0, 12.5, 25.0])),
         "seed": st.integers(0, 2**32 - 1),
     },
 )
+
+
+@st.composite
+def crowded(draw: st.DrawFn) -> dict[str, Any]:
+    """A scenario, a quarter of them with a wall, box or cylinder near where the robot starts."""
+    data = draw(scenarios)
+    if draw(st.integers(0, 3)) != 3:  # hypothesis favours 0: most are not crowded
+        return data
+    data["zz_crowded"] = True  # a marker for hostile_kinds, removed before dumping
+    start = data.get("robot", {}).get("start", {})
+    x = start.get("x", 0.0) + draw(floats(-1.0, 1.0))
+    y = start.get("y", 0.0) + draw(floats(-1.0, 1.0))
+    kind = draw(st.sampled_from(["wall", "box", "cylinder"]))
+    if kind == "wall":
+        angle = draw(floats(0, math.pi))
+        half = draw(floats(0.05, 1.0))
+        dx, dy = half * math.cos(angle), half * math.sin(angle)
+        blocker = {"type": "wall", "start": [x - dx, y - dy], "end": [x + dx, y + dy]}
+        blocker["thickness"] = draw(floats(0.01, 0.3))
+    elif kind == "box":
+        size = draw(st.lists(floats(0.01, 0.5), min_size=3, max_size=3))
+        blocker = {"type": "box", "position": [x, y], "size": size, "yaw": draw(floats(-4, 4))}
+    else:
+        blocker = {"type": "cylinder", "position": [x, y], "radius": draw(floats(0.005, 0.3))}
+    data["obstacles"] = [*data.get("obstacles", []), blocker]
+    return data
+
 
 # -- mutations ---------------------------------------------------------------
 
@@ -250,15 +317,67 @@ def places(node: Any) -> Iterator[tuple[Any, Any]]:
             yield from places(node[index])
 
 
+# Written into the YAML text as they are (yaml.safe_dump would quote them):
+# YAML 1.1 number and boolean forms, YAML 1.2 ones, and tags beyond the core schema.
+RAW_FORMS = [
+    "1_0",
+    "1_000.5",
+    "1:20",
+    "010",
+    "0b11",
+    "0x10",
+    "0o17",
+    "+5",
+    "1e3",
+    ".5",
+    "-.inf",
+    "yes",
+    "off",
+    "2024-01-01",
+    "!!int 1_0",
+    "!!float 1_0",
+    "!!float 12",
+    "!!str 0.5",
+    "!!set {a: null}",
+    "!!binary aGk=",
+]
+
+
+def raw_token(index: int) -> str:
+    """A placeholder yaml.safe_dump writes plainly, replaced by a RAW_FORMS entry afterwards."""
+    return f"zzraw{index}zz"
+
+
+def hostile_number(draw: st.DrawFn, value: int | float) -> Any:
+    """A number written the ways a loose loader would still read as a number."""
+    form = draw(st.sampled_from(["text", "text", "float", "raw", "raw"]))
+    if form == "text":
+        return str(value)  # dumped in quotes: text
+    if form == "float":
+        return float(value)  # 360.0 where a count is meant
+    return raw_token(draw(st.integers(0, len(RAW_FORMS) - 1)))
+
+
 @st.composite
 def mutated(draw: st.DrawFn, base: st.SearchStrategy[dict[str, Any]]) -> dict[str, Any]:
-    """A scenario with 0-3 structural mutations: replace, delete, add a key, wrap, scale."""
+    """A scenario with 0-3 mutations: replace, delete, add a key, wrap, scale, a hostile number."""
     data = copy.deepcopy(draw(base))
     for _ in range(draw(st.integers(0, 3))):
         spots = list(places(data))
         container, key = draw(st.sampled_from(spots))
-        action = draw(st.sampled_from(["replace", "replace", "delete", "add", "wrap", "scale"]))
-        if action == "replace":
+        action = draw(
+            st.sampled_from(["replace", "replace", "delete", "add", "wrap", "scale", "hostile"])
+        )
+        if action == "hostile":
+            numbers = [
+                (c, k)
+                for c, k in spots
+                if isinstance(c[k], (int, float)) and not isinstance(c[k], bool)
+            ]
+            if numbers:
+                container, key = draw(st.sampled_from(numbers))
+                container[key] = hostile_number(draw, container[key])
+        elif action == "replace":
             container[key] = draw(weird_values)
         elif action == "delete":
             del container[key]
@@ -276,9 +395,13 @@ def mutated(draw: st.DrawFn, base: st.SearchStrategy[dict[str, Any]]) -> dict[st
 
 
 @st.composite
-def scenario_files(draw: st.DrawFn) -> bytes:
+def scenario_files(draw: st.DrawFn) -> tuple[bytes, frozenset[str]]:
     """The bytes of a scenario file: mutated data as YAML, sometimes corrupted as text."""
-    text = yaml.safe_dump(draw(mutated(scenarios)), allow_unicode=True, sort_keys=False)
+    scenario = draw(mutated(crowded()))
+    kinds = hostile_kinds(scenario)
+    text = yaml.safe_dump(scenario, allow_unicode=True, sort_keys=False)
+    for index, form in enumerate(RAW_FORMS):
+        text = text.replace(raw_token(index), form)
     data = text.encode("utf-8")
     corruption = draw(st.sampled_from(["none"] * 8 + ["truncate", "insert", "bytes"]))
     if corruption == "truncate":
@@ -289,10 +412,50 @@ def scenario_files(draw: st.DrawFn) -> bytes:
     elif corruption == "bytes":
         at = draw(st.integers(0, len(data)))
         data = data[:at] + draw(st.binary(min_size=1, max_size=8)) + data[at:]
-    return data
+    return data, kinds
+
+
+def hostile_kinds(scenario: dict[str, Any]) -> frozenset[str]:
+    """Which hostile forms a generated scenario holds (for the statistics); drops the marker."""
+    kinds = set()
+    if scenario.pop("zz_crowded", False):
+        kinds.add("robot at an obstacle")
+    text = repr(scenario)
+    if "zzraw" in text:
+        kinds.add("YAML 1.1 form or tag")
+    if any(isinstance(v, str) and v[:1].isdigit() for _, v in leaves(scenario)):
+        kinds.add("number as text")
+    lidar = scenario.get("lidar")
+    if isinstance(lidar, dict):
+        samples, step = lidar.get("samples", 360), lidar.get("angle_increment", TURN / 360)
+        if isinstance(samples, float):
+            kinds.add("float samples")
+        numbers = all(isinstance(v, (int, float)) for v in (samples, step))
+        if numbers and (samples - 1) * step > TURN + 1e-5:
+            kinds.add("scan wider than a turn")
+    threshold = scenario.get("threshold")
+    if isinstance(threshold, float) and threshold > 12:
+        kinds.add("threshold beyond range_max")
+    return frozenset(kinds)
+
+
+def leaves(node: Any) -> Iterator[tuple[Any, Any]]:
+    """(key, value) of every scalar in a nested structure."""
+    for container, key in places(node):
+        if not isinstance(container[key], (dict, list)):
+            yield key, container[key]
 
 
 # -- the property ------------------------------------------------------------
+
+HOSTILE_KINDS = (
+    "robot at an obstacle",
+    "YAML 1.1 form or tag",
+    "number as text",
+    "float samples",
+    "scan wider than a turn",
+    "threshold beyond range_max",
+)
 
 
 def cheap_enough(scenario: Scenario) -> bool:
@@ -344,23 +507,30 @@ def test_generated_scenarios_run_or_are_refused(
     """Each generated file is run or refused with one ConfigError line; never anything else."""
     stats: Counter[str] = Counter()
 
+    kinds: Counter[str] = Counter()
+
     @settings(COMMON, max_examples=IN_PROCESS_EXAMPLES)
     @given(scenario_files())
-    def check(data: bytes) -> None:
+    def check(example: tuple[bytes, frozenset[str]]) -> None:
+        data, hostile = example
         path = tmp_path / f"generated_{stats['generated']}.yaml"
         path.write_bytes(data)
         try:
-            outcome(path, stats)
+            code = outcome(path, stats)
         finally:
             path.unlink()
+        for kind in hostile:
+            kinds[f"{kind}: {'refused' if code == 2 else 'ran or too long'}"] += 1
 
     check()
-    for key, value in stats.items():
+    for key, value in (stats + kinds).items():
         record_property(key, value)
     with capsys.disabled():
-        print(f"\n[scenario properties, in process] {dict(stats)}")
+        print(f"\n[scenario properties, in process] {dict(stats)}\n  hostile: {dict(kinds)}")
     assert stats["generated"] >= 500
     assert stats["ran"] >= 50 and stats["refused at load"] >= 100, dict(stats)
+    for kind in HOSTILE_KINDS:  # each hostile form is generated, and refused at least sometimes
+        assert kinds[f"{kind}: refused"] >= 5, dict(kinds)
 
 
 @pytest.mark.timeout(300)
@@ -374,7 +544,8 @@ def test_generated_scenarios_through_the_command(
 
     @settings(COMMON, max_examples=CLI_EXAMPLES)
     @given(scenario_files())
-    def check(data: bytes) -> None:
+    def check(example: tuple[bytes, frozenset[str]]) -> None:
+        data, _ = example
         path = tmp_path / f"generated_{stats['generated']}.yaml"
         path.write_bytes(data)
         try:
