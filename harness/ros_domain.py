@@ -2,17 +2,31 @@
 
 Like ROS 2's domain_coordinator, a reservation is held by an open OS
 resource that the kernel frees when the process dies, so a crashed run
-never leaks an id: here an exclusive ``flock`` on one file per id.
+never leaks an id: here an exclusive ``flock`` on one file per id
+(``harness.holder_lock``, which also writes the holder's pid and command
+line into the file for the message of a run that is refused).
+
+An id given explicitly (``--domain-id``, ``--hil-domain-id``, a board's)
+is reserved too, in the same files (any id 0..232): a second run on this
+machine asking for an id another run holds is refused with a ConfigError
+naming the holder, since the two would judge each other's messages. Like
+an automatic one it is held while the link is open (one scenario); within
+a process it may be taken again (the pytest plugin reserves an id, then
+the link takes it by number). A run started by the process that holds the
+id (a test that reserved a domain for the board it simulates) runs in
+that reservation. The reservation excludes only other fossbot-hil runs on
+this machine: joining a board's graph over the network (``--ros-network
+--domain-id 0``) is what an explicit id is for.
 """
 
 from __future__ import annotations
 
-import fcntl
 import os
 import tempfile
 from pathlib import Path
 
-from harness.errors import LinkError
+from harness.errors import ConfigError, LinkError
+from harness.holder_lock import Held, HolderLock, shared_folder, take
 
 # 0 is everyone's default; ids above 101 can collide with ephemeral ports on Linux.
 FIRST_ID, LAST_ID = 1, 101
@@ -22,14 +36,14 @@ LOCK_DIR = Path(tempfile.gettempdir()) / "fossbot-hil-domains"
 class DomainReservation:
     """An id held until `release()` (or process exit)."""
 
-    def __init__(self, domain_id: int, handle: int | None) -> None:
+    def __init__(self, domain_id: int, lock: HolderLock | None) -> None:
         self.domain_id = domain_id
-        self._handle = handle
+        self._lock = lock
 
     def release(self) -> None:
-        if self._handle is not None:
-            os.close(self._handle)
-            self._handle = None
+        if self._lock is not None:
+            self._lock.release()
+            self._lock = None
 
     def __enter__(self) -> DomainReservation:
         return self
@@ -38,61 +52,78 @@ class DomainReservation:
         self.release()
 
 
-def _lock_dir() -> Path:
-    """The shared folder of lock files: sticky and world-writable like /tmp, so
-    every user's runs on this machine take ids from the same pool."""
-    if not LOCK_DIR.is_dir():
-        LOCK_DIR.mkdir(parents=True, exist_ok=True)
-        try:
-            os.chmod(LOCK_DIR, 0o1777)
-        except OSError:  # made by another user a moment ago: theirs to set
-            pass
-    return LOCK_DIR
+def lock_file(domain_id: int) -> Path:
+    """The id's lock file, in a folder every user's runs on this machine share."""
+    return shared_folder(LOCK_DIR) / f"{domain_id}.lock"
 
 
-def _try_lock(domain_id: int) -> int | None:
-    """A locked handle on the id's file, or None when another run holds it.
+def _try_lock(domain_id: int) -> HolderLock | None:
+    """The id's lock, or None when another run (or this process) holds it.
 
     A file another user made without write access for us counts as taken:
     better one id fewer than a crash.
     """
-    path = _lock_dir() / f"{domain_id}.lock"
     try:
-        handle = os.open(path, os.O_RDWR | os.O_CREAT, 0o666)
-    except PermissionError:
+        return take(lock_file(domain_id), shared=True)
+    except (Held, OSError):
         return None
-    try:
-        os.fchmod(handle, 0o666)  # the umask must not lock other users out
-    except OSError:
-        pass  # not ours: its owner set it
-    try:
-        fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
-    except OSError:
-        os.close(handle)
-        return None
-    return handle
 
 
 _reservations = 0
 
 
 def reserve_domain(preferred: int | None = None) -> DomainReservation:
-    """A free domain id; `preferred` is taken as given (joining a board's graph).
+    """A free domain id, or `preferred` (an explicit id) if no other run holds it.
 
-    Each reservation in a process starts one id further on: a domain used a
-    moment ago may still hold what the last run's participants announced,
-    and rediscovery there has been seen to take seconds.
+    Each automatic reservation in a process starts one id further on: a
+    domain used a moment ago may still hold what the last run's
+    participants announced, and rediscovery there has been seen to take
+    seconds.
     """
     global _reservations
     if preferred is not None:
-        return DomainReservation(preferred, None)
+        return _reserve_explicit(preferred)
     span = LAST_ID - FIRST_ID + 1
     worker = os.environ.get("PYTEST_XDIST_WORKER", "gw0").removeprefix("gw")
     start = (os.getpid() + 17 * int(worker or 0) + _reservations) % span
     _reservations += 1
     for offset in range(span):
         domain_id = FIRST_ID + (start + offset) % span
-        handle = _try_lock(domain_id)
-        if handle is not None:
-            return DomainReservation(domain_id, handle)
+        lock = _try_lock(domain_id)
+        if lock is not None:
+            return DomainReservation(domain_id, lock)
     raise LinkError(f"no free ROS domain id in {FIRST_ID}..{LAST_ID}: too many runs at once")
+
+
+def _reserve_explicit(domain_id: int) -> DomainReservation:
+    """Take `domain_id` (again, within this process); ConfigError naming another holder."""
+    path = lock_file(domain_id)
+    try:
+        lock = take(path, reentrant=True, shared=True)
+    except Held as busy:
+        if busy.holder.pid is not None and busy.holder.pid in _ancestors():
+            return DomainReservation(domain_id, None)  # our starter's reservation
+        raise ConfigError(
+            f"ROS domain {domain_id} is in use by {busy.holder}: two runs in one domain "
+            "would judge each other's messages; wait for it, or choose another domain id "
+            "(or none: each run then reserves a free one)"
+        ) from None
+    except OSError as err:
+        raise ConfigError(
+            f"ROS domain {domain_id}: cannot use its lock file {path}: {err.strerror or err}"
+        ) from None
+    return DomainReservation(domain_id, lock)
+
+
+def _ancestors(limit: int = 64) -> set[int]:
+    """The pids of this process's parent, its parent, and so on (init excluded)."""
+    found: set[int] = set()
+    pid = os.getppid()
+    while pid > 1 and pid not in found and len(found) < limit:
+        found.add(pid)
+        try:
+            stat = Path(f"/proc/{pid}/stat").read_text()
+        except OSError:
+            break
+        pid = int(stat.rsplit(")", 1)[1].split()[1])  # after the name: state, ppid
+    return found

@@ -10,6 +10,10 @@ the run goes: a node seen to publish the Bool first costs no wait at all; for
 others a short grace after the String lets the Bool of the same callback
 arrive (bounded, a few ms; never a fixed per-scan wait of the deadline).
 
+While the node comes up, the harness publishes /clock (time 0), so a node
+that waits for a clock before it subscribes to the scans can start; the
+first scan's /clock is time 0 as well.
+
 A hostile node gets a verdict, not a hang (docs/hostile_nodes.md): a wrong
 message type on a topic is named from the ROS graph at once, a flood of
 messages ends the run, and when the run is over the node is stopped (and
@@ -111,6 +115,7 @@ class Ros2Link(Link):
         self._start_processes(env)  # before our DDS threads exist: fork stays simple
         self.observer = self._make_observer(self.domain.domain_id)
         deadline = time.monotonic() + opts.ready_timeout
+        clock_due = 0.0  # monotonic time of the next /clock while waiting
         while not self._ready():
             gone = self._node_gone("before it was ready")
             if gone:
@@ -118,14 +123,61 @@ class Ros2Link(Link):
             expired = time.monotonic() >= deadline
             self._check_types(named_only=not expired)
             if expired:
-                raise LinkError(
-                    f"node {self.command.description} never became ready within "
-                    f"{opts.ready_timeout:g} s: it must subscribe to {opts.scan_topic} and "
-                    f"publish {opts.status_topic} ({self.observer.graph_summary()})"
-                )
+                raise LinkError(self._never_ready())
+            if self._clock_before_ready() and time.monotonic() >= clock_due:
+                self.observer.publish_clock(0.0)  # a node may wait for /clock before it subscribes
+                clock_due = time.monotonic() + POLL_S
             self.observer.spin(POLL_S)
             self.observer.inbox.clear()  # nothing heard before it is ready is an answer
         self.startup_s = time.perf_counter() - started
+
+    def _clock_before_ready(self) -> bool:
+        """Publish /clock (time 0) while waiting for the node to come up?
+
+        Yes in a graph the harness made for the node (a use_sim_time node
+        reads time 0 until the first scan's /clock either way, so nothing it
+        is judged on changes; one that waits for a /clock message before
+        subscribing to the scans can start). Not into a physical board's
+        graph, where nothing may be waiting for the harness's time.
+        """
+        return self.options.port is None
+
+    def _reads_scans(self) -> bool:
+        """Does something besides the harness read the scan topic?"""
+        assert self.observer is not None
+        obs = self.observer
+        if obs.scan_pub is not None:
+            return obs.scan_pub.get_subscription_count() > 0
+        return obs.node.count_subscribers(self.options.scan_topic) > 1  # the harness's is one
+
+    def _never_ready(self) -> str:
+        """Why the node is not ready: what the harness waited for, and what was missing."""
+        assert self.observer is not None
+        opts = self.options
+        reads = self._reads_scans()
+        publishes = self.observer.status_sub.get_publisher_count() > 0
+        missing = [
+            *([] if reads else [f"subscribe to {opts.scan_topic}"]),
+            *([] if publishes else [f"publish {opts.status_topic}"]),
+        ]
+        reason = (
+            f"it did not {' or '.join(missing)}" if missing else "it was ready only as time ran out"
+        )
+        if not reads:
+            if self._clock_before_ready():
+                reason += " (the harness published /clock, time 0, all the while)"
+            else:
+                reason += (
+                    " (the harness publishes /clock only once the node is ready, so a node "
+                    f"that waits for /clock before it subscribes to {opts.scan_topic} never "
+                    "starts)"
+                )
+        return (
+            f"node {self.command.description} never became ready within "
+            f"{opts.ready_timeout:g} s: the harness waited for it to subscribe to "
+            f"{opts.scan_topic} and publish {opts.status_topic}, but {reason} "
+            f"({self.observer.graph_summary()})"
+        )
 
     def _check_types(self, *, named_only: bool = False) -> None:
         """Fail at once, naming it, when the node publishes what can never reach the harness:
@@ -192,8 +244,8 @@ class Ros2Link(Link):
             outcome = self._wait_for(answered, min(WARM_UP_RETRY_S, deadline - time.perf_counter()))
             if outcome is None:
                 break
-            if outcome != "timeout":
-                raise LinkError(f"node {self.command.description} {outcome} while warming up")
+            if outcome != "timeout":  # it names the node (or the driver, or the line) already
+                raise LinkError(self._node_gone("while warming up") or outcome)
             if time.perf_counter() >= deadline:
                 raise LinkError(
                     f"node {self.command.description} never answered a scan within "
