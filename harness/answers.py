@@ -2,8 +2,9 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
+from harness.safe_text import TEXT_LIMIT, for_storage
 from harness.scan import Scan
 
 
@@ -32,6 +33,26 @@ class Answers:
     # Earlier driver scans the node answered during this exchange (a revolution the
     # line made late, or split), each with its own answers: judged on their own.
     earlier: list[tuple[Scan, Answers]] = field(default_factory=list)
+
+    def clipped(self, limit: int = TEXT_LIMIT) -> Answers:
+        """A copy to keep in a record: each text clipped to `limit` (its length noted)
+        and storable as UTF-8. The oracle judges the answers as they arrived."""
+
+        def kept(items: list[Received]) -> list[Received]:
+            return [
+                replace(r, value=for_storage(r.value, limit)) if isinstance(r.value, str) else r
+                for r in items
+            ]
+
+        return replace(
+            self,
+            statuses=kept(self.statuses),
+            warnings=list(self.warnings),
+            problem=None if self.problem is None else for_storage(self.problem, limit),
+            late=kept(self.late),
+            lost=None if self.lost is None else for_storage(self.lost, limit),
+            earlier=[(scan, answers.clipped(limit)) for scan, answers in self.earlier],
+        )
 
     @property
     def extra_scans(self) -> int:

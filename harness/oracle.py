@@ -19,13 +19,14 @@ the truth behind faults never leaks into a verdict. Rules (docs/oracle.md):
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from harness.answers import Answers
 from harness.errors import ConfigError
 from harness.link_faults import ON_TIME, Delivery
+from harness.safe_text import QUOTE_LIMIT, TEXT_LIMIT, clip, for_storage
 from harness.scan import Scan
 from harness.status import StatusClaim, compile_status_pattern, half_unit, parse_status
 
@@ -62,6 +63,27 @@ class Verdict:
     warning_got: bool | None
     failures: tuple[str, ...]
     explanation: str
+
+    def clipped(self, limit: int = TEXT_LIMIT) -> Verdict:
+        """A copy to keep in a record: the status text, the failures and the explanation
+        clipped to `limit` (their length noted) and storable as UTF-8."""
+        claim = self.claim
+        if claim is not None:
+            claim = replace(claim, text=for_storage(claim.text, limit))
+        return replace(
+            self,
+            claim=claim,
+            failures=tuple(for_storage(f, limit) for f in self.failures),
+            explanation=for_storage(self.explanation, limit),
+        )
+
+
+def _quoted(text: str) -> str:
+    """A status as an explanation quotes it: repr, and only its start when long.
+
+    The oracle judged the whole text; the explanation notes its length.
+    """
+    return repr(clip(text, QUOTE_LIMIT))
 
 
 def _num(x: float | None, places: int = 3) -> str:
@@ -207,7 +229,7 @@ class Oracle:
         exp = self.expect(scan)
         failures: list[str] = []
         if answers.problem:
-            failures.append(f"link problem: {answers.problem}")
+            failures.append(f"link problem: {clip(answers.problem)}")
 
         texts = [str(r.value) for r in answers.statuses]
         claim: StatusClaim | None = None
@@ -219,13 +241,17 @@ class Oracle:
         if not texts:
             if answers.timed_out:
                 came = [r for r in answers.late if r.tick == tick and isinstance(r.value, str)]
-                late = f"; it came after {came[0].after:.2f} s: {came[0].value!r}" if came else ""
+                late = (
+                    f"; it came after {came[0].after:.2f} s: {_quoted(str(came[0].value))}"
+                    if came
+                    else ""
+                )
                 failures.append(f"no status within the deadline ({answers.waited:.2f} s){late}")
             else:
                 failures.append("no status arrived")
         else:
             if len(texts) > 1:
-                quoted = ", ".join(repr(x) for x in texts[:4])
+                quoted = ", ".join(_quoted(x) for x in texts[:4])
                 times = "twice" if len(texts) == 2 else f"{len(texts)} times"
                 failures.append(f"answered {times} (one status per scan expected): {quoted}")
             claim = parse_status(texts[0], self.pattern)
@@ -275,7 +301,7 @@ class Oracle:
         return f"{text}; {thr}{band}"
 
     def _judge_claim(self, scan: Scan, exp: Expectation, claim: StatusClaim) -> list[str]:
-        quoted = repr(claim.text)
+        quoted = _quoted(claim.text)
         if not exp.obstacle:
             if claim.obstacle:
                 return [f"status {quoted} claims an obstacle at {_num(claim.distance)} m"]

@@ -3,13 +3,17 @@
 ``assert result.ok, result.explanation`` prints the oracle's explanation of
 the first failed tick, how many more failed, why the run ended early, and
 the node's last stderr lines when it crashed or went quiet. The short
-``repr`` is what a bare ``assert result.ok`` shows. Pure: no rclpy here.
+``repr`` is what a bare ``assert result.ok`` shows. Both are bounded, with
+every non-printable character a node wrote shown as its escape
+(harness.safe_text). Pure: no rclpy here.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
+
+from harness.safe_text import DIAGNOSTICS_LIMIT, TEXT_LIMIT, clip, for_terminal
 
 if TYPE_CHECKING:
     from harness.trace import RunResult, TickRecord
@@ -63,9 +67,10 @@ class HilResult:
         r = self.raw
         failed = self.failed_ticks
         if self.ok:
-            return f"{self._title()}: all {len(r.records)} ticks passed"
+            return for_terminal(f"{self._title()}: all {len(r.records)} ticks passed")
+        error = clip(r.error, TEXT_LIMIT) if r.error is not None else None
         if r.not_started:
-            lines = [f"{self._title()}: did not start: {r.error}"]
+            lines = [f"{self._title()}: did not start: {error}"]
         else:
             lines = [f"{self._title()}: {len(failed)} of {len(r.records)} ticks failed"]
         if failed:
@@ -76,11 +81,11 @@ class HilResult:
                 lines.append(f"{len(failed) - 1} more failed ticks: {', '.join(more)}{etc}")
         if r.error is not None and not r.not_started:
             problem = r.error.partition(": ")[2] or r.error  # without its "t=... tick N: "
-            if not failed or problem not in failed[0].verdict.explanation:
-                lines.append(f"the run ended early: {r.error}")
+            if not failed or clip(problem) not in failed[0].verdict.explanation:
+                lines.append(f"the run ended early: {error}")
         if r.diagnostics and self._node_output_matters():
-            lines.append(r.diagnostics.rstrip())
-        return "\n".join(lines)
+            lines.append(clip(r.diagnostics, DIAGNOSTICS_LIMIT).rstrip())
+        return for_terminal("\n".join(lines))
 
     def check(self) -> HilResult:
         """Raise AssertionError with the explanation unless ok; returns self to chain."""
@@ -90,7 +95,7 @@ class HilResult:
 
     def __repr__(self) -> str:
         r = self.raw
-        where = f"{r.scenario} over {r.link}"
+        where = for_terminal(clip(f"{r.scenario} over {r.link}", REPR_CHARS))
         if self.ok:
             return f"<HilResult {where}: PASS, {len(r.records)} ticks>"
         failed = self.failed_ticks
@@ -98,6 +103,7 @@ class HilResult:
             first = failed[0].verdict.explanation
         else:
             first = r.error or "failed"
+        first = for_terminal(clip(first, 4 * REPR_CHARS))
         if len(first) > REPR_CHARS:
             first = first[: REPR_CHARS - 3] + "..."
         count = f"{len(failed)} of {len(r.records)} ticks failed"

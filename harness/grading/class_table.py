@@ -3,12 +3,13 @@
 Rendered three ways from the same rows: CSV (for a spreadsheet), one HTML
 page (to read or print), and a rich table for the terminal. Pure: no file
 writing here (``grade`` writes these bytes atomically), no rclpy, no pybullet.
+Student names and failures come from students: every text is bounded and
+made safe for its medium by harness.safe_text.
 """
 
 from __future__ import annotations
 
 import csv
-import html
 import io
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -17,11 +18,12 @@ from urllib.parse import quote
 from rich.table import Table
 from rich.text import Text
 
+from harness.safe_text import TEXT_LIMIT, clip, for_csv, for_html, for_terminal
+
 __all__ = ["StudentGrade", "class_csv", "class_html", "class_rich_table"]
 
 PASS, FAIL, ERROR, NOT_RUN = "PASS", "FAIL", "ERROR", "NOT RUN"
 VERDICT_STYLE = {PASS: "green", FAIL: "red", ERROR: "red", NOT_RUN: "yellow"}
-FORMULA_STARTS = ("=", "+", "-", "@", "\t", "\r")
 
 
 @dataclass(frozen=True)
@@ -47,7 +49,7 @@ class StudentGrade:
 
 def _cell(text: str) -> str:
     """A CSV cell a spreadsheet shows as text, never runs as a formula."""
-    return f"'{text}" if text.startswith(FORMULA_STARTS) else text
+    return for_csv(clip(text, TEXT_LIMIT))
 
 
 def class_csv(grades: Sequence[StudentGrade], scenarios: Sequence[str]) -> bytes:
@@ -80,7 +82,11 @@ td.student a { color: #555; }
 
 
 def _h(text: object) -> str:
-    return html.escape(str(text), quote=True)
+    return for_html(clip(str(text), TEXT_LIMIT))
+
+
+def _t(text: str, style: str = "") -> Text:
+    return Text(for_terminal(clip(text, TEXT_LIMIT)), style=style)
 
 
 def class_html(
@@ -124,11 +130,11 @@ def class_rich_table(grades: Sequence[StudentGrade], scenarios: Sequence[str]) -
     table = Table(box=None, pad_edge=False)
     table.add_column("student", overflow="fold")
     for s in scenarios:
-        table.add_column(s, overflow="fold")
+        table.add_column(_t(s), overflow="fold")
     table.add_column("passed", justify="right")
     table.add_column("first failure", overflow="fold", ratio=1)
     for g in grades:
         verdicts = [g.verdicts.get(s, NOT_RUN) for s in scenarios]
-        cells = [Text(v, style=VERDICT_STYLE.get(v, "")) for v in verdicts]
-        table.add_row(Text(g.name), *cells, g.score, Text(g.first_failure))
+        cells = [_t(v, VERDICT_STYLE.get(v, "")) for v in verdicts]
+        table.add_row(_t(g.name), *cells, g.score, _t(g.first_failure))
     return table

@@ -1,8 +1,9 @@
 """index.html: the run on one page, readable offline and from a CI artifact.
 
 Built from summary.json's data (so the page and the file cannot disagree),
-plain HTML with inline CSS, no scripts. All text is escaped: scenario
-names and status strings come from users and students.
+plain HTML with inline CSS, no scripts. All text is escaped, with every
+non-printable character shown as its escape (harness.safe_text): scenario
+names, status strings and a node's output come from users and students.
 """
 
 from __future__ import annotations
@@ -11,6 +12,8 @@ from collections.abc import Mapping, Sequence
 from html import escape
 from typing import Any
 from urllib.parse import quote
+
+from harness.safe_text import DIAGNOSTICS_LIMIT, TEXT_LIMIT, clip, for_html, visible
 
 __all__ = ["index_html"]
 
@@ -30,8 +33,8 @@ img { max-width: 100%; border: 1px solid #ddd; }
 """
 
 
-def _text(value: object) -> str:
-    return escape(str(value), quote=True)
+def _text(value: object, limit: int = TEXT_LIMIT) -> str:
+    return for_html(clip(str(value), limit))
 
 
 def _href(path: str) -> str:
@@ -72,8 +75,9 @@ def _section(i: int, e: Mapping[str, Any], diagnostics: str) -> list[str]:
     if error and error not in (e["first_failure"] or ""):
         out.append(f'<p class="failure">run ended: {_text(error)}</p>')
     if diagnostics and not e["ok"]:
-        tail = "\n".join(diagnostics.rstrip().splitlines()[-DIAGNOSTIC_LINES:])
-        out.append(f"<pre>{_text(tail)}</pre>")
+        lines = visible(clip(diagnostics, DIAGNOSTICS_LIMIT)).rstrip().split("\n")
+        tail = "\n".join(lines[-DIAGNOSTIC_LINES:])
+        out.append(f"<pre>{_text(tail, DIAGNOSTICS_LIMIT)}</pre>")
     plot = e["files"].get("plot")
     if plot:
         alt = f"plot of {e['scenario']}: ranges, the node's answers and failed ticks over time"

@@ -6,6 +6,10 @@ the files written for it (`plot`, `recording`, `summary`, when written).
 File paths are relative to the folder holding the XML file, so a CI
 artifact with the report folder keeps its links; without a known folder
 they are absolute.
+
+Every text is made valid XML 1.0 and harmless on a terminal (a node's
+stderr may hold escape sequences or NUL) and bounded in length
+(harness.safe_text).
 """
 
 from __future__ import annotations
@@ -15,6 +19,7 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 from harness.report.files import relative_path, write_atomically
+from harness.safe_text import DIAGNOSTICS_LIMIT, TEXT_LIMIT, clip, for_xml
 from harness.trace import RunResult
 
 MAX_LISTED_FAILURES = 50
@@ -22,6 +27,11 @@ MAX_LISTED_FAILURES = 50
 
 def _shown_path(path: Path, base: Path | None) -> str:
     return str(path.resolve()) if base is None else relative_path(path, base)
+
+
+def _x(value: object, limit: int = TEXT_LIMIT) -> str:
+    """Any value as XML-safe text, clipped to `limit` characters (its length noted)."""
+    return for_xml(clip(str(value), limit))
 
 
 def junit_xml(
@@ -44,7 +54,7 @@ def junit_xml(
     node = ET.SubElement(
         root,
         "testsuite",
-        name=suite,
+        name=_x(suite),
         tests=str(len(results)),
         failures=str(failures),
         errors=str(errors),
@@ -52,7 +62,11 @@ def junit_xml(
     )
     for i, r in enumerate(results):
         case = ET.SubElement(
-            node, "testcase", classname=f"{suite}.{r.link}", name=r.scenario, time=f"{r.wall_s:.3f}"
+            node,
+            "testcase",
+            classname=_x(f"{suite}.{r.link}"),
+            name=_x(r.scenario),
+            time=f"{r.wall_s:.3f}",
         )
         props = ET.SubElement(case, "properties")
         for key, value in (
@@ -63,25 +77,26 @@ def junit_xml(
             ("ticks", len(r.records)),
             ("failed_ticks", len(r.failed_ticks)),
         ):
-            ET.SubElement(props, "property", name=key, value=str(value))
-        if r.first_failure:
-            ET.SubElement(props, "property", name="explanation", value=r.first_failure)
+            ET.SubElement(props, "property", name=key, value=_x(value))
+        first = _x(r.first_failure or "")
+        if first:
+            ET.SubElement(props, "property", name="explanation", value=first)
         for name, path in (artifacts[i] if artifacts is not None else {}).items():
-            ET.SubElement(props, "property", name=name, value=_shown_path(path, base))
+            ET.SubElement(props, "property", name=_x(name), value=_x(_shown_path(path, base)))
         if r.ok:
             continue
         if r.not_run:
-            ET.SubElement(case, "skipped", message=r.error or "not run")
+            ET.SubElement(case, "skipped", message=_x(r.error or "not run"))
             continue
         kind = "failure" if r.failed_ticks else "error"
-        lines = [t.verdict.explanation for t in r.failed_ticks[:MAX_LISTED_FAILURES]]
+        lines = [_x(t.verdict.explanation) for t in r.failed_ticks[:MAX_LISTED_FAILURES]]
         if len(r.failed_ticks) > MAX_LISTED_FAILURES:
             lines.append(f"... and {len(r.failed_ticks) - MAX_LISTED_FAILURES} more failed ticks")
         if r.error:
-            lines.append(f"run ended: {r.error}")
+            lines.append(_x(f"run ended: {r.error}"))
         if r.diagnostics:
-            lines.append(r.diagnostics)
-        ET.SubElement(case, kind, message=r.first_failure or "", type=kind).text = "\n".join(lines)
+            lines.append(_x(r.diagnostics, DIAGNOSTICS_LIMIT))
+        ET.SubElement(case, kind, message=first, type=kind).text = "\n".join(lines)
     ET.indent(root)
     return ET.tostring(root, encoding="utf-8", xml_declaration=True)
 

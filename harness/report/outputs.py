@@ -18,14 +18,15 @@ from __future__ import annotations
 
 import os
 import re
-import tempfile
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from harness.errors import ConfigError
-from harness.report.files import relative_path, write_atomically
+from harness.report.files import fill_atomically, relative_path, write_atomically
+from harness.report.folder_lock import lock_folder
 from harness.report.summary import json_bytes, run_summary, scenario_details, scenario_entry
+from harness.safe_text import DIAGNOSTICS_LIMIT, for_storage
 from harness.trace import RunResult
 
 __all__ = [
@@ -99,24 +100,28 @@ def _safe_stem(name: str) -> str:
 
 
 def _write_via_temporary(writer: ArtifactWriter, final: Path, result: RunResult) -> Path:
-    """Run `writer` on a hidden temporary file, then rename it to `final` (atomic)."""
-    handle, name = tempfile.mkstemp(
-        prefix=f".{final.name}.", suffix=writer.suffix, dir=final.parent
+    """Run `writer` on a hidden temporary file, then rename it to `final` (atomic).
+
+    A writer that returns another path chose its own; it answers for it.
+    """
+    return fill_atomically(
+        final, lambda temporary: writer.write(temporary, result), suffix=writer.suffix
     )
-    os.close(handle)
-    temporary = Path(name)
-    try:
-        written = Path(writer.write(temporary, result))
-        if written != temporary:
-            temporary.unlink(missing_ok=True)
-            return written  # the writer chose its own path; it answers for it
-        with open(temporary, "rb") as done:
-            os.fsync(done.fileno())
-        os.replace(temporary, final)
-    except BaseException:
-        temporary.unlink(missing_ok=True)
-        raise
-    return final
+
+
+def stored(result: RunResult) -> RunResult:
+    """`result` as report files keep it: its texts bounded and storable as UTF-8.
+
+    Tick records are bounded when judged (harness.runner); the run's own
+    texts come from the node too (its error, its output tails and the
+    graph's topic names) and are bounded here.
+    """
+    return replace(
+        result,
+        scenario=for_storage(result.scenario),
+        error=None if result.error is None else for_storage(result.error),
+        diagnostics=for_storage(result.diagnostics, DIAGNOSTICS_LIMIT),
+    )
 
 
 @dataclass
@@ -131,11 +136,14 @@ class ReportFolder:
     """Fills a report folder: `add` each result as it finishes, then `finish`.
 
     Writing per scenario as soon as it ends keeps the plots of finished
-    scenarios when a later one hangs or the run is interrupted.
+    scenarios when a later one hangs or the run is interrupted. The folder
+    is locked from here until `finish` or `close` (report.folder_lock): a
+    second run on it is refused with a ConfigError naming this one.
     """
 
     def __init__(self, root: str | Path, writers: Sequence[ArtifactWriter] | None = None) -> None:
         self.root = prepare_folder(root)
+        self._lock = lock_folder(self.root, root)
         self.writers = list(writers) if writers is not None else artifact_writers()
         self.scenarios: list[ScenarioFiles] = []
         self._stems: set[str] = set()
@@ -153,6 +161,7 @@ class ReportFolder:
     def add(self, result: RunResult) -> ScenarioFiles:
         """Write this scenario's artifacts (none for a scenario with no ticks) and its JSON."""
         folder = self.root / SCENARIO_FOLDER
+        result = stored(result)
         stem = self._stem(result.scenario)
         files = ScenarioFiles(result)
         if result.records:
@@ -186,15 +195,27 @@ class ReportFolder:
         xml = junit_xml(results, artifacts=[s.paths for s in done], base=self.root)
         write_atomically(self.root / JUNIT, xml)
         page = index_html(summary, diagnostics=[s.result.diagnostics for s in done])
-        return write_atomically(self.root / INDEX, page)
+        index = write_atomically(self.root / INDEX, page)
+        self.close()  # the report is complete: the folder is the next run's
+        return index
+
+    def close(self) -> None:
+        """Unlock the folder (`finish` does); safe to call twice."""
+        self._lock.release()
+
+    def __enter__(self) -> ReportFolder:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
 
 
 def write_report(
     root: str | Path, results: Sequence[RunResult], writers: Sequence[ArtifactWriter] | None = None
 ) -> ReportFolder:
     """The whole folder for results already at hand (the CLI adds them one by one)."""
-    report = ReportFolder(root, writers)
-    for result in results:
-        report.add(result)
-    report.finish()
+    with ReportFolder(root, writers) as report:
+        for result in results:
+            report.add(result)
+        report.finish()
     return report

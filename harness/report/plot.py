@@ -17,6 +17,7 @@ import numpy as np
 
 from harness.report.files import write_atomically
 from harness.report.summary import verdict_of
+from harness.safe_text import visible
 from harness.trace import RunResult
 
 __all__ = ["PlotSeries", "plot_series", "render_plot", "write_plot"]
@@ -68,7 +69,7 @@ def plot_series(result: RunResult) -> PlotSeries:
         odd.append(d is not None and not finite)
     failed = len(result.failed_ticks)
     counted = f"{failed} of {len(records)} ticks failed" if failed else f"{len(records)} ticks"
-    title = f"{result.scenario} · {result.link} · {verdict_of(result)} ({counted})"
+    title = f"{visible(result.scenario)} · {result.link} · {verdict_of(result)} ({counted})"
     return PlotSeries(
         title=title,
         threshold=float(result.threshold),
@@ -106,7 +107,7 @@ def render_plot(series: PlotSeries) -> bytes:
     top, bottom = fig.subplots(
         2, 1, sharex=True, gridspec_kw={"height_ratios": [3, 1]}, squeeze=True
     )
-    fig.suptitle(series.title, fontsize=10)
+    fig.suptitle(series.title, fontsize=10, parse_math=False)  # a name may hold "$"
     t = series.t
     failed_spans = _spans(t, series.failed)
     band_spans = _spans(t, np.isnan(series.warning_expected))

@@ -22,6 +22,7 @@ from rich.progress import (
     TimeElapsedColumn,
 )
 
+from harness.safe_text import clip, for_terminal
 from harness.trace import RunResult, TickRecord
 
 __all__ = ["RunProgress"]
@@ -76,14 +77,16 @@ class RunProgress:
         return self._progress is not None
 
     def _current(self) -> str:
-        return self._names[self._done] if self._done < len(self._names) else "done"
+        """The scenario running, as plain text (its name could read as markup)."""
+        name = self._names[self._done] if self._done < len(self._names) else "done"
+        return for_terminal(clip(name, 200))
 
     def _show(self) -> None:
         if not self.enabled or self._progress is not None:
             return
         self._progress = Progress(
             SpinnerColumn(),
-            TextColumn("{task.description}"),
+            TextColumn("{task.description}", markup=False),
             BarColumn(),
             MofNCompleteColumn(),
             TextColumn("scenarios · {task.fields[ticks]} ticks, {task.fields[failed]} failed"),

@@ -1,4 +1,9 @@
-"""The terminal summary: one row per scenario, then the first failures in words."""
+"""The terminal summary: one row per scenario, then the first failures in words.
+
+Names, statuses, errors and a node's output are printed as plain text, never
+rich markup, with every non-printable character shown as its escape
+(harness.safe_text): what a node writes cannot drive the terminal.
+"""
 
 from __future__ import annotations
 
@@ -6,13 +11,26 @@ from collections.abc import Sequence
 
 from rich.console import Console
 from rich.table import Table
+from rich.text import Text
 
 from harness.report.summary import verdict_of
+from harness.safe_text import DIAGNOSTICS_LIMIT, TEXT_LIMIT, clip, for_terminal
 from harness.scenario import Scenario
 from harness.trace import RunResult
 
 DIAGNOSTIC_LINES = 15
 VERDICT_STYLES = {"PASS": "green", "FAIL": "red", "ERROR": "red", "NOT RUN": "yellow"}
+
+
+def _plain(text: object, style: str = "") -> Text:
+    """A table cell shown as written (no markup), safe and bounded."""
+    return Text(for_terminal(clip(str(text))), style=style)
+
+
+def _print(console: Console, text: str, *, style: str = "", limit: int | None = TEXT_LIMIT) -> None:
+    """External text on the terminal: escaped, bounded (unless `limit` is None), no markup."""
+    shown = for_terminal(text if limit is None else clip(text, limit))
+    console.print(shown, style=style, markup=False, highlight=False, soft_wrap=True)
 
 
 def scenario_table(scenarios: Sequence[Scenario]) -> Table:
@@ -22,7 +40,9 @@ def scenario_table(scenarios: Sequence[Scenario]) -> Table:
         table.add_column(column, overflow="fold")
     for s in scenarios:
         faults = ", ".join(f if isinstance(f, str) else str(f.get("type", "?")) for f in s.faults)
-        table.add_row(s.name, s.lidar.preset, faults or "clean", s.description)
+        table.add_row(
+            _plain(s.name), _plain(s.lidar.preset), _plain(faults or "clean"), _plain(s.description)
+        )
     return table
 
 
@@ -35,13 +55,12 @@ def results_table(results: Sequence[RunResult]) -> Table:
         )
     for r in results:
         word = verdict_of(r)
-        verdict = f"[{VERDICT_STYLES[word]}]{word}[/]"
         table.add_row(
-            r.scenario,
-            r.link,
+            _plain(r.scenario),
+            _plain(r.link),
             str(len(r.records)),
             str(len(r.failed_ticks)),
-            verdict,
+            Text(word, style=VERDICT_STYLES[word]),
             f"{r.wall_s:.2f}",
         )
     return table
@@ -56,29 +75,23 @@ def print_results(console: Console, results: Sequence[RunResult]) -> None:
         if r.not_run:
             continue
         console.print()
-        console.print(
-            r.first_failure, style="bold red", markup=False, highlight=False, soft_wrap=True
-        )
+        _print(console, r.first_failure or "", style="bold red")
         more = len(r.failed_ticks) - 1
         if more > 0:
             console.print(f"  ({more} more failed tick{'s' if more > 1 else ''})", highlight=False)
         if r.error and r.failed_ticks and r.error not in (r.first_failure or ""):
-            console.print(f"  run ended: {r.error}", markup=False, highlight=False, soft_wrap=True)
+            _print(console, f"  run ended: {r.error}")
         if r.diagnostics in shown:
             console.print("  (node output as above)", highlight=False)
         elif r.diagnostics:
             shown.add(r.diagnostics)
-            tail = r.diagnostics.rstrip().splitlines()[-DIAGNOSTIC_LINES:]
-            console.print("  " + "\n  ".join(tail), highlight=False, markup=False, soft_wrap=True)
+            lines = for_terminal(clip(r.diagnostics, DIAGNOSTICS_LIMIT)).rstrip().split("\n")
+            _print(console, "  " + "\n  ".join(lines[-DIAGNOSTIC_LINES:]), limit=None)
     not_run = [r for r in failed if r.not_run]
     if not_run:
         console.print()
         reason = (not_run[0].error or "").removeprefix("not run: ")
-        console.print(
-            f"{len(not_run)} not run: {reason}",
-            highlight=False,
-            markup=False,
-        )
+        _print(console, f"{len(not_run)} not run: {reason}")
     total = len(results)
     passed = total - len(failed)
     console.print()

@@ -165,8 +165,7 @@ def _broken_writer(path: Path, result: RunResult) -> Path:
 def test_writes_are_atomic(tmp_path: Path, passing: RunResult) -> None:
     """A writer failing halfway leaves nothing under its name and no temporary file."""
     writers = [*artifact_writers(), ArtifactWriter("broken", ".bin", _broken_writer)]
-    report = ReportFolder(tmp_path, writers)
-    with pytest.raises(OSError, match="No space left"):
+    with ReportFolder(tmp_path, writers) as report, pytest.raises(OSError, match="No space left"):
         report.add(passing)
     assert _files_in(tmp_path) == [
         "scenarios",

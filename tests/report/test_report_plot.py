@@ -104,3 +104,16 @@ def test_write_plot_of_a_run_without_ticks(tmp_path) -> None:
     path = write_plot(tmp_path / "gone.png", empty)
     assert path.read_bytes()[:4] == b"\x89PNG"
     assert [p.name for p in tmp_path.iterdir()] == ["gone.png"]
+
+
+def test_a_scenario_name_is_drawn_as_text_never_as_markup(tmp_path) -> None:
+    """A name holding mathtext (`$\\foo$`) or control characters is drawn as it reads.
+
+    It used to raise matplotlib's ParseFatalException out of `run --out`.
+    """
+    sent = _scan([1.0] * 36)
+    result = RunResult("$\\foo$ \x1b[31m", "inprocess", 0, 0.5, "clean")
+    result.records.append(_tick(0, sent, None, "Obstacle at 1.00 m, angle -3.14", False))
+    path = write_plot(tmp_path / "plot.png", result)
+    assert path.read_bytes().startswith(b"\x89PNG")
+    assert "\\x1b" in plot_series(result).title

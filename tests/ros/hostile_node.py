@@ -104,6 +104,17 @@ def crash_mid_run(pids: Path | None) -> Node:
     return node
 
 
+def crash_on_first_scan(pids: Path | None) -> Node:
+    """Ready, then raises in the callback of the very first scan (the harness's warm-up)."""
+    node = Answering()
+
+    def crash(stamp: float) -> None:
+        raise RuntimeError("hostile: crash in the callback of the first scan")
+
+    node.before_answer = crash
+    return node
+
+
 def hang(pids: Path | None) -> Node:
     """Blocks forever inside the scan callback."""
     node = Answering()
@@ -222,11 +233,54 @@ def status_parameter_ignored(pids: Path | None) -> Node:
     return Answering(status_topic="/lidar_status")
 
 
+def waits_for_clock(pids: Path | None) -> Node:
+    """Publishes its status and warning at once, but subscribes to the scans only once a
+    /clock message came (a node that needs sim time before it starts its work)."""
+    from rosgraph_msgs.msg import Clock
+
+    node = Answering()
+    node.destroy_subscription(node.sub)
+    topic = node.get_parameter("lidar_topic").value
+
+    def on_clock(msg: Clock) -> None:
+        if node.sub is None:
+            node.get_logger().info(f"first /clock: {msg.clock.sec}.{msg.clock.nanosec:09d}")
+            node.sub = node.create_subscription(LaserScan, topic, node.on_scan, 10)
+
+    node.sub = None
+    node.clock_sub = node.create_subscription(Clock, "/clock", on_clock, 10)
+    return node
+
+
 def ignores_signals(pids: Path | None) -> Node:
     """Ignores SIGINT and SIGTERM: only SIGKILL ends it."""
     node = Answering()
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGTERM, signal.SIG_IGN)
+    return node
+
+
+# Terminal and XML poison: erase, reset, bell, carriage return, a bidi
+# override, a C1 control, rich markup, then NUL (a ROS String ends there);
+# on stderr also invalid UTF-8 (a lone surrogate's bytes). No digits in the
+# status: it must read as claiming nothing.
+POISON = "\x1b[J\x1bc\x07\r\u202e\x9b\x0b\x0c[bold]x[/] \x00"
+POISON_BYTES = POISON.encode() + b" \xff\xfe \xed\xa0\x80 \x1b]0;title\x07\r\n"
+
+
+def control_characters(pids: Path | None) -> Node:
+    """Writes escape sequences, NUL, CR, bidi overrides and invalid UTF-8 to stderr on every
+    scan, answers with a status full of them (and wrong: it claims nothing), then exits
+    with code 1 at tick 2, so they reach the error text (its last stderr) too."""
+    node = Answering()
+
+    def poison(stamp: float) -> None:
+        os.write(2, b"hostile " + POISON_BYTES)
+        if stamp >= MISBEHAVE_AT_S - 1e-6:
+            os._exit(1)
+
+    node.before_answer = poison
+    node.answer = lambda text, warning: node.status_pub.publish(String(data=f"none {POISON}"))
     return node
 
 
@@ -275,6 +329,7 @@ VARIANTS: dict[str, Callable[[Path | None], Node]] = {
     for f in (
         crash_at_start,
         crash_mid_run,
+        crash_on_first_scan,
         hang,
         exits_early,
         flood_status,
@@ -286,8 +341,10 @@ VARIANTS: dict[str, Callable[[Path | None], Node]] = {
         best_effort,
         status_topic_wrong,
         status_parameter_ignored,
+        waits_for_clock,
         ignores_signals,
         leaves_children,
+        control_characters,
     )
 }
 

@@ -17,7 +17,9 @@ from pathlib import Path
 import pytest
 from command_line import COMMAND, fossbot_hil
 
+from harness.errors import LinkError
 from harness.links.base import LinkOptions
+from harness.links.ros2 import Ros2Link
 from harness.runner import run
 from harness.scenario import resolve_scenario
 from harness.trace import RunResult
@@ -123,6 +125,22 @@ def test_crash_mid_run(pids: Path) -> None:
     assert survivors(pids) == []
 
 
+def test_crash_while_warming_up_names_the_node_once(pids: Path) -> None:
+    """Raises on the first scan: 'node CMD exited with code 1 while warming up', CMD once."""
+    done = hostile_cli("crash_on_first_scan", pids)
+    assert done.returncode == 1, explanation(done)
+    command = node("crash_on_first_scan", pids)
+    says(
+        done,
+        f"hostile_wall: t=0.00 s tick 0: node {command} exited with code 1 while warming up; "
+        "last stderr:",
+        "RuntimeError: hostile: crash in the callback of the first scan",
+    )
+    first = next(line for line in done.stdout.splitlines() if line.startswith("hostile_wall:"))
+    assert first.count(command) == 1, first
+    assert survivors(pids) == []
+
+
 def test_hang_in_callback(pids: Path) -> None:
     """Blocks forever in a callback: three missed deadlines end the run; the node is stopped."""
     done = hostile_cli("hang", pids)
@@ -218,15 +236,52 @@ def test_best_effort_publisher_is_named(pids: Path) -> None:
 def test_wrong_topic_names_are_listed(
     variant: str, extra: tuple[str, ...], publishes: str, pids: Path
 ) -> None:
-    """A status on another topic: 'never ready', and what the node does publish."""
+    """A status on another topic: 'never ready', what was missing, what the node does publish."""
     done = hostile_cli(variant, pids, *extra)
     assert done.returncode == 1, explanation(done)
+    status = extra[-1] if extra else "/lidar_status"
     says(
         done,
-        "never became ready within 5 s",
+        "never became ready within 5 s: the harness waited for it to subscribe to /scan and "
+        f"publish {status}, but it did not publish {status} (subscribers on /scan: 1",
         f"/fossbot_lidar_node publishes {publishes}, /obstacle_warning",
         "subscribes to /scan (sensor_msgs/msg/LaserScan)",
     )
+    assert "/clock" not in done.stdout  # it reads the scans: /clock is no suspect
+    assert survivors(pids) == []
+
+
+def test_a_node_waiting_for_clock_before_it_subscribes_starts_and_passes(pids: Path) -> None:
+    """The harness publishes /clock (time 0) while it waits for the node to come up."""
+    done = hostile_cli("waits_for_clock", pids)
+    assert done.returncode == 0, explanation(done)
+    says(done, "1 of 1 scenarios passed")
+    assert survivors(pids) == []
+
+
+class ClockOnlyWhenReady(Ros2Link):
+    """The ros2 link as into a physical board's graph: no /clock before the node is ready."""
+
+    def _clock_before_ready(self) -> bool:
+        return False
+
+
+def test_never_ready_says_clock_comes_only_once_the_node_is_ready(pids: Path) -> None:
+    """No /clock before it is ready: the clock-waiting node never subscribes, and is told why."""
+    options = LinkOptions(node=node("waits_for_clock", pids), ready_timeout=2.0)
+    link = ClockOnlyWhenReady(options)
+    try:
+        with pytest.raises(LinkError) as never:
+            link.open()
+    finally:
+        link.close()
+    message = str(never.value)
+    assert (
+        "never became ready within 2 s: the harness waited for it to subscribe to /scan and "
+        "publish /lidar_status, but it did not subscribe to /scan (the harness publishes /clock "
+        "only once the node is ready, so a node that waits for /clock before it subscribes to "
+        "/scan never starts) (subscribers on /scan: 0, publishers on /lidar_status: 1"
+    ) in message, message
     assert survivors(pids) == []
 
 
