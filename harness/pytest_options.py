@@ -108,19 +108,19 @@ OPTIONS = (
         "timeout",
         "S",
         f"seconds to wait for the answers to one scan (default {DEFAULT_TIMEOUT_S:g})",
-        _lazy("positive", "timeout"),
+        _lazy("duration", "timeout"),
     ),
     _Option(
         "ready_timeout",
         "S",
         f"seconds for the node to come up (default {DEFAULT_READY_TIMEOUT_S:g})",
-        _lazy("positive", "ready timeout"),
+        _lazy("duration", "ready timeout"),
     ),
     _Option(
         "port_wait",
         "S",
         f"seconds to wait while another run uses --hil-port (default {DEFAULT_PORT_WAIT_S:g})",
-        _lazy("positive", "port wait"),
+        _lazy("duration", "port wait"),
     ),
 )
 
@@ -236,6 +236,14 @@ def check_config(cfg: HilConfig, config: pytest.Config) -> None:
                 raise pytest.UsageError(
                     f"{src(name)} needs a link that runs a node, not --hil-link inprocess"
                 )
+    if cfg.param:
+        from harness.commands.arguments import check_parameters
+        from harness.errors import ConfigError
+
+        try:  # each item is checked as it is read; here: none given twice
+            check_parameters(cfg.param, None, {"params": f"{src('param')} "})
+        except ConfigError as err:
+            raise pytest.UsageError(str(err)) from None
     if cfg.port is not None:
         from harness.commands.arguments import check_port
         from harness.errors import ConfigError

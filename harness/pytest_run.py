@@ -36,6 +36,40 @@ if TYPE_CHECKING:
 __all__ = ["Hil"]
 #: LinkOptions fields the runner fills in itself, per scenario.
 RUNNER_FIELDS = ("threshold", "scan_rate_hz")
+#: How a failure names hil.run's arguments (harness.commands.arguments.checked_node_options).
+RUN_NAMES = {
+    "scan_topic": "scan_topic=",
+    "status_topic": "status_topic=",
+    "warning_topic": "warning_topic=",
+    "params": "params=",
+    "threshold_param": "threshold_param=",
+    "threshold": "threshold=",
+}
+
+
+def _checked_numbers(overrides: dict[str, Any]) -> dict[str, Any]:
+    """The waits and the domain id among `overrides`, by the command line's own rules."""
+    import argparse
+
+    from harness.commands.arguments import domain_id, duration
+
+    rules = {
+        "scan_timeout": duration("scan_timeout"),
+        "ready_timeout": duration("ready_timeout"),
+        "domain_id": domain_id,
+    }
+    checked: dict[str, Any] = {}
+    for key, rule in rules.items():
+        value = overrides.get(key)
+        if value is None:
+            continue
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise ConfigError(f"{key} must be a number, got {value!r}"[:200])
+        try:
+            checked[key] = rule(repr(value))
+        except argparse.ArgumentTypeError as err:
+            raise ConfigError(str(err)) from None
+    return checked
 
 
 def _fail(message: str) -> NoReturn:
@@ -113,7 +147,12 @@ class Hil:
             if key not in names:
                 raise ConfigError(f"unknown option {key!r} (known: link, {', '.join(names)})")
         if "params" in overrides:
-            overrides = {**overrides, "params": tuple(overrides["params"])}
+            params = overrides["params"]
+            if isinstance(params, str) or not isinstance(params, (Sequence, set, frozenset)):
+                got = repr(params)[:60]
+                raise ConfigError(f"params must be a list of NAME:=VALUE items, got {got}")
+            overrides = {**overrides, "params": tuple(params)}
+        overrides = {**overrides, **_checked_numbers(overrides)}
         options = replace(self.options, **overrides)
         if link not in SERIAL_LINKS and "port" not in overrides:
             options = replace(options, port=None)  # the board's port concerns board links only
@@ -142,7 +181,10 @@ class Hil:
             from harness.status import compile_status_pattern
 
             compile_status_pattern(status_regex)
-        return chosen, fault_items, self._options(link, overrides)
+        from harness.commands.arguments import checked_node_options
+
+        options = checked_node_options(self._options(link, overrides), RUN_NAMES)
+        return chosen, fault_items, options
 
     # -- running ------------------------------------------------------------
     def run(
@@ -184,7 +226,11 @@ class Hil:
         result = self._run(chosen, link, options, settings)
         self.results.append(result)
         if self._record is not None:
-            verdict = "PASS" if result.ok else f"FAIL ({len(result.failed_ticks)} ticks)"
+            from harness.report.summary import verdict_of
+
+            verdict = verdict_of(result.raw)
+            if result.failed_ticks:
+                verdict += f" ({len(result.failed_ticks)} ticks)"
             self._record("hil", f"{result.scenario} over {link}: {verdict}")
         return result
 

@@ -1,27 +1,41 @@
 """Argument types and option groups shared by the commands that run scenarios.
 
-Every type turns bad input into a one-line argparse error (exit 2).
+Every type turns bad input into a one-line argparse error (exit 2). The
+checks that look at several options at once (a topic used twice, a
+parameter that would set the threshold behind the oracle's back) are
+`checked_node_options`, which the pytest plugin calls too; the rules for
+ROS 2 names themselves live in harness.ros_names.
 """
 
 from __future__ import annotations
 
 import argparse
-import importlib.util
+import errno
 import math
 import os
 import stat
-from collections.abc import Callable
+from collections.abc import Callable, Iterable, Mapping
+from dataclasses import replace
 
 from harness.errors import ConfigError
 from harness.links.base import LinkOptions, known_links
+from harness.ros_names import (
+    InvalidName,
+    check_parameter_name,
+    check_parameter_rule,
+    parameter_target,
+    resolve_topic,
+    shown,
+)
 
 DEFAULT_LINK = "ros2"
 SERIAL_LINKS = ("rplidar", "ldlidar")
 NODE_OPTIONS = ("node", "package", "executable", "workspace")
+MAX_WAIT_S = 86400.0
 
 
-def positive(kind: str) -> Callable[[str], float]:
-    """A finite number above zero, named `kind` in the error."""
+def positive(kind: str, maximum: float = math.inf) -> Callable[[str], float]:
+    """A finite number above zero (and at most `maximum`), named `kind` in the error."""
 
     def parse(text: str) -> float:
         try:
@@ -30,9 +44,17 @@ def positive(kind: str) -> Callable[[str], float]:
             raise argparse.ArgumentTypeError(f"{kind} must be a number, got {text!r}") from None
         if not math.isfinite(value) or value <= 0:
             raise argparse.ArgumentTypeError(f"{kind} must be a positive number, got {text!r}")
+        if value > maximum:
+            raise argparse.ArgumentTypeError(f"{kind} must be at most {maximum:g}, got {text!r}")
         return value
 
     return parse
+
+
+def duration(kind: str) -> Callable[[str], float]:
+    """Seconds to wait for something: positive, at most a day (the OS's timed waits
+    overflow somewhere past 24 days; no wait of the harness needs more than a day)."""
+    return positive(kind, MAX_WAIT_S)
 
 
 def seed(text: str) -> int:
@@ -56,25 +78,15 @@ def domain_id(text: str) -> int:
 
 
 def param(text: str) -> str:
-    """NAME:=VALUE, and (where rclpy is installed) one ROS 2 itself can parse.
+    """NAME:=VALUE that ROS 2 itself can parse (harness.ros_names has the rules).
 
     A rule rcl cannot parse would stop the node before it starts; better a
     usage error now than a failed run.
     """
-    name, sep, value = text.partition(":=")
-    if not sep or not name or not value or any(c.isspace() for c in name):
-        raise argparse.ArgumentTypeError(f"expected NAME:=VALUE, got {text!r}")
-    if importlib.util.find_spec("rclpy") is not None:
-        from rclpy.utilities import remove_ros_args
-
-        try:
-            remove_ros_args(["fossbot-hil", "--ros-args", "-p", text])
-        except Exception as err:  # noqa: BLE001 - rclpy's RCLInvalidROSArgsError and kin
-            reason = str(err).split("Error: ", 1)[-1].split(", at ", 1)[0]
-            raise argparse.ArgumentTypeError(
-                f"ROS 2 cannot parse {text!r}: {' '.join(reason.split())[:150]}"
-            ) from None
-    return text
+    try:
+        return check_parameter_rule(text)
+    except InvalidName as err:
+        raise argparse.ArgumentTypeError(str(err)) from None
 
 
 def given(option: str) -> Callable[[str], str]:
@@ -140,7 +152,7 @@ def add_judging_options(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument(
         "--timeout",
-        type=positive("timeout"),
+        type=duration("timeout"),
         default=1.0,
         metavar="S",
         help="seconds to wait for the answers to one scan (default 1)",
@@ -180,14 +192,31 @@ def add_node_options(parser: argparse.ArgumentParser) -> None:
         "--threshold-param",
         default="threshold",
         metavar="NAME",
-        help="node parameter that receives the threshold ('' for none)",
+        help="node parameter that receives the threshold (default threshold; '' for none; "
+        "a --param of that name is refused: use --threshold)",
     )
-    node.add_argument("--scan-topic", default="/scan", metavar="T")
-    node.add_argument("--status-topic", default="/lidar_status", metavar="T")
-    node.add_argument("--warning-topic", default="/obstacle_warning", metavar="T")
+    topic_help = "; relative names resolve to /NAME, ~ and {} names are refused"
+    node.add_argument(
+        "--scan-topic",
+        default="/scan",
+        metavar="T",
+        help="LaserScan topic the node reads (default /scan" + topic_help + ")",
+    )
+    node.add_argument(
+        "--status-topic",
+        default="/lidar_status",
+        metavar="T",
+        help="String topic the node answers on (default /lidar_status)",
+    )
+    node.add_argument(
+        "--warning-topic",
+        default="/obstacle_warning",
+        metavar="T",
+        help="Bool warning topic (default /obstacle_warning); the three topics must differ",
+    )
     node.add_argument(
         "--ready-timeout",
-        type=positive("ready timeout"),
+        type=duration("ready timeout"),
         default=20.0,
         metavar="S",
         help="seconds for the node to come up (default 20)",
@@ -232,8 +261,12 @@ def add_device_options(parser: argparse.ArgumentParser) -> None:
 
 
 def link_options(args: argparse.Namespace) -> LinkOptions:
-    """Link settings from the command line (the runner fills in the threshold)."""
-    return LinkOptions(
+    """Link settings from the command line (the runner fills in the threshold), checked.
+
+    ConfigError names the option when a topic or parameter cannot work
+    (`checked_node_options`); topics come back fully qualified.
+    """
+    options = LinkOptions(
         scan_timeout=args.timeout,
         ready_timeout=args.ready_timeout,
         processor=getattr(args, "processor", None),
@@ -251,6 +284,7 @@ def link_options(args: argparse.Namespace) -> LinkOptions:
         realtime=args.realtime,
         port=getattr(args, "port", None),
     )
+    return checked_node_options(options)
 
 
 def check_link_options(args: argparse.Namespace) -> None:
@@ -269,6 +303,7 @@ def check_link_options(args: argparse.Namespace) -> None:
         )
         if given:
             raise ConfigError(f"{given[0]} needs a link that runs a node, not --link inprocess")
+    link_options(args)  # topics and parameters: a usage error now, not a traceback later
 
 
 def check_status_regex(args: argparse.Namespace) -> None:
@@ -277,3 +312,130 @@ def check_status_regex(args: argparse.Namespace) -> None:
         from harness.status import parse_status
 
         parse_status("", args.status_regex)
+
+
+# -- ROS 2 names and parameters: every command and the pytest plugin ------------
+
+#: How the command line names each LinkOptions field in a message (with the
+#: separator before the value); the plugin passes its own (``scan_topic=``).
+CLI_NAMES: Mapping[str, str] = {
+    "scan_topic": "--scan-topic ",
+    "status_topic": "--status-topic ",
+    "warning_topic": "--warning-topic ",
+    "params": "--param ",
+    "threshold_param": "--threshold-param ",
+    "threshold": "--threshold ",
+}
+TOPIC_FIELDS = ("scan_topic", "status_topic", "warning_topic")
+
+
+def topic_option(label: str, value: object) -> str:
+    """A topic option's value, fully qualified; ConfigError names `label` and says why not."""
+    try:
+        return resolve_topic(value)  # type: ignore[arg-type] - resolve_topic checks the type
+    except InvalidName as err:
+        shown_value = shown(value) if isinstance(value, str) else repr(value)[:60]
+        raise ConfigError(f"{label}{shown_value}: {err}") from None
+
+
+def check_parameters(
+    params: Iterable[str], threshold_param: str | None, names: Mapping[str, str] = CLI_NAMES
+) -> None:
+    """Parameter items that ROS 2 parses, each set once, none setting the threshold parameter.
+
+    The harness passes the threshold to the node itself (``-p
+    <threshold_param>:=<threshold>``, from --threshold or the scenario), and
+    the oracle judges with that same threshold: a --param setting it too
+    would make the node and the oracle disagree. A parameter given twice
+    is refused, not warned about: ROS 2 silently keeps the last, and a
+    test whose meaning depends on the order of its options is a mistake
+    waiting to be made.
+    """
+    label = names["params"]
+    if threshold_param:
+        try:
+            check_parameter_name(threshold_param)
+        except InvalidName as err:
+            option = names["threshold_param"]
+            raise ConfigError(f"{option}{shown(threshold_param)}: {err}") from None
+    threshold_name = parameter_target(f"{threshold_param}:=") if threshold_param else None
+    seen: dict[tuple[str, str], str] = {}
+    for rule in params:
+        try:
+            check_parameter_rule(rule)
+        except InvalidName as err:
+            raise ConfigError(f"{label.rstrip(' =')}: {err}") from None
+        target = parameter_target(rule)
+        if target in seen:
+            raise ConfigError(
+                f"{label}{shown(seen[target])} and {label}{shown(rule)} set the same "
+                "parameter: ROS 2 would silently keep the last; give it once"
+            )
+        seen[target] = rule
+        if target[1] == "use_sim_time":
+            raise ConfigError(
+                f"{label}{shown(rule)} sets use_sim_time, which the harness passes itself "
+                "(true: the node's time is the harness's /clock, the simulated time of "
+                "each scan); leave it out"
+            )
+        if threshold_name is not None and target[1] == threshold_name[1]:
+            value = rule.partition(":=")[2]
+            threshold = names["threshold"]
+            raise ConfigError(
+                f"{label}{shown(rule)} sets {target[1]!r}, the parameter the harness passes "
+                f"the threshold in ({threshold.rstrip(' =')}, default the scenario's): the node "
+                f"and the oracle would disagree; use {threshold}{value.strip()} instead "
+                f"(or {names['threshold_param']}'' if the node must not get the threshold)"
+            )
+
+
+def checked_node_options(options: LinkOptions, names: Mapping[str, str] = CLI_NAMES) -> LinkOptions:
+    """`options` with fully qualified topics, once its names and parameters can work.
+
+    ConfigError, one line naming the option as `names` calls it, for a
+    topic or parameter name ROS 2 refuses, two of the scan, status and
+    warning topics that are one topic (after resolving ``scan`` to
+    ``/scan``), or a parameter `check_parameters` refuses.
+    """
+    topics = {field: topic_option(names[field], getattr(options, field)) for field in TOPIC_FIELDS}
+    first_with: dict[str, str] = {}
+    for field, topic in topics.items():
+        if topic in first_with:
+            other = first_with[topic]
+            raise ConfigError(
+                f"{names[field]}{shown(getattr(options, field))}: the same topic as "
+                f"{names[other]}{shown(getattr(options, other))} ({topic}); the scan, the "
+                "status and the warning need a topic each"
+            )
+        first_with[topic] = field
+    check_parameters(options.params, options.threshold_param, names)
+    return replace(options, **topics)
+
+
+def check_output_file(option: str, path: str | None) -> None:
+    """A file the command will write (--junit-xml, --record): not a folder, in one that exists.
+
+    Checked before anything runs, so a typo costs nothing; an existing
+    regular file is overwritten (atomically), anything else is refused.
+    """
+    if path is None:
+        return
+    text = path if path.isprintable() else repr(path)
+    if not path.strip():
+        raise ConfigError(f"{option} must not be empty")
+    if path.endswith(("/", os.sep)):
+        raise ConfigError(f"{option} {text}: names a folder, not a file")
+    try:
+        mode = os.stat(path).st_mode
+    except FileNotFoundError:
+        mode = None
+    except (OSError, ValueError) as err:
+        if getattr(err, "errno", None) == errno.ENOTDIR:
+            raise ConfigError(f"{option} {text}: a part of this path is a file") from None
+        raise ConfigError(f"{option} {text}: {getattr(err, 'strerror', None) or err}") from None
+    if mode is not None and stat.S_ISDIR(mode):
+        raise ConfigError(f"{option} {text}: a folder, not a file")
+    if mode is not None and not stat.S_ISREG(mode):
+        raise ConfigError(f"{option} {text}: exists and is not a regular file")
+    if not os.path.isdir(os.path.dirname(os.path.abspath(path))):
+        raise ConfigError(f"{option} {text}: its folder does not exist")

@@ -21,13 +21,16 @@ from harness.commands.arguments import (
     add_node_options,
     add_scenario_overrides,
     check_status_regex,
+    duration,
     fault_list,
+    given,
     link_options,
-    positive,
 )
 from harness.errors import ConfigError
 from harness.grading import LAB_EXECUTABLE, LAB_PACKAGE
 from harness.grading.discover import GRADES_MARKER, Student
+from harness.holder_lock import HolderLock
+from harness.report.folder_lock import lock_folder
 from harness.scenario import Scenario, resolve_scenario, shipped_scenarios
 
 NAME = "grade"
@@ -62,6 +65,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument(
         "--out",
+        type=given("--out"),
         default="grades",
         metavar="DIR",
         help="where the class table and each student's logs go (default: grades)",
@@ -85,14 +89,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     add_judging_options(parser)
     parser.add_argument(
         "--build-timeout",
-        type=positive("build timeout"),
+        type=duration("build timeout"),
         default=180.0,
         metavar="S",
         help="longest one student's colcon build may take (default 180)",
     )
     parser.add_argument(
         "--student-timeout",
-        type=positive("student timeout"),
+        type=duration("student timeout"),
         default=900.0,
         metavar="S",
         help="longest one student's scenario suite may take (default 900)",
@@ -151,20 +155,31 @@ def check_out(out: Path) -> None:
         )
 
 
-def prepare_out(out: Path) -> Path:
-    """Create (or reuse) the output folder, marked as ours, without last time's students."""
+def prepare_out(out: Path) -> HolderLock:
+    """Create (or reuse) the output folder, marked as ours, without last time's students.
+
+    The folder is locked before anything in it changes (report.folder_lock):
+    a second grade (or run) into it is refused, naming this one, until the
+    returned lock is released.
+    """
     check_out(out)
     try:
         out.mkdir(parents=True, exist_ok=True)
-        (out / GRADES_MARKER).write_text("written by fossbot-hil grade\n", encoding="utf-8")
     except OSError as err:
         raise ConfigError(f"--out {out}: {err.strerror or err}") from None
+    lock = lock_folder(out, f"--out {out}")
+    try:
+        (out / GRADES_MARKER).write_text("written by fossbot-hil grade\n", encoding="utf-8")
+    except OSError as err:
+        lock.release()
+        raise ConfigError(f"--out {out}: {err.strerror or err}") from None
     shutil.rmtree(out / "students", ignore_errors=True)  # last time's students
-    return out
+    return lock
 
 
 def _progress(console: Console, student: Student, grade: object) -> None:
     from harness.grading.class_table import StudentGrade
+    from harness.safe_text import for_terminal
 
     assert isinstance(grade, StudentGrade)
     parts = [student.kind]
@@ -175,7 +190,8 @@ def _progress(console: Console, student: Student, grade: object) -> None:
         parts.append(f"{grade.score} passed in {grade.run_s:.1f} s")
     else:
         parts.append("not run")
-    console.print(f"  {student.name}: {', '.join(parts)}", markup=False, highlight=False)
+    name = for_terminal(student.name)  # a folder name is the student's choice
+    console.print(f"  {name}: {', '.join(parts)}", markup=False, highlight=False)
 
 
 def run(args: argparse.Namespace, console: Console) -> int:
@@ -187,6 +203,7 @@ def run(args: argparse.Namespace, console: Console) -> int:
     from harness.runner import RunSettings, fault_profile
 
     check_grading_options(args)
+    link_options(args)  # topics and parameters: refused now, before any folder is made
     scenarios = selected_scenarios(args.scenario)
     settings = RunSettings(
         seed=args.seed,
@@ -206,52 +223,51 @@ def run(args: argparse.Namespace, console: Console) -> int:
         raise ConfigError(
             "grading needs rclpy: pip install 'fossbot-hil[ros]' (or source ROS 2 Jazzy)"
         )
-    prepare_out(out)
-
-    names = tuple(s.name for s in scenarios)
-    config = GradeConfig(
-        scenarios=names,
-        scenario_refs=tuple(s.source or s.name for s in scenarios),
-        link=args.link,
-        options=link_options(args),
-        settings=settings,
-        students_dir=out.resolve() / "students",  # workers run in their student's folder
-        build_timeout=args.build_timeout,
-        student_timeout=args.student_timeout,
-    )
-    for note in found.skipped:
-        console.print(f"skipped {note}", markup=False, highlight=False)
-    count = len(found.students)
-    console.print(
-        f"grading {count} student{'s' if count != 1 else ''} on {len(names)} scenario"
-        f"{'s' if len(names) != 1 else ''} over {args.link}, {args.jobs} at a time, into {out}",
-        markup=False,
-        highlight=False,
-    )
-    started = time.monotonic()
-    grades = grade_class(
-        found.students,
-        config,
-        jobs=args.jobs,
-        on_graded=lambda student, grade: _progress(console, student, grade),
-    )
-    wall_s = time.monotonic() - started
-    meta = [
-        ("scenarios", ", ".join(names)),
-        ("link", args.link),
-        ("node", f"{args.package}/{args.executable}"),
-        ("seed", "per scenario" if args.seed is None else str(args.seed)),
-        ("threshold", "per scenario" if args.threshold is None else f"{args.threshold:g} m"),
-        ("graded", time.strftime("%Y-%m-%d %H:%M")),
-    ]
-    csv_path = write_atomically(out / "grades.csv", class_csv(grades, names))
-    html_path = write_atomically(out / "grades.html", class_html(grades, names, meta=meta))
-    console.print()
-    console.print(class_rich_table(grades, names))
-    console.print()
-    console.print(
-        f"graded {count} in {wall_s:.1f} s; wrote {csv_path} and {html_path}",
-        markup=False,
-        highlight=False,
-    )
-    return 0
+    with prepare_out(out):  # the folder is this grade's until it is done
+        names = tuple(s.name for s in scenarios)
+        config = GradeConfig(
+            scenarios=names,
+            scenario_refs=tuple(s.source or s.name for s in scenarios),
+            link=args.link,
+            options=link_options(args),
+            settings=settings,
+            students_dir=out.resolve() / "students",  # workers run in their student's folder
+            build_timeout=args.build_timeout,
+            student_timeout=args.student_timeout,
+        )
+        for note in found.skipped:
+            console.print(f"skipped {note}", markup=False, highlight=False)
+        count = len(found.students)
+        console.print(
+            f"grading {count} student{'s' if count != 1 else ''} on {len(names)} scenario"
+            f"{'s' if len(names) != 1 else ''} over {args.link}, {args.jobs} at a time, into {out}",
+            markup=False,
+            highlight=False,
+        )
+        started = time.monotonic()
+        grades = grade_class(
+            found.students,
+            config,
+            jobs=args.jobs,
+            on_graded=lambda student, grade: _progress(console, student, grade),
+        )
+        wall_s = time.monotonic() - started
+        meta = [
+            ("scenarios", ", ".join(names)),
+            ("link", args.link),
+            ("node", f"{args.package}/{args.executable}"),
+            ("seed", "per scenario" if args.seed is None else str(args.seed)),
+            ("threshold", "per scenario" if args.threshold is None else f"{args.threshold:g} m"),
+            ("graded", time.strftime("%Y-%m-%d %H:%M")),
+        ]
+        csv_path = write_atomically(out / "grades.csv", class_csv(grades, names))
+        html_path = write_atomically(out / "grades.html", class_html(grades, names, meta=meta))
+        console.print()
+        console.print(class_rich_table(grades, names))
+        console.print()
+        console.print(
+            f"graded {count} in {wall_s:.1f} s; wrote {csv_path} and {html_path}",
+            markup=False,
+            highlight=False,
+        )
+        return 0

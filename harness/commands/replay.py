@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-from pathlib import Path
 
 from rich.console import Console
 
@@ -13,12 +12,15 @@ from harness.commands.arguments import (
     add_link_option,
     add_node_options,
     check_link_options,
+    check_output_file,
     check_status_regex,
     fault_list,
+    given,
     link_options,
     seed,
+    topic_option,
 )
-from harness.errors import ConfigError
+from harness.errors import ConfigError, Interrupted
 from harness.link_faults import NO_LINK_FAULTS, LinkFaults
 
 NAME = "replay"
@@ -32,11 +34,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--topic",
         metavar="T",
-        help="the LaserScan topic to replay (default /scan, or the only LaserScan topic)",
+        help="the LaserScan topic to replay (default /scan, or the only LaserScan topic; "
+        "a relative name means /NAME)",
     )
     add_link_option(parser)
     add_judging_options(parser)
-    parser.add_argument("--junit-xml", metavar="FILE", help="write a JUnit XML report")
+    parser.add_argument(
+        "--junit-xml", type=given("--junit-xml"), metavar="FILE", help="write a JUnit XML report"
+    )
     parser.add_argument(
         "--faults",
         metavar="FAULT[,FAULT]",
@@ -45,7 +50,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument("--seed", type=seed, help="seed of the link faults (default recorded)")
     parser.add_argument(
-        "--record", metavar="FILE", help="write the replayed run as a new MCAP recording"
+        "--record",
+        type=given("--record"),
+        metavar="FILE",
+        help="write the replayed run as a new MCAP recording",
     )
     add_node_options(parser)
     add_device_options(parser)
@@ -79,20 +87,24 @@ def run(args: argparse.Namespace, console: Console) -> int:
 
     check_link_options(args)
     check_status_regex(args)
-    for option, path in (("--junit-xml", args.junit_xml), ("--record", args.record)):
-        if path and not Path(path).resolve().parent.is_dir():
-            raise ConfigError(f"{option} {path}: its folder does not exist")
+    check_output_file("--junit-xml", args.junit_xml)
+    check_output_file("--record", args.record)
+    topic = None if args.topic is None else topic_option("--topic ", args.topic)
     link_faults = replay_link_faults(args.faults)
-    recording = read_scans(args.recording, args.topic)
-    result = replay(
-        recording,
-        args.link,
-        link_options(args),
-        threshold=args.threshold,
-        status_pattern=args.status_regex,
-        link_faults=link_faults,
-        seed=args.seed,
-    )
+    recording = read_scans(args.recording, topic)
+    try:
+        result = replay(
+            recording,
+            args.link,
+            link_options(args),
+            threshold=args.threshold,
+            status_pattern=args.status_regex,
+            link_faults=link_faults,
+            seed=args.seed,
+        )
+    except Interrupted as stop:  # what was judged before Ctrl-C or SIGTERM, then stop
+        print_results(console, stop.results)
+        raise Interrupted(stop.signum, stop.results, "the replay was judged in part") from None
     print_results(console, [result])
     if args.record:
         from harness.record import write_recording

@@ -771,7 +771,8 @@ def workdir(tmp_path: Path) -> Path:
     (tmp_path / "a_folder").mkdir()
     (tmp_path / "not_executable").write_text("#!/bin/sh\n")
     (tmp_path / "not_executable").chmod(stat.S_IRUSR | stat.S_IWUSR)
-    return tmp_path
+    os.mkfifo(tmp_path / "a_fifo")  # not a regular file; never /dev/null: a writer run as
+    return tmp_path  # root would replace the device itself
 
 
 # (id, arguments after the command, phrase); all could start a node or open a port.
@@ -896,6 +897,53 @@ OPTIONS: list[tuple[str, list[str], str]] = [
         ["emulate", "rplidar", "--scenario", "regular_file"],
         "regular_file: a scenario must be a mapping of fields, got text",
     ),
+    # Issue 12 item 3: a topic rclpy refuses was a traceback from inside the ros2 link.
+    (
+        "scan_topic_not_a_topic",
+        ["run", "s.yaml", "--scan-topic", "not a topic"],
+        "--scan-topic 'not a topic': topic name must not contain characters other than",
+    ),
+    (
+        "status_topic_is_scan_topic",
+        ["run", "s.yaml", "--status-topic", "scan"],
+        "--status-topic 'scan': the same topic as --scan-topic '/scan' (/scan)",
+    ),
+    # Issue 12 item 8: parameters the node would never get right.
+    (
+        "threshold_param_bad_name",
+        ["run", "s.yaml", "--threshold-param", "bad name!"],
+        "--threshold-param 'bad name!': a parameter name is words",
+    ),
+    (
+        "param_sets_the_threshold",
+        ["run", "s.yaml", "--threshold", "0.5", "--param", "threshold:=0.1"],
+        "the node and the oracle would disagree; use --threshold 0.1 instead",
+    ),
+    (
+        "param_sets_the_threshold_without_threshold_option",
+        ["run", "s.yaml", "--param", "threshold:=0.1"],
+        "--param 'threshold:=0.1' sets 'threshold', the parameter the harness passes",
+    ),
+    (
+        "param_sets_the_renamed_threshold",
+        ["run", "s.yaml", "--threshold-param", "min_dist", "--param", "min_dist:=0.2"],
+        "--param 'min_dist:=0.2' sets 'min_dist'",
+    ),
+    (
+        "param_sets_the_threshold_for_one_node",
+        ["run", "s.yaml", "--param", "fossbot_lidar_node:threshold:=0.1"],
+        "sets 'threshold', the parameter the harness passes the threshold in",
+    ),
+    (
+        "param_given_twice",
+        ["run", "s.yaml", "--param", "lidar_topic:=/a", "--param", "lidar_topic:=/b"],
+        "--param 'lidar_topic:=/a' and --param 'lidar_topic:=/b' set the same parameter",
+    ),
+    (
+        "replay_scan_topic_not_a_topic",
+        ["replay", "regular_file", "--scan-topic", "not a topic"],
+        "--scan-topic 'not a topic': topic name must not contain",
+    ),
 ]
 
 
@@ -905,6 +953,148 @@ def test_hostile_option(workdir: Path, args: list[str], phrase: str) -> None:
     """A node, package, workspace, parameter or port that cannot work: refused before it starts."""
     before = listing(workdir)
     outcome = run_command(args, workdir)
+    assert_refused(outcome, phrase)
+    assert_nothing_left(workdir, before)
+
+
+# (id, arguments, phrase): names, topics and output paths refused before anything
+# starts, so they run through `main` in this process.
+NAMES_AND_PATHS: list[tuple[str, list[str], str]] = [
+    *[
+        (f"run_{i}", ["run", "s.yaml", "--link", "inprocess", *args], phrase)
+        for i, args, phrase in [
+            (
+                "scan_topic_spaces",
+                ["--scan-topic", "not a topic"],
+                "--scan-topic 'not a topic': topic name must not contain characters other than",
+            ),
+            ("status_topic_empty", ["--status-topic", ""], "--status-topic '': topic name must"),
+            ("warning_topic_blank", ["--warning-topic", " "], "--warning-topic ' ': topic name"),
+            ("scan_topic_double_slash", ["--scan-topic", "/a//b"], "repeated '/' (character 4)"),
+            ("scan_topic_trailing_slash", ["--scan-topic", "/scan/"], "end with a forward slash"),
+            ("scan_topic_digit", ["--scan-topic", "/robot/2d"], "must not start with a number"),
+            ("scan_topic_private", ["--scan-topic", "~/scan"], "a private name (~) resolves"),
+            ("scan_topic_substitution", ["--scan-topic", "{node}/scan"], "substitutions ({node}"),
+            ("scan_topic_too_long", ["--scan-topic", "a" * 300], "301 characters, at most 247"),
+            (
+                "scan_topic_escapes",
+                ["--scan-topic", "/scan\x1b[31m\n"],
+                "--scan-topic '/scan\\x1b[31m\\n': topic name must not contain",
+            ),
+            (
+                "status_topic_is_scan_topic",
+                ["--status-topic", "/scan"],
+                "--status-topic '/scan': the same topic as --scan-topic '/scan' (/scan)",
+            ),
+            (
+                "warning_topic_is_status_topic_relative",
+                ["--warning-topic", "lidar_status"],
+                "--warning-topic 'lidar_status': the same topic as --status-topic",
+            ),
+            (
+                "scan_topic_is_warning_topic",
+                ["--scan-topic", "obstacle_warning"],
+                "--warning-topic '/obstacle_warning': the same topic as --scan-topic",
+            ),
+            (
+                "threshold_param_bad_name",
+                ["--threshold-param", "bad name!"],
+                "--threshold-param 'bad name!': a parameter name is words",
+            ),
+            ("threshold_param_digit", ["--threshold-param", "1x"], "a parameter name is words"),
+            ("out_empty", ["--out", ""], "argument --out: must not be empty"),
+            ("out_a_file", ["--out", "regular_file"], "regular_file: exists and is not a folder"),
+            ("junit_empty", ["--junit-xml", ""], "argument --junit-xml: must not be empty"),
+            ("junit_a_folder", ["--junit-xml", "a_folder"], "--junit-xml a_folder: a folder"),
+            ("junit_slash", ["--junit-xml", "new/"], "--junit-xml new/: names a folder"),
+            ("junit_fifo", ["--junit-xml", "a_fifo"], "a_fifo: exists and is not a regular"),
+            ("junit_no_folder", ["--junit-xml", "no/x.xml"], "its folder does not exist"),
+            ("junit_through_a_file", ["--junit-xml", "regular_file/x"], "a part of this path"),
+        ]
+    ],
+    (
+        "replay_topic_spaces",
+        ["replay", "regular_file", "--link", "inprocess", "--topic", "bad topic"],
+        "--topic 'bad topic': topic name must not contain",
+    ),
+    (
+        "replay_topic_private",
+        ["replay", "regular_file", "--link", "inprocess", "--topic", "~/scan"],
+        "--topic '~/scan': a private name",
+    ),
+    (
+        "replay_topic_empty",
+        ["replay", "regular_file", "--link", "inprocess", "--topic", ""],
+        "--topic '': topic name must not be empty",
+    ),
+    (
+        "replay_status_topic_is_scan_topic",
+        ["replay", "regular_file", "--link", "inprocess", "--status-topic", "/scan"],
+        "--status-topic '/scan': the same topic as --scan-topic",
+    ),
+    (
+        "replay_record_a_folder",
+        ["replay", "regular_file", "--link", "inprocess", "--record", "a_folder"],
+        "--record a_folder: a folder, not a file",
+    ),
+    (
+        "replay_record_empty",
+        ["replay", "regular_file", "--link", "inprocess", "--record", ""],
+        "argument --record: must not be empty",
+    ),
+    (
+        "replay_junit_a_folder",
+        ["replay", "regular_file", "--link", "inprocess", "--junit-xml", "a_folder/"],
+        "--junit-xml a_folder/: names a folder",
+    ),
+    (
+        "grade_scan_topic_spaces",
+        ["grade", "a_folder", "--scan-topic", "x y"],
+        "--scan-topic 'x y': topic name must not contain",
+    ),
+    (
+        "grade_warning_topic_is_scan_topic",
+        ["grade", "a_folder", "--warning-topic", "/scan"],
+        "--warning-topic '/scan': the same topic as --scan-topic",
+    ),
+    (
+        "grade_param_sets_the_threshold",
+        ["grade", "a_folder", "--param", "threshold:=0.2"],
+        "the node and the oracle would disagree; use --threshold 0.2 instead",
+    ),
+    (
+        "param_sets_use_sim_time",
+        ["run", "--param", "use_sim_time:=false"],
+        "sets use_sim_time, which the harness passes itself",
+    ),
+    (
+        "grade_param_given_twice",
+        ["grade", "a_folder", "--param", "a:=1", "--param", "a:=2"],
+        "set the same parameter",
+    ),
+    (
+        "grade_threshold_param_bad_name",
+        ["grade", "a_folder", "--threshold-param", "x-y"],
+        "--threshold-param 'x-y': a parameter name is words",
+    ),
+    ("grade_out_empty", ["grade", "a_folder", "--out", ""], "argument --out: must not be empty"),
+]
+
+
+@pytest.mark.parametrize(
+    ("args", "phrase"), [pytest.param(a, p, id=i) for i, a, p in NAMES_AND_PATHS]
+)
+def test_hostile_name_or_path_option(
+    workdir: Path,
+    args: list[str],
+    phrase: str,
+    capfd: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """A topic or parameter name ROS 2 refuses, two roles on one topic, a parameter that
+    fights the harness, or an output path that cannot be written: exit 2, one line."""
+    before = listing(workdir)
+    outcome = run_in_process(args, workdir, capfd, monkeypatch)
     assert_refused(outcome, phrase)
     assert_nothing_left(workdir, before)
 
