@@ -204,12 +204,20 @@ class OutputTail:
         with self._lock:
             return bytes(self._buffer[-self._keep :]).decode("utf-8", "replace")
 
+    def last_lines(self, lines: int = 15) -> str:
+        """The last lines written (very long lines cut)."""
+        kept = self.text().rstrip().splitlines()[-lines:]
+        return "\n".join(
+            line if len(line) <= LINE_CHARS else f"{line[:LINE_CHARS]}... ({len(line)} characters)"
+            for line in kept
+        )
+
     def join(self, timeout: float) -> None:
         """Wait (bounded) for end of file: every process holding the pipe has exited."""
         self._thread.join(timeout)
 
 
-def _signal_name(number: int) -> str:
+def signal_name(number: int) -> str:
     try:
         return signal.Signals(number).name
     except ValueError:
@@ -355,13 +363,7 @@ class NodeProcess:
     def tail(self, which: str = "stderr", lines: int = 15) -> str:
         """The last lines the node wrote on stdout or stderr (very long lines cut)."""
         output = self._outputs.get(which)
-        if output is None:
-            return ""
-        kept = output.text().rstrip().splitlines()[-lines:]
-        return "\n".join(
-            line if len(line) <= LINE_CHARS else f"{line[:LINE_CHARS]}... ({len(line)} characters)"
-            for line in kept
-        )
+        return output.last_lines(lines) if output is not None else ""
 
     def exit_summary(self, when: str = "") -> str:
         """`exited with code 1 <when>; last stderr: ...` for failure explanations."""
@@ -369,7 +371,7 @@ class NodeProcess:
         if code is None:
             return "still running"
         if code < 0:
-            how = f"was killed by {_signal_name(-code)}"
+            how = f"was killed by {signal_name(-code)}"
         else:
             how = f"exited with code {code}"
         words = [how, when]

@@ -16,7 +16,6 @@ the parent with ``preexec_fn`` is unsafe with threads.)
 from __future__ import annotations
 
 import os
-import select
 import signal
 import subprocess
 import sys
@@ -26,10 +25,15 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
+from harness.process_group import signal_group, wait_group_gone
+
 __all__ = ["Finished", "run_bounded"]
 
 MAX_FILE_BYTES = 128 * 1024 * 1024  # any one file a student's build or node writes
-POLL_S = 0.2  # how often a running child's log size and the cancel flag are looked at
+# How often a running child's log size and the cancel flag are looked at: a child
+# flooding its log writes hundreds of MB a second, so a cheap stat() often keeps the
+# overshoot small.
+POLL_S = 0.02
 TERM_GRACE_S = 15.0  # after SIGTERM: a worker stops its node (up to 9 s) and writes results
 KILL_WAIT_S = 5.0
 PR_SET_PDEATHSIG = 1
@@ -51,64 +55,22 @@ class Finished:
         return self.returncode == 0 and not (self.timed_out or self.flooded or self.cancelled)
 
 
-def _signal_group(popen: subprocess.Popen[bytes], sig: int) -> None:
-    try:
-        os.killpg(popen.pid, sig)
-    except (ProcessLookupError, PermissionError):
-        pass
-
-
-def _group_members(pgid: int) -> list[int]:
-    """Pids still running (not zombies) in process group `pgid`, from /proc."""
-    members = []
-    for entry in os.scandir("/proc"):
-        if not entry.name.isdigit():
-            continue
-        try:
-            with open(f"/proc/{entry.name}/stat", "rb") as stat:
-                fields = stat.read().rsplit(b")", 1)[1].split()
-        except OSError:
-            continue
-        # After the command name: state, ppid, pgrp, ...
-        if int(fields[2]) == pgid and fields[0] not in (b"Z", b"X"):
-            members.append(int(entry.name))
-    return members
-
-
-def _wait_group_gone(pgid: int, timeout: float) -> None:
-    """Wait, bounded, until nothing in the group runs: SIGKILL is delivered, not instant.
-
-    Orphans that were in the group are reaped by init, not by us, so each is
-    waited on through a pidfd, which becomes readable when it dies.
-    """
-    deadline = time.monotonic() + timeout
-    for pid in _group_members(pgid):
-        try:
-            fd = os.pidfd_open(pid)
-        except OSError:  # gone already
-            continue
-        try:
-            select.select([fd], [], [], max(0.0, deadline - time.monotonic()))
-        finally:
-            os.close(fd)
-
-
 def _stop(popen: subprocess.Popen[bytes]) -> None:
     """SIGTERM the group, then SIGKILL it after a bounded wait; reap the child."""
     for sig, grace in ((signal.SIGTERM, TERM_GRACE_S), (signal.SIGKILL, KILL_WAIT_S)):
         if popen.poll() is not None:
             break
-        _signal_group(popen, sig)
+        signal_group(popen.pid, sig)
         try:
             popen.wait(timeout=grace)
         except subprocess.TimeoutExpired:
             continue
-    _signal_group(popen, signal.SIGKILL)  # anything the child left in its group
+    signal_group(popen.pid, signal.SIGKILL)  # anything the child left in its group
     try:
         popen.wait(timeout=KILL_WAIT_S)
     except subprocess.TimeoutExpired:  # unkillable (D state): give up on it, do not hang
         pass
-    _wait_group_gone(popen.pid, KILL_WAIT_S)
+    wait_group_gone(popen.pid, KILL_WAIT_S)
 
 
 def run_bounded(

@@ -111,13 +111,18 @@ def register(name: str) -> Callable[[L], L]:
     """Class decorator: make a link available under `name` (once)."""
 
     def decorate(cls: L) -> L:
-        if name in _REGISTRY and _REGISTRY[name] is not cls:
+        known = _REGISTRY.get(name)
+        if known is not None and _where(known) != _where(cls):  # a re-import may replace it
             raise RuntimeError(f"link {name!r} is registered twice")
         cls.name = name
         _REGISTRY[name] = cls
         return cls
 
     return decorate
+
+
+def _where(cls: type[Link]) -> str:
+    return f"{cls.__module__}.{cls.__qualname__}"
 
 
 def known_links() -> list[str]:

@@ -10,15 +10,16 @@ from __future__ import annotations
 
 import importlib
 import importlib.util
-import time
-import traceback
 from collections.abc import Callable
 from pathlib import Path
 
 from harness.answers import Answers, Received
 from harness.errors import ConfigError
 from harness.links.base import Link, LinkOptions, register
+from harness.processor_child import ProcessorChild
 from harness.scan import Scan
+
+DIAGNOSTIC_LINES = 14  # with the heading, what the terminal summary shows
 
 Processor = Callable[[Scan, float], "tuple[str, bool | None]"]
 
@@ -59,35 +60,58 @@ def load_processor(ref: str) -> Processor:
 
 @register("inprocess")
 class InprocessLink(Link):
-    """Feed each scan to a Python function in this process."""
+    """Feed each scan to a Python function: no ROS, and nothing it does can end the harness.
+
+    The function runs in a child forked when the link opens (see
+    ``harness.processor_child``): the scan goes out on `send`, the runner
+    simulates the next one meanwhile, and `collect` waits for the answer
+    within the per-scan deadline. Raising, exiting, hanging or crashing is
+    a problem that ends the run as an ERROR at that tick, never a pass.
+    """
 
     def __init__(self, options: LinkOptions) -> None:
         super().__init__(options)
         self._process = (
             load_processor(options.processor) if options.processor else reference_processor
         )
-        self._pending: Answers | None = None
+        self._child: ProcessorChild | None = None
+        self._refused: str | None = None  # why the last scan could not be handed over
+
+    def open(self) -> None:
+        self._child = ProcessorChild(self._process)
+        self._child.start()
 
     def send(self, scan: Scan, tick: int, *, clock: float | None = None) -> None:
-        started = time.perf_counter()
-        try:
-            text, warning = self._process(scan, self.options.threshold)
-        except Exception as err:
-            where = traceback.extract_tb(err.__traceback__)[-1]
-            self._pending = Answers(
-                problem=f"processing function raised {type(err).__name__}: {err} "
-                f"({Path(where.filename).name}:{where.lineno})"
-            )
-            return
-        after = time.perf_counter() - started
-        answers = Answers(statuses=[Received(str(text), after)], waited=after)
-        if warning is not None:
-            answers.warnings.append(Received(bool(warning), after))
-        self._pending = answers
+        if self._child is None:
+            self.open()
+        assert self._child is not None
+        self._refused = self._child.call(scan, self.options.threshold)
 
     def hold(self, seconds: float) -> None:
         """A delay changes nothing for a function called in lockstep: no wall time is spent."""
 
     def collect(self, scan: Scan, tick: int, *, may_be_ignored: bool = False) -> Answers:
-        answers, self._pending = self._pending, None
-        return answers if answers is not None else Answers(timed_out=True)
+        assert self._child is not None
+        if self._refused is not None:
+            return Answers(problem=self._refused)
+        outcome = self._child.outcome(self.options.scan_timeout)
+        if outcome.problem is not None:
+            return Answers(problem=outcome.problem)
+        after = outcome.seconds
+        answers = Answers(statuses=[Received(outcome.status or "", after)], waited=after)
+        if outcome.warning is not None:
+            answers.warnings.append(Received(outcome.warning, after))
+        return answers
+
+    def diagnostics(self) -> str:
+        """What the function printed (stdout and stderr), last lines; the child is stopped
+        first, so all it wrote is in."""
+        if self._child is None:
+            return ""
+        self._child.close()
+        tail = self._child.output_tail(DIAGNOSTIC_LINES)
+        return f"processing function output:\n{tail}" if tail else ""
+
+    def close(self) -> None:
+        if self._child is not None:
+            self._child.close()

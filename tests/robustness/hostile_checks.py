@@ -101,13 +101,20 @@ def run_in_process(
     return Outcome(code, captured.out, captured.err)
 
 
-def run_command(args: list[str], workdir: Path, *, timeout: float = COMMAND_TIMEOUT_S) -> Outcome:
-    """The real `fossbot-hil ARGS` in `workdir`; fails if anything it started outlives it."""
+def run_command(
+    args: list[str],
+    workdir: Path,
+    *,
+    timeout: float = COMMAND_TIMEOUT_S,
+    env: dict[str, str] | None = None,
+) -> Outcome:
+    """The real `fossbot-hil ARGS` in `workdir` (with `env` added to the environment);
+    fails if anything it started outlives it."""
     tmp = workdir / "tmp"
     tmp.mkdir(exist_ok=True)
     marker = f"FOSSBOT_HIL_HOSTILE_TEST={uuid.uuid4().hex}"
     name, _, value = marker.partition("=")
-    env = {**os.environ, name: value, "TMPDIR": str(tmp)}
+    env = {**os.environ, **(env or {}), name: value, "TMPDIR": str(tmp)}
     try:
         done = subprocess.run(
             [*COMMAND, *args],
