@@ -15,9 +15,9 @@ from rich.console import Console
 
 from harness import __version__
 from harness.commands import command_modules
-from harness.errors import ConfigError, HarnessError
+from harness.errors import ConfigError, HarnessError, Interrupted
 
-EXIT_OK, EXIT_FAILED, EXIT_USAGE, EXIT_INTERRUPTED = 0, 1, 2, 130
+EXIT_OK, EXIT_FAILED, EXIT_USAGE = 0, 1, 2
 
 
 class _Parser(argparse.ArgumentParser):
@@ -37,14 +37,17 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def _print_error(message: str) -> None:
-    print(f"fossbot-hil: error: {message}", file=sys.stderr)
+    """One error on stderr; it may quote a node's text (topic names), so shown safely."""
+    from harness.safe_text import clip, for_terminal
+
+    print(f"fossbot-hil: error: {for_terminal(clip(message))}", file=sys.stderr)
 
 
 def _interrupt_on_sigterm() -> None:
     """SIGTERM ends a run like Ctrl-C does: links close, nodes are stopped and reaped."""
 
     def handler(signum: int, frame: object) -> None:
-        raise KeyboardInterrupt
+        raise Interrupted(signum)
 
     signal.signal(signal.SIGTERM, handler)
 
@@ -64,9 +67,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     except ConfigError as err:
         _print_error(str(err))
         return EXIT_USAGE
-    except KeyboardInterrupt:
-        _print_error("interrupted")
-        return EXIT_INTERRUPTED
+    except KeyboardInterrupt as err:  # 130 for Ctrl-C, 143 for SIGTERM, as shells expect
+        signum = getattr(err, "signum", signal.SIGINT)
+        summary = getattr(err, "summary", "")
+        name = signal.Signals(signum).name
+        _print_error(f"interrupted by {name}: {summary}" if summary else f"interrupted by {name}")
+        return 128 + signum
     except HarnessError as err:
         _print_error(str(err))
         return EXIT_FAILED

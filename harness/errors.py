@@ -18,3 +18,23 @@ class ConfigError(HarnessError):
 
 class LinkError(HarnessError):
     """The link to the software under test broke in a way that ends the run."""
+
+
+class Interrupted(KeyboardInterrupt):
+    """Ctrl-C or SIGTERM: the run stops, and says what it had judged.
+
+    `signum` is the signal (the exit code is 128 + signum); `results` holds
+    what was judged up to then, the interrupted scenario last, once the
+    runner has gathered it; `summary` is what the command tells the user.
+    """
+
+    def __init__(self, signum: int, results: list | None = None, summary: str = "") -> None:
+        super().__init__(signum)
+        self.signum = signum
+        self.results = results if results is not None else []
+        self.summary = summary
+
+    @property
+    def exit_code(self) -> int:
+        """128 + the signal's number, as shells report a command a signal ended."""
+        return 128 + self.signum

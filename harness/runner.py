@@ -7,15 +7,17 @@ arrived or its deadline passed.
 
 from __future__ import annotations
 
+import signal
 import time
 from collections.abc import Callable, Iterable, Sequence
+from contextlib import AbstractContextManager, nullcontext
 from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from harness.answers import Answers, Received
-from harness.errors import ConfigError, LinkError
+from harness.errors import ConfigError, Interrupted, LinkError
 from harness.faults import FaultProfile, build_profile
 from harness.link_faults import (
     NO_LINK_FAULTS,
@@ -48,7 +50,28 @@ class RunSettings:
 
 
 def effective_threshold(scenario: Scenario, settings: RunSettings) -> float:
-    return settings.threshold if settings.threshold is not None else scenario.threshold
+    """The run's threshold (the scenario's unless overridden), within the LIDAR's range.
+
+    Beyond range_max no answer could be right (a driver's range_max "no
+    return" would need a warning the oracle also lets a node leave out).
+    """
+    if settings.threshold is None:
+        return scenario.threshold
+    range_max = scenario.lidar_spec.range_max
+    if settings.threshold > range_max:
+        raise ConfigError(
+            f"threshold {settings.threshold:g} m is beyond scenario {scenario.name}'s "
+            f"lidar.range_max ({range_max:g} m); a warning threshold must be within its range"
+        )
+    return settings.threshold
+
+
+def check_settings(scenarios: Sequence[Scenario], settings: RunSettings) -> None:
+    """Every override fits every scenario: checked before the first one runs, so a
+    usage error never comes after some scenarios were judged."""
+    for scenario in scenarios:
+        effective_threshold(scenario, settings)
+        fault_profile(scenario, settings)
 
 
 def fault_profile(scenario: Scenario, settings: RunSettings) -> FaultProfile:
@@ -113,13 +136,15 @@ def run_scenario(
         raise ConfigError(f"{_faults_origin(scenario, settings)}: {err}") from None
     drift = profile.link.get("rate_drift")
     periods = scan_periods(drift, scenario.lidar_spec.rate_hz, seed) if drift else None
-    with Simulation(scenario, gui=settings.gui) as sim:
-        frames = (
-            Frame(s.tick, s.t, s.x, s.y, s.yaw, _emit(profile, s, sim.spec, rng, drift is not None))
-            for s in sim.ticks(periods)
-        )
-        judge_frames(frames, link, oracle, result, on_tick=on_tick, link_faults=profile.link)
-    result.wall_s = time.perf_counter() - started
+    try:
+        with Simulation(scenario, gui=settings.gui) as sim:
+            frames = (
+                Frame(s.tick, s.t, s.x, s.y, s.yaw, _emit(profile, s, sim.spec, rng, bool(drift)))
+                for s in sim.ticks(periods)
+            )
+            judge_frames(frames, link, oracle, result, on_tick=on_tick, link_faults=profile.link)
+    finally:  # an interrupted run reports its time too
+        result.wall_s = time.perf_counter() - started
     return result
 
 
@@ -184,6 +209,7 @@ def judge_frames(
         # board driver's scan, quantised and re-binned, not ours.
         seen = answers.seen if answers.seen is not None else frame.scan
         verdict = oracle.judge(frame.tick, frame.t, seen, answers, delivery)
+        # Judged whole; kept clipped (lengths noted), so a flood cannot bloat the reports.
         record = TickRecord(
             frame.tick,
             frame.t,
@@ -191,8 +217,8 @@ def judge_frames(
             frame.y,
             frame.yaw,
             frame.scan,
-            answers,
-            verdict,
+            answers.clipped(),
+            verdict.clipped(),
             delivery,
         )
         result.records.append(record)
@@ -215,43 +241,61 @@ def judge_frames(
 
     warmed = False
     planned = iter(plan_deliveries(frames, link_faults, result.seed))
-    upcoming = next(planned, None)
-    while upcoming is not None:
-        frame, delivery = upcoming
-        if not delivery.delivered:
-            pending.append((frame, Answers(), delivery))
-            upcoming = next(planned, None)
-            continue
-        scan = frame.scan
-        if delivery.stamp_age_s:
-            scan = replace(scan, stamp=max(0.0, frame.t - delivery.stamp_age_s))
-        try:
-            if not warmed:
-                link.warm_up(frame.scan)
-                warmed = True
-                if link_faults.on_line:  # after the warm-up, whose retries vary in number
-                    link.damage_line(LineDamage(link_faults, result.seed))
-            if delivery.delay_s:
-                link.hold(delivery.delay_s)
-            link.send(scan, frame.tick, clock=frame.t)
-            # While the node works on this scan, judge the ticks that are
-            # complete and simulate the next one.
-            judge_ready()
-            upcoming = next(planned, None)
-            answers = link.collect(scan, frame.tick, may_be_ignored=delivery.may_be_ignored)
-        except LinkError as err:  # the line or graph broke: end here, keep what we have
-            result.error = f"t={frame.t:.2f} s tick {frame.tick}: {err}"
-            break
-        answers.late = complete_pending(answers.late)
-        pending.append((replace(frame, scan=scan), answers, delivery))
-        if answers.problem is not None:  # the node died or went silent: nothing more to judge
-            result.error = f"t={frame.t:.2f} s tick {frame.tick}: {answers.problem}"
-            break
-    complete_pending(link.settle())  # ready ticks stay ahead of the pending ones
-    judge_ready()
+    current: Frame | None = None  # the frame being delivered, for an interruption's message
+    try:
+        upcoming = next(planned, None)
+        while upcoming is not None:
+            frame, delivery = upcoming
+            current = frame
+            if not delivery.delivered:
+                pending.append((frame, Answers(), delivery))
+                upcoming = next(planned, None)
+                continue
+            scan = frame.scan
+            if delivery.stamp_age_s:
+                scan = replace(scan, stamp=max(0.0, frame.t - delivery.stamp_age_s))
+            try:
+                if not warmed:
+                    link.warm_up(frame.scan)
+                    warmed = True
+                    if link_faults.on_line:  # after the warm-up, whose retries vary in number
+                        link.damage_line(LineDamage(link_faults, result.seed))
+                if delivery.delay_s:
+                    link.hold(delivery.delay_s)
+                link.send(scan, frame.tick, clock=frame.t)
+                # While the node works on this scan, judge the ticks that are
+                # complete and simulate the next one.
+                judge_ready()
+                upcoming = next(planned, None)
+                answers = link.collect(scan, frame.tick, may_be_ignored=delivery.may_be_ignored)
+            except LinkError as err:  # the line or graph broke: end here, keep what we have
+                result.error = f"t={frame.t:.2f} s tick {frame.tick}: {err}"
+                break
+            answers.late = complete_pending(answers.late)
+            pending.append((replace(frame, scan=scan), answers, delivery))
+            if answers.problem is not None:  # the node died or went silent: nothing more to judge
+                result.error = f"t={frame.t:.2f} s tick {frame.tick}: {answers.problem}"
+                break
+        complete_pending(link.settle())  # ready ticks stay ahead of the pending ones
+        judge_ready()
+    except KeyboardInterrupt as err:  # Ctrl-C or SIGTERM: keep what was judged, say where
+        judge_ready()  # complete ticks only; those still waiting for answers are not judged
+        raise _interrupted(err, result, current) from None
     if diagnose:
         result.diagnostics = link.diagnostics()
     return result
+
+
+def _interrupted(err: KeyboardInterrupt, result: RunResult, frame: Frame | None) -> Interrupted:
+    """The run's partial result, ended by the signal, for the caller to report."""
+    signum = getattr(err, "signum", signal.SIGINT)
+    where = f" at t={frame.t:.2f} s tick {frame.tick}" if frame is not None else ""
+    count = len(result.records)
+    result.error = (
+        f"interrupted by {signal.Signals(signum).name}{where} "
+        f"({count} tick{'' if count == 1 else 's'} judged)"
+    )
+    return Interrupted(signum, [result])
 
 
 def with_link(
@@ -321,15 +365,55 @@ def run_suite(
     up, the rest are marked not run instead of each waiting out its start."""
     results: list[RunResult] = []
     failed_start: str | None = None
-    for scenario in scenarios:
-        if failed_start is not None:
-            reason = f"not run: the node did not start in {failed_start}"
-            result = RunResult(scenario.name, link_name, 0, 0.0, "", error=reason, not_run=True)
-        else:
-            result = run(scenario, link_name, options, settings, on_tick=on_tick)
-            if result.not_started:
-                failed_start = scenario.name
-        results.append(result)
-        if on_result is not None:
-            on_result(result)
+    with _explicit_domain(link_name, options):
+        for i, scenario in enumerate(scenarios):
+            if failed_start is not None:
+                reason = f"not run: the node did not start in {failed_start}"
+                result = RunResult(scenario.name, link_name, 0, 0.0, "", error=reason, not_run=True)
+            else:
+                try:
+                    result = run(scenario, link_name, options, settings, on_tick=on_tick)
+                except KeyboardInterrupt as err:
+                    rest = scenarios[i:]
+                    raise _suite_interrupted(err, results, rest, link_name, on_result) from None
+                if result.not_started:
+                    failed_start = scenario.name
+            results.append(result)
+            if on_result is not None:
+                on_result(result)
     return results
+
+
+def _explicit_domain(link_name: str, options: LinkOptions) -> AbstractContextManager[object]:
+    """An explicit domain id held for the whole suite (each scenario's link takes it again):
+    no other run slips in between two scenarios, and an id in use fails before the first."""
+    if options.domain_id is None or link_name == "inprocess":
+        return nullcontext()
+    from harness.ros_domain import reserve_domain
+
+    return reserve_domain(options.domain_id)
+
+
+def _suite_interrupted(
+    err: KeyboardInterrupt,
+    done: list[RunResult],
+    rest: Sequence[Scenario],
+    link_name: str,
+    on_result: Callable[[RunResult], None] | None,
+) -> Interrupted:
+    """What the suite judged before the signal: the finished scenarios, the
+    interrupted one (its judged ticks, an error saying where it stopped), and
+    the others not run."""
+    signum = getattr(err, "signum", signal.SIGINT)
+    partial = list(getattr(err, "results", []))
+    if not partial:  # interrupted before its first tick (starting the node, building the world)
+        why = f"interrupted by {signal.Signals(signum).name} before its first tick"
+        partial = [RunResult(rest[0].name, link_name, 0, 0.0, "", error=why)]
+    reason = f"not run: interrupted by {signal.Signals(signum).name}"
+    skipped = [
+        RunResult(s.name, link_name, 0, 0.0, "", error=reason, not_run=True) for s in rest[1:]
+    ]
+    if on_result is not None:
+        for result in [*partial, *skipped]:
+            on_result(result)
+    return Interrupted(signum, [*done, *partial, *skipped])

@@ -51,6 +51,18 @@ class RunResult:
         return [r for r in self.records if not r.verdict.ok]
 
     @property
+    def broken(self) -> bool:
+        """The run ended early and no answer was judged wrong before it (a verdict of ERROR).
+
+        The tick at which a node died, a processing function raised or the
+        link broke fails for that reason alone; it is the break, not a wrong
+        answer.
+        """
+        return self.error is not None and all(
+            r.answers.problem is not None for r in self.failed_ticks
+        )
+
+    @property
     def first_failure(self) -> str | None:
         """The explanation a user reads first: the run error or the first failed tick."""
         failed = self.failed_ticks

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import argparse
 from collections.abc import Callable, Sequence
-from pathlib import Path
 from typing import TYPE_CHECKING, Any, TypeVar
 
 from rich.console import Console
@@ -16,11 +15,13 @@ from harness.commands.arguments import (
     add_node_options,
     add_scenario_overrides,
     check_link_options,
+    check_output_file,
     check_status_regex,
     fault_list,
+    given,
     link_options,
 )
-from harness.errors import ConfigError
+from harness.errors import ConfigError, Interrupted
 from harness.runner import RunSettings
 from harness.scenario import Scenario, resolve_scenario, shipped_scenarios
 from harness.trace import RunResult
@@ -45,9 +46,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     add_scenario_overrides(parser)
     add_judging_options(parser)
     parser.add_argument("--gui", action="store_true", help="open the PyBullet viewer")
-    parser.add_argument("--junit-xml", metavar="FILE", help="write a JUnit XML report")
+    parser.add_argument(
+        "--junit-xml", type=given("--junit-xml"), metavar="FILE", help="write a JUnit XML report"
+    )
     parser.add_argument(
         "--out",
+        type=given("--out"),
         metavar="DIR",
         help="write a report folder: plots, summary.json, junit.xml, index.html "
         "(see docs/reports.md)",
@@ -74,7 +78,7 @@ def settings_from(args: argparse.Namespace) -> RunSettings:
 
 def open_report(out: str | None) -> ReportFolder | None:
     """The `--out` folder, created now so a bad path fails before anything runs."""
-    if not out:
+    if out is None:
         return None
     from harness.report.outputs import ReportFolder
 
@@ -90,11 +94,12 @@ def run(args: argparse.Namespace, console: Console) -> int:
 
     check_link_options(args)
     scenarios = selected(args.scenarios)
-    if args.junit_xml and not Path(args.junit_xml).resolve().parent.is_dir():
-        raise ConfigError(f"--junit-xml {args.junit_xml}: its folder does not exist")
+    check_output_file("--junit-xml", args.junit_xml)
     check_status_regex(args)
+    from harness.runner import check_settings, run_suite
+
+    check_settings(scenarios, settings_from(args))
     report = open_report(args.out)
-    from harness.runner import run_suite
 
     with RunProgress(console, [s.name for s in scenarios]) as progress:
 
@@ -103,14 +108,18 @@ def run(args: argparse.Namespace, console: Console) -> int:
             if report is not None:
                 _write(f"--out {args.out}", report.add, result)
 
-        results = run_suite(
-            scenarios,
-            args.link,
-            link_options(args),
-            settings_from(args),
-            on_tick=progress.on_tick,
-            on_result=finished,
-        )
+        interrupted: Interrupted | None = None
+        try:
+            results = run_suite(
+                scenarios,
+                args.link,
+                link_options(args),
+                settings_from(args),
+                on_tick=progress.on_tick,
+                on_result=finished,
+            )
+        except Interrupted as stop:  # Ctrl-C or SIGTERM: report what was judged, then stop
+            interrupted, results = stop, stop.results
     print_results(console, results)
     if report is not None:
         index = _write(f"--out {args.out}", report.finish)
@@ -126,6 +135,10 @@ def run(args: argparse.Namespace, console: Console) -> int:
             results,
             artifacts=artifacts,
         )
+    if interrupted is not None:
+        judged = sum(1 for r in results if not r.not_run)
+        summary = f"{judged} of {len(scenarios)} scenarios judged, the last one in part"
+        raise Interrupted(interrupted.signum, results, summary)
     return 0 if all(r.ok for r in results) else 1
 
 

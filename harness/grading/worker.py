@@ -20,20 +20,10 @@ from typing import Any
 
 from harness.errors import ConfigError
 from harness.report.files import write_atomically
+from harness.report.summary import verdict_of
 from harness.trace import RunResult
 
-__all__ = ["result_entry", "verdict_of", "write_job"]
-
-PASS, FAIL, ERROR, NOT_RUN = "PASS", "FAIL", "ERROR", "NOT RUN"
-
-
-def verdict_of(result: RunResult) -> str:
-    """PASS, FAIL (an expectation failed), ERROR (the run broke) or NOT RUN."""
-    if result.ok:
-        return PASS
-    if result.not_run:
-        return NOT_RUN
-    return FAIL if result.failed_ticks else ERROR
+__all__ = ["result_entry", "write_job"]
 
 
 def result_entry(result: RunResult) -> dict[str, Any]:

@@ -30,12 +30,12 @@ FORMAT = 1  # bump when a key changes meaning or disappears (docs/reports.md)
 
 
 def verdict_of(result: RunResult) -> str:
-    """PASS, FAIL (some tick failed), ERROR (the run broke, no tick failed) or NOT RUN."""
+    """PASS, FAIL (an answer was wrong), ERROR (the run broke, no answer was wrong) or NOT RUN."""
     if result.ok:
         return "PASS"
     if result.not_run:
         return "NOT RUN"
-    return "ERROR" if result.error and not result.failed_ticks else "FAIL"
+    return "ERROR" if result.broken else "FAIL"
 
 
 def _number(x: float | None) -> float | str | None:
