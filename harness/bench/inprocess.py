@@ -1,8 +1,9 @@
-"""Stage 'inprocess': the whole lockstep loop with the reference logic called in-process.
+"""Stage 'inprocess': the whole lockstep loop through the inprocess link, no ROS.
 
-Simulation, faults, the link, the oracle and the records: everything a run
-does except crossing a process boundary, so the gap to the ros2 stage is
-the cost of DDS and of the node process.
+Simulation, faults, the link, the oracle and the records. The reference
+logic runs in a child forked from the harness (as every processing
+function does), so one pipe round trip per scan is included; the gap to
+the ros2 stage is the cost of DDS and of a node process.
 """
 
 from __future__ import annotations
