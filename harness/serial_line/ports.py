@@ -311,10 +311,16 @@ class PortInfo:
     manufacturer: str | None = None
 
     def line(self) -> str:
-        """One row for the terminal: device, USB ids, description."""
+        """One row for the terminal: device, USB ids, description.
+
+        The serial number and description are the adapter's own strings:
+        shown through the sanitiser, like any text a device sends.
+        """
+        from harness.safe_text import for_terminal
+
         ids = self.vid_pid or "-"
         sn = f" SN={self.serial_number}" if self.serial_number else ""
-        return f"{self.device}  {ids}{sn}  {self.description}"
+        return for_terminal(f"{self.device}  {ids}{sn}  {self.description}")
 
 
 def list_serial_ports() -> list[PortInfo]:

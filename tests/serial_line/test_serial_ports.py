@@ -215,3 +215,11 @@ def test_list_serial_ports_reports_usb_ids(monkeypatch) -> None:
     assert ports[1].line() == (
         "/dev/ttyUSB0  10C4:EA60 SN=0001  CP2102 USB to UART Bridge Controller"
     )
+
+
+def test_an_adapters_own_strings_cannot_drive_the_terminal() -> None:
+    """USB descriptor strings come from the device: escapes are shown, never sent raw."""
+    port = PortInfo("/dev/ttyUSB0", "UART\x1b[2J\x1b]0;pwned\x07", "10C4:EA60", "\x1b[31m1")
+    line = port.line()
+    assert line.isprintable()
+    assert "\\x1b[2J" in line and "SN=\\x1b[31m1" in line
