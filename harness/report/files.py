@@ -18,10 +18,17 @@ import secrets
 from collections.abc import Callable
 from pathlib import Path
 
-__all__ = ["fill_atomically", "relative_path", "remove_stale_temporaries", "write_atomically"]
+__all__ = [
+    "TEMPORARY_NAME",
+    "fill_atomically",
+    "relative_path",
+    "remove_stale_temporaries",
+    "write_atomically",
+]
 
 _NAME_CHARS = 100  # of the final name, in a temporary's name (file names have 255 at most)
-_TEMPORARY = re.compile(r"\..*\.hil-(?P<pid>[0-9]+)-[0-9a-f]{8}\.tmp(?:\.[A-Za-z0-9]+)?")
+#: A writer's hidden temporary file; its pid says whether its writer may still run.
+TEMPORARY_NAME = re.compile(r"\..*\.hil-(?P<pid>[0-9]+)-[0-9a-f]{8}\.tmp(?:\.[A-Za-z0-9]+)?")
 
 
 def _running(pid: int) -> bool:
@@ -43,7 +50,7 @@ def remove_stale_temporaries(folder: str | Path) -> list[Path]:
     except OSError:
         return removed
     for entry in entries:
-        match = _TEMPORARY.fullmatch(entry.name)
+        match = TEMPORARY_NAME.fullmatch(entry.name)
         if match is None:
             continue
         pid = int(match["pid"])

@@ -20,7 +20,6 @@ from __future__ import annotations
 
 import json
 import os
-import re
 import xml.etree.ElementTree as ET
 from collections import Counter
 from dataclasses import dataclass
@@ -33,6 +32,7 @@ from hypothesis import strategies as st
 from mcap.reader import make_reader
 from mcap_ros2.decoder import DecoderFactory
 
+from harness.report.files import TEMPORARY_NAME
 from harness.report.folder_lock import LOCK_NAME
 
 pytestmark = pytest.mark.timeout(300)
@@ -46,8 +46,6 @@ motion:
   segments:
     - until: {duration: 0.2}
 """
-# A writer's hidden temporary file (harness.report.files).
-TEMPORARY = re.compile(r"\..*\.hil-[0-9]+-[0-9a-f]{8}\.tmp(?:\.[A-Za-z0-9]+)?")
 
 HOSTILE = st.text(alphabet="ab/_~{}0 9.-:=*\t\n\x1b\x00\x7f\u00e9\u202e", max_size=12)
 
@@ -234,7 +232,7 @@ def test_generated_command_lines_run_or_are_refused_in_one_line(
         hidden = [
             p
             for p in workdir.rglob(".*")
-            if TEMPORARY.fullmatch(p.name) or (p.is_file() and p.name != LOCK_NAME)
+            if TEMPORARY_NAME.fullmatch(p.name) or (p.is_file() and p.name != LOCK_NAME)
         ]
         assert not hidden, (argv, hidden)
 

@@ -25,6 +25,7 @@ from hypothesis import strategies as st
 from mcap.reader import make_reader
 from mcap_ros2.decoder import DecoderFactory
 
+from harness.report.files import TEMPORARY_NAME
 from harness.safe_text import TEXT_LIMIT
 
 pytestmark = pytest.mark.timeout(600)
@@ -49,7 +50,6 @@ def process(scan, threshold):
     sys.stderr.buffer.write(printed[::-1])
     return status.decode("utf-8", "surrogateescape"), None
 """
-TEMPORARY = re.compile(r"\..*\.hil-[0-9]+-[0-9a-f]{8}\.tmp")
 CONTROL = re.compile(r"[\x00-\x08\x0b-\x1f\x7f-\x9f]")
 
 BYTES = st.one_of(
@@ -116,7 +116,7 @@ def test_any_output_bytes_give_a_verdict_and_readable_records(
         assert summary["scenarios"][0]["ticks"] == len(details["records"]) > 0, shown
         statuses = _read_mcap(out / "scenarios" / "one_tick.mcap")
         assert statuses and all(len(s) <= TEXT_LIMIT for s in statuses), shown
-        left = [p for p in tmp_path.rglob(".*") if TEMPORARY.fullmatch(p.name)]
+        left = [p for p in tmp_path.rglob(".*") if TEMPORARY_NAME.fullmatch(p.name)]
         assert not left, left
 
     check()
