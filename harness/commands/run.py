@@ -99,6 +99,7 @@ def run(args: argparse.Namespace, console: Console) -> int:
     from harness.runner import check_settings, run_suite
 
     check_settings(scenarios, settings_from(args))
+    options = link_options(args)  # checks the names: all before the report folder exists
     report = open_report(args.out)
 
     with RunProgress(console, [s.name for s in scenarios]) as progress:
@@ -113,7 +114,7 @@ def run(args: argparse.Namespace, console: Console) -> int:
             results = run_suite(
                 scenarios,
                 args.link,
-                link_options(args),
+                options,
                 settings_from(args),
                 on_tick=progress.on_tick,
                 on_result=finished,

@@ -1063,6 +1063,11 @@ NAMES_AND_PATHS: list[tuple[str, list[str], str]] = [
         "the node and the oracle would disagree; use --threshold 0.2 instead",
     ),
     (
+        "bad_topic_with_out_creates_no_folder",
+        ["run", "--out", "new_report", "--scan-topic", "a b"],
+        "--scan-topic 'a b': topic name must not contain",
+    ),
+    (
         "param_sets_use_sim_time",
         ["run", "--param", "use_sim_time:=false"],
         "sets use_sim_time, which the harness passes itself",
