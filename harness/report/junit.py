@@ -19,6 +19,7 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 from harness.report.files import relative_path, write_atomically
+from harness.report.summary import verdict_of
 from harness.safe_text import DIAGNOSTICS_LIMIT, TEXT_LIMIT, clip, for_xml
 from harness.trace import RunResult
 
@@ -48,8 +49,9 @@ def junit_xml(
     """
     if artifacts is not None and len(artifacts) != len(results):
         raise ValueError("junit_xml: one artifacts mapping per result")
-    failures = sum(1 for r in results if r.failed_ticks)
-    errors = sum(1 for r in results if r.error and not r.failed_ticks and not r.not_run)
+    verdicts = [verdict_of(r) for r in results]  # the table's words: FAIL and ERROR as there
+    failures = verdicts.count("FAIL")
+    errors = verdicts.count("ERROR")
     root = ET.Element("testsuites")
     node = ET.SubElement(
         root,
@@ -88,7 +90,7 @@ def junit_xml(
         if r.not_run:
             ET.SubElement(case, "skipped", message=_x(r.error or "not run"))
             continue
-        kind = "failure" if r.failed_ticks else "error"
+        kind = "failure" if verdicts[i] == "FAIL" else "error"
         lines = [_x(t.verdict.explanation) for t in r.failed_ticks[:MAX_LISTED_FAILURES]]
         if len(r.failed_ticks) > MAX_LISTED_FAILURES:
             lines.append(f"... and {len(r.failed_ticks) - MAX_LISTED_FAILURES} more failed ticks")

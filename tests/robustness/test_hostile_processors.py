@@ -202,3 +202,15 @@ def test_an_interrupted_run_reports_what_it_judged(
     ET.parse(tmp_path / "junit.xml")
     ET.parse(tmp_path / "report" / "junit.xml")
     assert not marked_processes(marker)
+
+
+def test_junit_calls_a_broken_run_an_error_as_the_table_does() -> None:
+    """A run that broke before any wrong answer is a JUnit <error>, counted as one."""
+    from harness.report.junit import junit_xml
+
+    root = ET.fromstring(junit_xml([run_with("exits_0"), run_with("hides_the_obstacle")]))
+    suite = root.find("testsuite")
+    assert suite is not None and (suite.get("errors"), suite.get("failures")) == ("1", "1")
+    broken, wrong = suite.findall("testcase")
+    assert broken.find("error") is not None and broken.find("failure") is None
+    assert wrong.find("failure") is not None
