@@ -68,11 +68,10 @@ def main(argv: Sequence[str] | None = None) -> int:
         _print_error(str(err))
         return EXIT_USAGE
     except KeyboardInterrupt as err:  # 130 for Ctrl-C, 143 for SIGTERM, as shells expect
-        signum = getattr(err, "signum", signal.SIGINT)
-        summary = getattr(err, "summary", "")
-        name = signal.Signals(signum).name
-        _print_error(f"interrupted by {name}: {summary}" if summary else f"interrupted by {name}")
-        return 128 + signum
+        stop = Interrupted.of(err)
+        summary = f": {stop.summary}" if stop.summary else ""
+        _print_error(f"interrupted by {stop.name}{summary}")
+        return stop.exit_code
     except HarnessError as err:
         _print_error(str(err))
         return EXIT_FAILED

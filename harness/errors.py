@@ -7,6 +7,8 @@ and exits 2. Anything else escaping is a harness bug.
 
 from __future__ import annotations
 
+import signal
+
 
 class HarnessError(Exception):
     """Base class of every error the harness raises deliberately."""
@@ -33,6 +35,16 @@ class Interrupted(KeyboardInterrupt):
         self.signum = signum
         self.results = results if results is not None else []
         self.summary = summary
+
+    @classmethod
+    def of(cls, err: KeyboardInterrupt) -> Interrupted:
+        """`err` as an Interrupted: a plain KeyboardInterrupt is Python's Ctrl-C (SIGINT)."""
+        return err if isinstance(err, Interrupted) else cls(signal.SIGINT)
+
+    @property
+    def name(self) -> str:
+        """The signal's name, e.g. SIGTERM."""
+        return signal.Signals(self.signum).name
 
     @property
     def exit_code(self) -> int:

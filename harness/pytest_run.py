@@ -36,15 +36,13 @@ if TYPE_CHECKING:
 __all__ = ["Hil"]
 #: LinkOptions fields the runner fills in itself, per scenario.
 RUNNER_FIELDS = ("threshold", "scan_rate_hz")
-#: How a failure names hil.run's arguments (harness.commands.arguments.checked_node_options).
-RUN_NAMES = {
-    "scan_topic": "scan_topic=",
-    "status_topic": "status_topic=",
-    "warning_topic": "warning_topic=",
-    "params": "params=",
-    "threshold_param": "threshold_param=",
-    "threshold": "threshold=",
-}
+
+
+def _run_names() -> dict[str, str]:
+    """How a failure names hil.run's arguments: ``scan_topic=`` for the CLI's --scan-topic."""
+    from harness.commands.arguments import CLI_NAMES
+
+    return {field: f"{field}=" for field in CLI_NAMES}
 
 
 def _checked_numbers(overrides: dict[str, Any]) -> dict[str, Any]:
@@ -183,7 +181,7 @@ class Hil:
             compile_status_pattern(status_regex)
         from harness.commands.arguments import checked_node_options
 
-        options = checked_node_options(self._options(link, overrides), RUN_NAMES)
+        options = checked_node_options(self._options(link, overrides), _run_names())
         return chosen, fault_items, options
 
     # -- running ------------------------------------------------------------

@@ -7,7 +7,6 @@ arrived or its deadline passed.
 
 from __future__ import annotations
 
-import signal
 import time
 from collections.abc import Callable, Iterable, Sequence
 from contextlib import AbstractContextManager, nullcontext
@@ -288,14 +287,13 @@ def judge_frames(
 
 def _interrupted(err: KeyboardInterrupt, result: RunResult, frame: Frame | None) -> Interrupted:
     """The run's partial result, ended by the signal, for the caller to report."""
-    signum = getattr(err, "signum", signal.SIGINT)
+    stop = Interrupted.of(err)
     where = f" at t={frame.t:.2f} s tick {frame.tick}" if frame is not None else ""
     count = len(result.records)
     result.error = (
-        f"interrupted by {signal.Signals(signum).name}{where} "
-        f"({count} tick{'' if count == 1 else 's'} judged)"
+        f"interrupted by {stop.name}{where} ({count} tick{'' if count == 1 else 's'} judged)"
     )
-    return Interrupted(signum, [result])
+    return Interrupted(stop.signum, [result])
 
 
 def with_link(
@@ -369,7 +367,7 @@ def run_suite(
         for i, scenario in enumerate(scenarios):
             if failed_start is not None:
                 reason = f"not run: the node did not start in {failed_start}"
-                result = RunResult(scenario.name, link_name, 0, 0.0, "", error=reason, not_run=True)
+                result = _not_run(scenario, link_name, reason)
             else:
                 try:
                     result = run(scenario, link_name, options, settings, on_tick=on_tick)
@@ -404,16 +402,18 @@ def _suite_interrupted(
     """What the suite judged before the signal: the finished scenarios, the
     interrupted one (its judged ticks, an error saying where it stopped), and
     the others not run."""
-    signum = getattr(err, "signum", signal.SIGINT)
-    partial = list(getattr(err, "results", []))
+    stop = Interrupted.of(err)
+    partial = list(stop.results)
     if not partial:  # interrupted before its first tick (starting the node, building the world)
-        why = f"interrupted by {signal.Signals(signum).name} before its first tick"
+        why = f"interrupted by {stop.name} before its first tick"
         partial = [RunResult(rest[0].name, link_name, 0, 0.0, "", error=why)]
-    reason = f"not run: interrupted by {signal.Signals(signum).name}"
-    skipped = [
-        RunResult(s.name, link_name, 0, 0.0, "", error=reason, not_run=True) for s in rest[1:]
-    ]
+    reason = f"not run: interrupted by {stop.name}"
+    skipped = [_not_run(s, link_name, reason) for s in rest[1:]]
     if on_result is not None:
         for result in [*partial, *skipped]:
             on_result(result)
-    return Interrupted(signum, [*done, *partial, *skipped])
+    return Interrupted(stop.signum, [*done, *partial, *skipped])
+
+
+def _not_run(scenario: Scenario, link_name: str, reason: str) -> RunResult:
+    return RunResult(scenario.name, link_name, 0, 0.0, "", error=reason, not_run=True)

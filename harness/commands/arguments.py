@@ -287,8 +287,9 @@ def link_options(args: argparse.Namespace) -> LinkOptions:
     return checked_node_options(options)
 
 
-def check_link_options(args: argparse.Namespace) -> None:
-    """Options that the chosen link would silently ignore are mistakes."""
+def check_link_options(args: argparse.Namespace) -> LinkOptions:
+    """The link's options, checked: ones the chosen link would silently ignore are
+    mistakes, and topics and parameters must work (`link_options`)."""
     port = getattr(args, "port", None)
     processor = getattr(args, "processor", None)
     if port is not None:
@@ -303,7 +304,7 @@ def check_link_options(args: argparse.Namespace) -> None:
         )
         if given:
             raise ConfigError(f"{given[0]} needs a link that runs a node, not --link inprocess")
-    link_options(args)  # topics and parameters: a usage error now, not a traceback later
+    return link_options(args)
 
 
 def check_status_regex(args: argparse.Namespace) -> None:

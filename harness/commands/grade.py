@@ -200,10 +200,10 @@ def run(args: argparse.Namespace, console: Console) -> int:
     from harness.grading.discover import discover
     from harness.grading.grade import GradeConfig, grade_class
     from harness.report.files import write_atomically
-    from harness.runner import RunSettings, fault_profile
+    from harness.runner import RunSettings, check_settings
 
     check_grading_options(args)
-    link_options(args)  # topics and parameters: refused now, before any folder is made
+    options = link_options(args)  # topics and parameters: refused now, before any folder
     scenarios = selected_scenarios(args.scenario)
     settings = RunSettings(
         seed=args.seed,
@@ -211,8 +211,7 @@ def run(args: argparse.Namespace, console: Console) -> int:
         faults=fault_list(args.faults),
         status_pattern=args.status_regex,
     )
-    for scenario in scenarios:
-        fault_profile(scenario, settings)  # a bad --faults is a usage error now
+    check_settings(scenarios, settings)  # a bad --faults or --threshold: a usage error now
     check_status_regex(args)
     out = Path(args.out)
     found = discover(args.dirs, exclude=out)  # before prepare_out: no folder for a typo
@@ -229,7 +228,7 @@ def run(args: argparse.Namespace, console: Console) -> int:
             scenarios=names,
             scenario_refs=tuple(s.source or s.name for s in scenarios),
             link=args.link,
-            options=link_options(args),
+            options=options,
             settings=settings,
             students_dir=out.resolve() / "students",  # workers run in their student's folder
             build_timeout=args.build_timeout,

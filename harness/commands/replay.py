@@ -16,7 +16,6 @@ from harness.commands.arguments import (
     check_status_regex,
     fault_list,
     given,
-    link_options,
     seed,
     topic_option,
 )
@@ -85,7 +84,7 @@ def run(args: argparse.Namespace, console: Console) -> int:
     from harness.replay import replay
     from harness.report.terminal import print_results
 
-    check_link_options(args)
+    options = check_link_options(args)
     check_status_regex(args)
     check_output_file("--junit-xml", args.junit_xml)
     check_output_file("--record", args.record)
@@ -96,7 +95,7 @@ def run(args: argparse.Namespace, console: Console) -> int:
         result = replay(
             recording,
             args.link,
-            link_options(args),
+            options,
             threshold=args.threshold,
             status_pattern=args.status_regex,
             link_faults=link_faults,

@@ -19,7 +19,6 @@ from harness.commands.arguments import (
     check_status_regex,
     fault_list,
     given,
-    link_options,
 )
 from harness.errors import ConfigError, Interrupted
 from harness.runner import RunSettings
@@ -92,14 +91,13 @@ def run(args: argparse.Namespace, console: Console) -> int:
     from harness.report.progress import RunProgress
     from harness.report.terminal import print_results
 
-    check_link_options(args)
+    options = check_link_options(args)  # all before the report folder exists
     scenarios = selected(args.scenarios)
     check_output_file("--junit-xml", args.junit_xml)
     check_status_regex(args)
     from harness.runner import check_settings, run_suite
 
     check_settings(scenarios, settings_from(args))
-    options = link_options(args)  # checks the names: all before the report folder exists
     report = open_report(args.out)
 
     with RunProgress(console, [s.name for s in scenarios]) as progress:

@@ -27,6 +27,7 @@ __all__ = [
 ]
 
 _NAME_CHARS = 100  # of the final name, in a temporary's name (file names have 255 at most)
+_swept: set[str] = set()  # folders this process has cleared of stale temporaries
 #: A writer's hidden temporary file; its pid says whether its writer may still run.
 TEMPORARY_NAME = re.compile(r"\..*\.hil-(?P<pid>[0-9]+)-[0-9a-f]{8}\.tmp(?:\.[A-Za-z0-9]+)?")
 
@@ -96,11 +97,15 @@ def fill_atomically(
     `fill` returns a path other than the temporary, it chose where to
     write: the temporary is removed and that path returned. On any
     failure the temporary is removed. Stale temporary files of writers
-    that were killed are removed from the folder first.
+    that were killed are removed from the folder first (once per folder
+    and process: a run writes many files into one folder).
     """
     target = Path(path)
     target.parent.mkdir(parents=True, exist_ok=True)
-    remove_stale_temporaries(target.parent)
+    folder = str(target.parent.resolve())
+    if folder not in _swept:
+        remove_stale_temporaries(folder)
+        _swept.add(folder)
     temporary = _new_temporary(target, suffix)
     try:
         written = fill(temporary)
