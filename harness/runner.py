@@ -29,7 +29,7 @@ from harness.link_faults import (
 from harness.links.base import Link, LinkOptions, create_link
 from harness.oracle import Oracle
 from harness.scan import Scan
-from harness.scenario import Scenario, check_run_length
+from harness.scenario import Scenario, check_run_length, threshold_problem
 from harness.trace import RunResult, TickRecord
 
 if TYPE_CHECKING:
@@ -49,19 +49,12 @@ class RunSettings:
 
 
 def effective_threshold(scenario: Scenario, settings: RunSettings) -> float:
-    """The run's threshold (the scenario's unless overridden), within the LIDAR's range.
-
-    Beyond range_max no answer could be right (a driver's range_max "no
-    return" would need a warning the oracle also lets a node leave out).
-    """
+    """The run's threshold (the scenario's unless overridden), within the LIDAR's range."""
     if settings.threshold is None:
         return scenario.threshold
-    range_max = scenario.lidar_spec.range_max
-    if settings.threshold > range_max:
-        raise ConfigError(
-            f"threshold {settings.threshold:g} m is beyond scenario {scenario.name}'s "
-            f"lidar.range_max ({range_max:g} m); a warning threshold must be within its range"
-        )
+    problem = threshold_problem(settings.threshold, scenario)
+    if problem is not None:
+        raise ConfigError(f"threshold for scenario {scenario.name}: {problem}")
     return settings.threshold
 
 

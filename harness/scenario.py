@@ -466,23 +466,35 @@ def parse_scenario(data: Any, *, source: str = "<scenario>") -> Scenario:
     return scenario
 
 
+def threshold_problem(threshold: float, scenario: Scenario) -> str | None:
+    """Why `threshold` cannot be judged with this scenario's LIDAR, or None.
+
+    Beyond range_max a driver's range_max "no return" reading would need a
+    warning that the oracle also lets a node leave out: no answer could be
+    right. Used for the file's own threshold and for a run's override.
+    """
+    range_max = scenario.lidar_spec.range_max
+    if threshold <= range_max:
+        return None
+    return (
+        f"{threshold:g} m is beyond lidar.range_max ({range_max:g} m); "
+        "a warning threshold must be within the LIDAR's range"
+    )
+
+
 def check_lidar_fits(scenario: Scenario) -> None:
     """The threshold and the obstacle conditions ask what this LIDAR can answer.
 
-    A threshold beyond range_max would expect a warning for a driver's
-    range_max "no return" reading, which the oracle also lets a node call
-    "no obstacle": no answer could be right. An ``obstacle_ahead_*``
+    The threshold must be within range (`threshold_problem`). An ``obstacle_ahead_*``
     condition looks at the beams within +-10 deg of straight ahead; without
     any, it could never hold (below) or would always hold (above).
     """
     from harness.sim.motion import AHEAD_HALF_WIDTH, ahead_mask  # imports this module
 
     spec = scenario.lidar_spec
-    if scenario.threshold > spec.range_max:
-        raise ConfigError(
-            f"threshold: {scenario.threshold:g} m is beyond lidar.range_max "
-            f"({spec.range_max:g} m); a warning threshold must be within the LIDAR's range"
-        )
+    problem = threshold_problem(scenario.threshold, scenario)
+    if problem is not None:
+        raise ConfigError(f"threshold: {problem}")
     waits = [
         (index, name)
         for index, segment in enumerate(scenario.motion.segments)
