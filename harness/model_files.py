@@ -44,6 +44,7 @@ __all__ = [
     "ModelParts",
     "check_model_file",
     "find_model_file",
+    "parse_xml",
     "robot_models_dir",
 ]
 
@@ -166,7 +167,8 @@ def _read_bounded(path: Path, limit: int, what: str) -> bytes:
     return data
 
 
-def _parse_xml(path: Path, what: str) -> ET.Element:
+def parse_xml(path: Path, what: str) -> ET.Element:
+    """A URDF/SDF file's XML, bounded in size and without DTDs; ConfigError names `what`."""
     data = _read_bounded(path, MAX_MODEL_BYTES, what)
     if b"<!DOCTYPE" in data or b"<!ENTITY" in data:
         raise ConfigError(f"{what}: DOCTYPE and ENTITY declarations are not allowed")
@@ -508,7 +510,7 @@ def check_model_file(model: ModelFile, *, what: str = "") -> ModelParts:
     URDF's link and joint names come back, for checks that name them.
     """
     label = what or str(model.path)
-    root = _parse_xml(model.path, label)
+    root = parse_xml(model.path, label)
     if model.path.suffix == ".sdf":
         _check_sdf(root, model, label)
         return ModelParts()

@@ -35,7 +35,7 @@ from harness.errors import ConfigError
 from harness.faults import FaultProfile, build_profile
 from harness.lidar_spec import PRESETS, LidarSpec, preset
 from harness.messages import shown
-from harness.model_files import _parse_xml, check_model_file, find_model_file, robot_models_dir
+from harness.model_files import check_model_file, find_model_file, parse_xml, robot_models_dir
 from harness.sim.footprint import Outline, disc, overlap, rectangle, robot_outlines
 from harness.sim.geometry import cylinder_segments
 
@@ -585,7 +585,7 @@ def check_start_clear(scenario: Scenario, robot_urdf: Path | None = None) -> Non
     parts: list[Outline] = []
     if robot_urdf is not None:
         what = f"{where}: robot.urdf: cannot load {scenario.robot.urdf!r}"
-        body = robot_outlines(_parse_xml(robot_urdf, what))
+        body = robot_outlines(parse_xml(robot_urdf, what))
         parts = [part.placed(start.x, start.y, start.yaw) for part in body]
     at = _xy((start.x, start.y))
     for index, obstacle in enumerate(scenario.obstacles):
