@@ -14,8 +14,8 @@ from harness.links.base import LinkOptions, create_link
 def test_inprocess_lockstep_run(benchmark) -> None:
     """approach_wall through the inprocess link and the oracle (the whole loop, no DDS)."""
     workload = lab_workload(1, ("approach_wall",))
-    link = create_link("inprocess", LinkOptions(threshold=0.5))
-    run = benchmark.pedantic(run_through, args=(link, workload), rounds=5)
+    with create_link("inprocess", LinkOptions(threshold=0.5)) as link:
+        run = benchmark.pedantic(run_through, args=(link, workload), rounds=5)
     assert not run.result.failed_ticks
 
 

@@ -145,16 +145,15 @@ class ProcessorChild:
         self._pid, self._conn = pid, ours
         self._output = OutputTail(out_read, f"processor-{pid}-output")
 
-    def call(self, scan: Any, threshold: float) -> str | None:
-        """Hand the child one scan; a reason instead when it cannot take it."""
+    def call(self, scan: Any, threshold: float) -> None:
+        """Hand the child one scan; if it is gone, `outcome` says how it ended."""
         if self._conn is None:
-            return self._gone_reason()
+            return
         try:
             self._conn.send((scan, threshold))
         except (OSError, ValueError):
-            return self._gone_reason()
+            return
         self._busy = True
-        return None
 
     def outcome(self, timeout: float) -> Outcome:
         """The answer to the last `call`, waiting at most `timeout` seconds.

@@ -75,25 +75,20 @@ class InprocessLink(Link):
             load_processor(options.processor) if options.processor else reference_processor
         )
         self._child: ProcessorChild | None = None
-        self._refused: str | None = None  # why the last scan could not be handed over
 
     def open(self) -> None:
         self._child = ProcessorChild(self._process)
         self._child.start()
 
     def send(self, scan: Scan, tick: int, *, clock: float | None = None) -> None:
-        if self._child is None:
-            self.open()
-        assert self._child is not None
-        self._refused = self._child.call(scan, self.options.threshold)
+        assert self._child is not None, "open() the link first"
+        self._child.call(scan, self.options.threshold)
 
     def hold(self, seconds: float) -> None:
         """A delay changes nothing for a function called in lockstep: no wall time is spent."""
 
     def collect(self, scan: Scan, tick: int, *, may_be_ignored: bool = False) -> Answers:
-        assert self._child is not None
-        if self._refused is not None:
-            return Answers(problem=self._refused)
+        assert self._child is not None, "open() the link first"
         outcome = self._child.outcome(self.options.scan_timeout)
         if outcome.problem is not None:
             return Answers(problem=outcome.problem)
