@@ -43,6 +43,7 @@ class BoardLink(Ros2Link):
     profile: ClassVar[DeviceProfile]
     serial_line = True
     publishes_scans = False  # the board's driver publishes /scan; the harness listens
+    starts_ahead = False  # one line, one board at a time
 
     def __init__(self, options: LinkOptions) -> None:
         physical = options.port is not None

@@ -27,6 +27,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from harness.errors import ConfigError
+from harness.links.base import LinkOptions
+from harness.node_forkserver import ForkedSupervisor
+from harness.node_forkserver import shared as shared_fork_server
 
 AMENT_MARKERS = Path("share/ament_index/resource_index/packages")
 REAPER = Path(__file__).with_name("node_reaper.py")
@@ -37,7 +40,16 @@ START_WAIT_S = 10.0  # for the reaper (a Python start-up) to report the node sta
 STOP_WAIT_S = INT_GRACE_S + TERM_GRACE_S + 5.0 + 0.5 + 5.0 + 2.0
 POLL_S = 0.05
 TAIL_BYTES = 16384
+FORK_SERVER_SETTING = "FOSSBOT_HIL_FORK_SERVER"
 LINE_CHARS = 300  # a longer line in a tail is cut (a flood may have no newlines)
+
+
+def fork_server_enabled() -> bool:
+    """Start the bundled node by fork from a warm process? Not when
+    ``FOSSBOT_HIL_FORK_SERVER=0``, and only from the main thread: the server
+    (and every node it started) goes when the thread that started it ends."""
+    on = os.environ.get(FORK_SERVER_SETTING, "1") != "0"
+    return on and threading.current_thread() is threading.main_thread()
 
 
 @dataclass(frozen=True)
@@ -47,13 +59,23 @@ class NodeCommand:
     argv: tuple[str, ...]
     env: dict[str, str] = field(default_factory=dict)
     description: str = ""
+    # Set when argv is ``sys.executable -m MODULE``: the fork server may start it.
+    module: str | None = None
+
+
+def prepare_start(command: NodeCommand) -> None:
+    """Start what starting `command` will use (its fork server), so it is ready sooner."""
+    if command.module is not None and fork_server_enabled():
+        shared_fork_server(command.module)
 
 
 def reference_node() -> NodeCommand:
     """The bundled reference solution, runnable without colcon."""
+    module = "harness.reference.lidar_node"
     return NodeCommand(
-        (sys.executable, "-m", "harness.reference.lidar_node"),
+        (sys.executable, "-m", module),
         description="the bundled reference node (fossbot_lidar_processing)",
+        module=module,
     )
 
 
@@ -231,7 +253,7 @@ class NodeProcess:
         self.command = command
         self.argv = [*command.argv, *args]
         self.env = {**os.environ, **command.env, **env, "PYTHONUNBUFFERED": "1"}
-        self._popen: subprocess.Popen[bytes] | None = None  # the reaper
+        self._popen: subprocess.Popen[bytes] | ForkedSupervisor | None = None  # the reaper
         self._status_fd: int | None = None
         self._partial = b""
         self._outputs: dict[str, OutputTail] = {}
@@ -243,6 +265,7 @@ class NodeProcess:
         self.leftovers: list[str] = []  # "PID (name)" of processes killed after the node
         self.stop_problem: str | None = None
         self._done = False  # the reaper finished its stop (its last event)
+        self._stop_requested = False
         self.started_at = 0.0
 
     def start(self) -> None:
@@ -263,7 +286,7 @@ class NodeProcess:
             *self.argv,
         ]
         try:
-            self._popen = subprocess.Popen(
+            self._popen = self._forked([status_w, out_w, err_w]) or subprocess.Popen(
                 argv,
                 stdin=subprocess.DEVNULL,
                 stdout=out_w,
@@ -300,6 +323,14 @@ class NodeProcess:
             )
             self.stop()
             raise ConfigError(f"cannot start {self.command.description}: {why}")
+
+    def _forked(self, fds: list[int]) -> ForkedSupervisor | None:
+        """The node started by the fork server (a module of this interpreter), or None."""
+        module = self.command.module
+        if module is None or not fork_server_enabled():
+            return None
+        argv = self.argv[len(self.command.argv) :]
+        return shared_fork_server(module).start(argv, self.env, (INT_GRACE_S, TERM_GRACE_S), fds)
 
     # -- what the reaper reports --------------------------------------------
     def _read_events(self, timeout: float = 0.0) -> None:
@@ -400,12 +431,18 @@ class NodeProcess:
             notes.append(self.stop_problem)
         return "; ".join(notes)
 
+    def request_stop(self) -> None:
+        """Ask the reaper to stop the node and everything it started; do not wait (see stop)."""
+        if self._popen is not None and not self._stop_requested and self._popen.poll() is None:
+            self._popen.send_signal(signal.SIGTERM)  # the reaper's cue to stop its node
+            self._stop_requested = True
+
     def stop(self) -> int | None:
         """Stop the node and everything it started (SIGINT, SIGTERM, SIGKILL; bounded); reap all."""
         if self._popen is None:
             return None
         if self._popen.poll() is None:
-            self._popen.send_signal(signal.SIGTERM)  # the reaper's cue to stop its node
+            self.request_stop()
             try:
                 self._popen.wait(timeout=STOP_WAIT_S)
             except subprocess.TimeoutExpired:
@@ -425,3 +462,25 @@ class NodeProcess:
             output.join(1.0)
         _LIVE.discard(self)
         return self.returncode()
+
+
+def node_command(options: LinkOptions) -> NodeCommand:
+    """The node the options name: a command, a package in a workspace, or the reference."""
+    if options.node and options.package:
+        raise ConfigError("give either --node or --package/--executable, not both")
+    if options.node:
+        return shell_node(options.node)
+    if options.package or options.executable:
+        if not (options.package and options.executable):
+            raise ConfigError("--package and --executable go together")
+        return package_node(options.package, options.executable, options.workspace)
+    return reference_node()
+
+
+def node_parameters(options: LinkOptions) -> tuple[str, ...]:
+    """The user's --param items, plus the threshold unless the user set it."""
+    params = tuple(options.params)
+    name = options.threshold_param
+    if name and not any(p.split(":=", 1)[0] == name for p in params):
+        params = (f"{name}:={options.threshold!r}", *params)
+    return params

@@ -11,6 +11,10 @@ every descendant still running, reaps them all and exits.
 
 Usage: ``python3 node_reaper.py STATUS_FD PARENT_PID INT_GRACE TERM_GRACE -- ARGV...``
 
+The node fork server (``node_forkserver.py``) runs the same supervision
+(``supervise``) in a forked child instead, starting the node by a second
+fork rather than by ``posix_spawn``.
+
 It tells the harness what happens through STATUS_FD, one event a line:
 ``started PID``, ``error MESSAGE`` (the command could not be started),
 ``exited CODE`` (negative: killed by that signal), ``stopped HOW SECONDS``
@@ -25,6 +29,7 @@ import os
 import signal
 import sys
 import time
+from collections.abc import Callable
 
 PR_SET_PDEATHSIG = 1
 PR_SET_CHILD_SUBREAPER = 36
@@ -83,16 +88,10 @@ class Reaper:
                 self.reap()
         return True
 
-    def start(self, argv: list[str]) -> bool:
+    def start(self, launch: Callable[[], int]) -> bool:
+        """Start the node with `launch` (which returns its pid); report how that went."""
         try:
-            self.node = os.posix_spawnp(
-                argv[0],
-                argv,
-                os.environ,
-                setsid=True,
-                setsigmask=(),
-                setsigdef=DEFAULT_SIGNALS,
-            )
+            self.node = launch()
         except OSError as err:
             self.emit(f"error {err}")
             return False
@@ -188,27 +187,51 @@ def _descendants(root: int) -> dict[int, str]:
     return found
 
 
+def spawn(argv: list[str]) -> int:
+    """Start `argv` in its own session with default signal handling; its pid."""
+    return os.posix_spawnp(
+        argv[0],
+        argv,
+        os.environ,
+        setsid=True,
+        setsigmask=(),
+        setsigdef=DEFAULT_SIGNALS,
+    )
+
+
+def supervise(reaper: Reaper, parent: int, launch: Callable[[], int]) -> int:
+    """Become the node's subreaper, start it, relay its exit until asked to stop; stop it.
+
+    `parent` is the process whose death stops everything (PDEATHSIG).
+    Returns this process's exit code.
+    """
+    os.set_inheritable(reaper.status_fd, False)  # the node must not hold the harness's pipe
+    signal.pthread_sigmask(signal.SIG_BLOCK, WATCHED)  # taken by sigwaitinfo, never async
+    libc = ctypes.CDLL(None, use_errno=True)
+    libc.prctl(PR_SET_CHILD_SUBREAPER, 1, 0, 0, 0)
+    libc.prctl(PR_SET_PDEATHSIG, signal.SIGTERM, 0, 0, 0)
+    if os.getppid() != parent:  # the parent died before PDEATHSIG was set
+        return 1
+    if not reaper.start(launch):
+        return 127
+    reaper.serve()
+    reaper.stop()
+    return 0
+
+
 def main(argv: list[str]) -> int:
     try:
         status_fd, parent, int_grace, term_grace = argv[:4]
         separator = argv.index("--", 4)
         command = argv[separator + 1 :]
         reaper = Reaper(int(status_fd), float(int_grace), float(term_grace))
+        parent_pid = int(parent)
     except ValueError:
         print(__doc__, file=sys.stderr)
         return 2
-    os.set_inheritable(reaper.status_fd, False)  # the node must not hold the harness's pipe
-    signal.pthread_sigmask(signal.SIG_BLOCK, WATCHED)  # taken by sigwaitinfo, never async
-    libc = ctypes.CDLL(None, use_errno=True)
-    libc.prctl(PR_SET_CHILD_SUBREAPER, 1, 0, 0, 0)
-    libc.prctl(PR_SET_PDEATHSIG, signal.SIGTERM, 0, 0, 0)
-    if os.getppid() != int(parent):  # the harness died before PDEATHSIG was set
-        return 1
-    if not command or not reaper.start(command):
+    if not command:
         return 127
-    reaper.serve()
-    reaper.stop()
-    return 0
+    return supervise(reaper, parent_pid, lambda: spawn(command))
 
 
 if __name__ == "__main__":

@@ -127,3 +127,8 @@ def _ancestors(limit: int = 64) -> set[int]:
             break
         pid = int(stat.rsplit(")", 1)[1].split()[1])  # after the name: state, ppid
     return found
+
+
+def discovery_environment(*, network: bool) -> dict[str, str]:
+    """Environment that keeps discovery on this machine unless a network is wanted."""
+    return {} if network else {"ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST"}

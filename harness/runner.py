@@ -26,7 +26,9 @@ from harness.link_faults import (
     plan_deliveries,
     scan_periods,
 )
-from harness.links.base import Link, LinkOptions, create_link
+from harness.link_pipeline import LinkPipeline
+from harness.links.base import Link, LinkOptions, create_link, link_class
+from harness.node_forkserver import scope as fork_servers
 from harness.oracle import Oracle
 from harness.scan import Scan
 from harness.scenario import Scenario, check_run_length, threshold_problem
@@ -302,14 +304,66 @@ def with_link(
     """
     link = create_link(link_name, options)
     try:
+        result = run_through(link, body, not_started)
+    finally:
+        started = time.perf_counter()
+        link.close()
+    closed(result, link, time.perf_counter() - started)
+    return result
+
+
+def run_through(
+    link: Link,
+    body: Callable[[Link], RunResult],
+    not_started: Callable[[str, str], RunResult],
+) -> RunResult:
+    """Open `link` (waiting until it is ready) and run `body` through it; the caller closes it.
+
+    The result says how long the run waited for the link to come up.
+    """
+    started = time.perf_counter()
+    try:
         link.open()
-        return body(link)
+        ready = time.perf_counter() - started
+        result = body(link)
     except LinkError as err:
+        ready = time.perf_counter() - started
         result = not_started(str(err), link.diagnostics())
         result.not_started = True
-        return result
-    finally:
-        link.close()
+    result.startup_s = ready
+    return result
+
+
+def closed(result: RunResult, link: Link, waited: float) -> None:
+    """The link is closed: the time waited for it, and how its stop went, join the result."""
+    result.stop_s = waited
+    note = link.stop_note()
+    if note:
+        result.diagnostics = "\n".join(part for part in (result.diagnostics, note) if part)
+
+
+def scenario_options(
+    scenario: Scenario, options: LinkOptions, settings: RunSettings
+) -> LinkOptions:
+    """The link options for one scenario: its threshold and its LIDAR's rate."""
+    threshold = effective_threshold(scenario, settings)
+    return replace(options, threshold=threshold, scan_rate_hz=scenario.lidar_spec.rate_hz)
+
+
+def _not_started_as(
+    scenario: Scenario, link_name: str, settings: RunSettings
+) -> Callable[[str, str], RunResult]:
+    """How a scenario whose link never came up is recorded."""
+    threshold = effective_threshold(scenario, settings)
+    seed = settings.seed if settings.seed is not None else scenario.seed
+    faults = fault_profile(scenario, settings).name
+
+    def failed(reason: str, diagnostics: str) -> RunResult:
+        return RunResult(
+            scenario.name, link_name, seed, threshold, faults, error=reason, diagnostics=diagnostics
+        )
+
+    return failed
 
 
 def run(
@@ -325,21 +379,11 @@ def run(
     A link that cannot bring the software under test up gives a result with
     the reason and ``not_started`` set, not an exception.
     """
-    threshold = effective_threshold(scenario, settings)
-    rate = scenario.lidar_spec.rate_hz
-    seed = settings.seed if settings.seed is not None else scenario.seed
-    faults = fault_profile(scenario, settings).name
-
-    def failed(reason: str, diagnostics: str) -> RunResult:
-        return RunResult(
-            scenario.name, link_name, seed, threshold, faults, error=reason, diagnostics=diagnostics
-        )
-
     return with_link(
         link_name,
-        replace(options, threshold=threshold, scan_rate_hz=rate),
+        scenario_options(scenario, options, settings),
         lambda link: run_scenario(scenario, link, settings, on_tick=on_tick),
-        failed,
+        _not_started_as(scenario, link_name, settings),
     )
 
 
@@ -352,27 +396,68 @@ def run_suite(
     on_tick: Callable[[TickRecord], None] | None = None,
     on_result: Callable[[RunResult], None] | None = None,
 ) -> list[RunResult]:
-    """Run each scenario in turn; once the software under test fails to come
-    up, the rest are marked not run instead of each waiting out its start."""
+    """Run each scenario in turn, each through a link of its own, and report the
+    results in order.
+
+    Where links can overlap (their own ROS domains), the next scenarios'
+    links start while one runs and finished ones stop behind it
+    (``harness.link_pipeline``). Once the software under test fails to come
+    up, the rest are marked not run instead of each waiting out its start.
+    """
     results: list[RunResult] = []
-    failed_start: str | None = None
-    with _explicit_domain(link_name, options):
-        for i, scenario in enumerate(scenarios):
-            if failed_start is not None:
-                reason = f"not run: the node did not start in {failed_start}"
-                result = _not_run(scenario, link_name, reason)
-            else:
-                try:
-                    result = run(scenario, link_name, options, settings, on_tick=on_tick)
-                except KeyboardInterrupt as err:
-                    rest = scenarios[i:]
-                    raise _suite_interrupted(err, results, rest, link_name, on_result) from None
+
+    def report(result: RunResult) -> None:
+        results.append(result)
+        if on_result is not None:
+            on_result(result)
+
+    def make(index: int) -> Link:
+        return create_link(link_name, scenario_options(scenarios[index], options, settings))
+
+    link_class(link_name).prepare(options)
+    with fork_servers(), _explicit_domain(link_name, options):
+        pipeline = LinkPipeline(make, len(scenarios), overlap=_links_overlap(link_name, options))
+        failed_start: str | None = None
+        index = 0
+        try:
+            for index, scenario in enumerate(scenarios):
+                if failed_start is not None:
+                    pipeline.drain()
+                    reason = f"not run: the node did not start in {failed_start}"
+                    report(_not_run(scenario, link_name, reason))
+                    continue
+                link = pipeline.take(index)
+                result = run_through(
+                    link,
+                    lambda link, s=scenario: run_scenario(s, link, settings, on_tick=on_tick),
+                    _not_started_as(scenario, link_name, settings),
+                )
                 if result.not_started:
                     failed_start = scenario.name
-            results.append(result)
-            if on_result is not None:
-                on_result(result)
+                pipeline.retire(link, _reporter(result, link, report))
+            pipeline.drain()
+        except KeyboardInterrupt as err:
+            pipeline.drain()  # every process reaped; finished scenarios reported first
+            rest = scenarios[index:]
+            raise _suite_interrupted(err, results, rest, link_name, on_result) from None
     return results
+
+
+def _reporter(
+    result: RunResult, link: Link, report: Callable[[RunResult], None]
+) -> Callable[[float], None]:
+    """Once `link` is closed: complete `result` (`closed`) and report it."""
+
+    def on_closed(waited: float) -> None:
+        closed(result, link, waited)
+        report(result)
+
+    return on_closed
+
+
+def _links_overlap(link_name: str, options: LinkOptions) -> bool:
+    """Start links ahead and stop them behind? Only where each has a domain of its own."""
+    return link_class(link_name).starts_ahead and options.domain_id is None
 
 
 def _explicit_domain(link_name: str, options: LinkOptions) -> AbstractContextManager[object]:

@@ -38,9 +38,16 @@ class RunResult:
     records: list[TickRecord] = field(default_factory=list)
     error: str | None = None
     diagnostics: str = ""  # e.g. the node's last stderr lines, shown on failure
-    wall_s: float = 0.0
+    wall_s: float = 0.0  # the run itself: simulating, exchanging, judging
+    startup_s: float = 0.0  # waiting for the software under test to come up (in series)
+    stop_s: float = 0.0  # waiting for it to stop, after the run (in series)
     not_started: bool = False  # the software under test never came up
     not_run: bool = False  # skipped because it did not come up in an earlier scenario
+
+    @property
+    def total_s(self) -> float:
+        """What the scenario cost the run in wall time: start-up, the run, the stop."""
+        return self.startup_s + self.wall_s + self.stop_s
 
     @property
     def ok(self) -> bool:

@@ -96,3 +96,12 @@ class ChildProcesses:
     def __exit__(self, *exc_info: object) -> None:
         for process in self.started:
             process.kill()
+
+
+def alive(pid: int) -> bool:
+    """Is process `pid` running (not gone, not a zombie)? From /proc."""
+    try:
+        status = Path(f"/proc/{pid}/status").read_text()
+    except OSError:
+        return False
+    return "State:\tZ" not in status

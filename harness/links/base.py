@@ -8,12 +8,14 @@ import time
 from abc import ABC, abstractmethod
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import ClassVar, TypeVar
+from typing import TYPE_CHECKING, ClassVar, TypeVar
 
-from harness.answers import Answers, Received
 from harness.errors import ConfigError
-from harness.link_faults import LineDamage
-from harness.scan import Scan
+
+if TYPE_CHECKING:  # naming the links and their options needs none of these (nor numpy)
+    from harness.answers import Answers, Received
+    from harness.link_faults import LineDamage
+    from harness.scan import Scan
 
 
 @dataclass(frozen=True)
@@ -49,8 +51,22 @@ class Link(ABC):
     def __init__(self, options: LinkOptions) -> None:
         self.options = options
 
+    # A suite may start the next scenarios' links while one runs (`start`)
+    # and let finished ones stop while the next runs (`stop`, then `close`).
+    # Links whose software under test cannot be isolated that way say no.
+    starts_ahead: ClassVar[bool] = False
+
+    @classmethod  # noqa: B027 - optional hook
+    def prepare(cls, options: LinkOptions) -> None:
+        """Get ready for links with these options while the caller does other work
+        (e.g. start a helper process); optional, and never required."""
+
+    def start(self) -> None:  # noqa: B027 - optional hook
+        """Begin bringing the software under test up, without waiting for it."""
+
     def open(self) -> None:  # noqa: B027 - optional hook
-        """Bring the software under test up and wait (bounded) until it is ready."""
+        """Bring the software under test up (unless `start` did) and wait, bounded,
+        until it is ready."""
 
     def warm_up(self, scan: Scan) -> None:  # noqa: B027 - optional hook
         """Before tick 0: make sure answers to `scan` can reach us (answers discarded)."""
@@ -91,8 +107,15 @@ class Link(ABC):
         """Extra text for failure reports (e.g. the node's last stderr lines)."""
         return ""
 
+    def stop(self) -> None:  # noqa: B027 - optional hook
+        """Ask everything this link started to stop, without waiting (`close` waits)."""
+
     def close(self) -> None:  # noqa: B027 - optional hook
-        """Stop everything this link started; safe to call twice."""
+        """Stop everything this link started, wait for it and reap it; safe to call twice."""
+
+    def stop_note(self) -> str:
+        """After `close`: anything stopping took beyond the usual (signals, leftovers)."""
+        return ""
 
     def __enter__(self) -> Link:
         self.open()
@@ -134,6 +157,11 @@ def known_links() -> list[str]:
 
 def create_link(name: str, options: LinkOptions) -> Link:
     """The link registered as `name`, importing its module on first use."""
+    return link_class(name)(options)
+
+
+def link_class(name: str) -> type[Link]:
+    """The class registered as `name`, importing its module on first use."""
     if name not in _REGISTRY:
         if name not in known_links():
             raise ConfigError(f"unknown link {name!r} (known: {', '.join(known_links())})")
@@ -147,4 +175,4 @@ def create_link(name: str, options: LinkOptions) -> Link:
                     " or source ROS 2 Jazzy)"
                 )
             raise ConfigError(f"link {name!r} cannot start: {err}{hint}") from None
-    return _REGISTRY[name](options)
+    return _REGISTRY[name]

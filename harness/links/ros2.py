@@ -23,24 +23,27 @@ if it had to be killed.
 
 from __future__ import annotations
 
+import contextlib
 import time
 from collections import deque
 from collections.abc import Callable, Iterable
+from typing import TYPE_CHECKING
 
 from harness.answers import Answers, Received
 from harness.errors import ConfigError, LinkError
 from harness.links.base import Link, LinkOptions, register
 from harness.node_process import (
-    NodeCommand,
     NodeProcess,
-    package_node,
-    reference_node,
+    node_command,
+    node_parameters,
+    prepare_start,
     ros_arguments,
-    shell_node,
 )
-from harness.ros.observer import Heard, Observer, discovery_environment
-from harness.ros_domain import DomainReservation, reserve_domain
+from harness.ros_domain import DomainReservation, discovery_environment, reserve_domain
 from harness.scan import Scan
+
+if TYPE_CHECKING:  # rclpy is imported when the first link starts, after its node
+    from harness.ros.observer import Heard, Observer
 
 POLL_S = 0.05  # longest single spin; liveness of the node is checked this often
 MIN_GRACE_S = 0.002  # wait for a Bool after the String while the order is unknown
@@ -54,33 +57,12 @@ FLOOD_RATE_HZ = 200.0  # and this many a second (a 10 Hz timer during long waits
 LOUD_BYTES = 1 << 20  # a node that wrote more than this is told how much, in the diagnostics
 
 
-def node_command(options: LinkOptions) -> NodeCommand:
-    """The node the options name: a command, a package in a workspace, or the reference."""
-    if options.node and options.package:
-        raise ConfigError("give either --node or --package/--executable, not both")
-    if options.node:
-        return shell_node(options.node)
-    if options.package or options.executable:
-        if not (options.package and options.executable):
-            raise ConfigError("--package and --executable go together")
-        return package_node(options.package, options.executable, options.workspace)
-    return reference_node()
-
-
-def node_parameters(options: LinkOptions) -> tuple[str, ...]:
-    """The user's --param items, plus the threshold unless the user set it."""
-    params = tuple(options.params)
-    name = options.threshold_param
-    if name and not any(p.split(":=", 1)[0] == name for p in params):
-        params = (f"{name}:={options.threshold!r}", *params)
-    return params
-
-
 @register("ros2")
 class Ros2Link(Link):
     """Drive a ROS 2 node process through its scan topic; watch status and warning."""
 
     publishes_scans = True  # the harness publishes /scan (a board link listens instead)
+    starts_ahead = True  # each link has its own domain, so several can be up at once
 
     def __init__(self, options: LinkOptions) -> None:
         super().__init__(options)
@@ -102,18 +84,47 @@ class Ros2Link(Link):
         # (statuses, Bools, seconds) of each recent exchange, for flood checks
         self._recent: deque[tuple[int, int, float]] = deque(maxlen=FLOOD_SCANS)
         self.startup_s = 0.0
+        self._started = False
+        self._start_error: Exception | None = None
 
     # -- life cycle -------------------------------------------------------
-    def open(self) -> None:
+    @classmethod
+    def prepare(cls, options: LinkOptions) -> None:
+        """Start the fork server of the node, if it has one (its imports take a while)."""
+        with contextlib.suppress(ConfigError):  # a bad node is reported where it is used
+            prepare_start(node_command(options))
+
+    def start(self) -> None:
+        """Reserve a domain, start the node and the harness's own ROS node; do not wait.
+
+        A suite starts the next scenarios' links this way while one runs
+        (each in its own domain); `open` then waits for readiness.
+        A failure to start is kept and raised by `open`, so a link started
+        ahead reports it when its own scenario comes, as if started then.
+        """
+        if self._started:
+            return
+        self._started = True
         opts = self.options
-        self.domain = reserve_domain(opts.domain_id)
-        env = {
-            "ROS_DOMAIN_ID": str(self.domain.domain_id),
-            **discovery_environment(network=opts.ros_network),
-        }
+        try:
+            self.domain = reserve_domain(opts.domain_id)
+            env = {
+                "ROS_DOMAIN_ID": str(self.domain.domain_id),
+                **discovery_environment(network=opts.ros_network),
+            }
+            self._start_processes(env)
+            self.observer = self._make_observer(self.domain.domain_id)
+        except Exception as err:  # raised again by open()
+            self._start_error = err
+
+    def open(self) -> None:
+        """Start (unless started ahead) and wait, bounded, until the node is ready."""
         started = time.perf_counter()
-        self._start_processes(env)  # before our DDS threads exist: fork stays simple
-        self.observer = self._make_observer(self.domain.domain_id)
+        self.start()
+        if self._start_error is not None:
+            raise self._start_error
+        assert self.observer is not None
+        opts = self.options
         deadline = time.monotonic() + opts.ready_timeout
         clock_due = 0.0  # monotonic time of the next /clock while waiting
         while not self._ready():
@@ -206,6 +217,8 @@ class Ros2Link(Link):
         self.process.start()
 
     def _make_observer(self, domain_id: int) -> Observer:
+        from harness.ros.observer import Observer
+
         opts = self.options
         return Observer(
             domain_id,
@@ -267,21 +280,32 @@ class Ros2Link(Link):
         self._counted = (obs.heard["status"], obs.heard["warning"])
         self._warmed_up = True
 
-    def close(self) -> None:
+    def stop(self) -> None:
+        """Close the harness's ROS node and ask the node under test to stop; `close` waits."""
         if self.observer is not None:
             self.observer.close()
+        if self.process is not None:
+            self.process.request_stop()
+
+    def close(self) -> None:
+        self.stop()
         if self.process is not None:
             self.process.stop()
         if self.domain is not None:
             self.domain.release()
 
+    def stop_note(self) -> str:
+        """After `close`: what stopping the node took beyond a plain SIGINT, if anything."""
+        note = self.process.stop_note() if self.process is not None else ""
+        return f"stopping node {self.command.description}: {note}" if note else ""
+
     def diagnostics(self) -> str:
-        """The node's last output and what the graph showed; then stop it and say how that went.
+        """The node's last output and what the graph showed; then ask the node to stop.
 
         The runner asks for diagnostics once, when the run is over (before
-        closing the link): stopping the node here lets them say whether it
-        had to be killed or left processes behind. Its output is taken
-        first, so its shutdown messages do not push out the lines that matter.
+        closing the link). Its output is taken first, so its shutdown
+        messages do not push out the lines that matter; how the stop went
+        (killed, processes left behind) is `stop_note`, after `close`.
         """
         if self.process is None:
             return ""
@@ -294,16 +318,13 @@ class Ros2Link(Link):
             if tail:
                 parts.append(f"node {which} (last lines):\n{tail}")
         parts += self._graph_notes()
-        self.process.stop()
-        note = self.process.stop_note()
-        if note:
-            parts.append(f"stopping node {self.command.description}: {note}")
+        self.stop()
         return "\n".join(parts)
 
     def _graph_notes(self) -> list[str]:
         """Topic trouble in the graph at the end (a publisher made after it was ready)."""
         obs = self.observer
-        if obs is None or not obs.context.ok():
+        if obs is None or not obs.usable:
             return []
         notes = [f"wrong message type: {w}" for w in obs.wrong_types()]
         silent = not obs.heard["warning"] and not obs.warning_publishers()

@@ -31,6 +31,7 @@ from sensor_msgs.msg import LaserScan
 from std_msgs.msg import Bool, String
 
 from harness.ros.messages import clock_message, scan_from_message, scan_message
+from harness.ros_domain import discovery_environment
 from harness.scan import Scan
 
 QOS = QoSProfile(depth=50, reliability=ReliabilityPolicy.RELIABLE)
@@ -52,11 +53,6 @@ class Heard:
     arrived: float  # time.perf_counter() when the harness took it
 
 
-def discovery_environment(*, network: bool) -> dict[str, str]:
-    """Environment that keeps discovery on this machine unless a network is wanted."""
-    return {} if network else {"ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST"}
-
-
 class Observer:
     """Publish scans and collect the node's String and Bool answers."""
 
@@ -74,6 +70,7 @@ class Observer:
         os.environ.pop("ROS_AUTOMATIC_DISCOVERY_RANGE", None)
         os.environ.update(discovery_environment(network=network))
         self.context = Context()
+        self._closed = False
         # The harness handles SIGINT/SIGTERM itself (stop the node, report);
         # rclpy's own handlers would shut the context down under our feet.
         # args=[]: not sys.argv, where the user's NAME:=VALUE items would be
@@ -84,7 +81,10 @@ class Observer:
             domain_id=domain_id,
             signal_handler_options=SignalHandlerOptions.NO,
         )
-        self.node = rclpy.create_node("fossbot_hil", context=self.context)
+        # No /rosout: the harness logs nothing there, and a suite has several
+        # of these nodes at once (one per domain), whose rosout publishers
+        # would clash by name within this process.
+        self.node = rclpy.create_node("fossbot_hil", context=self.context, enable_rosout=False)
         self.scan_topic, self.status_topic = scan_topic, status_topic
         self.warning_topic = warning_topic
         # Either we publish the scans (ros2 link) or a board's driver does and
@@ -313,12 +313,20 @@ class Observer:
         )
         return "; ".join([counts, *self.qos_mismatches(), self.node_topics()])
 
+    @property
+    def usable(self) -> bool:
+        """Not closed, and its context not shut down."""
+        return not self._closed and self.context.ok()
+
     def close(self) -> None:
         """Tear down wait set, node and context, in that order; safe to call twice.
 
         The context must be destroyed too: until then its DDS participant
         lives on and a later run in the same domain can still see it.
         """
+        if self._closed:
+            return
+        self._closed = True
         if self.context.ok():
             self._wait_set.destroy_when_not_in_use()
             self.node.destroy_node()

@@ -11,6 +11,7 @@ import time
 from pathlib import Path
 
 import pytest
+from child_process import alive
 
 pytestmark = [pytest.mark.ros, pytest.mark.timeout(300)]
 
@@ -27,14 +28,6 @@ def children_of(pid: int) -> set[int]:
         except OSError:
             pass
     return found
-
-
-def alive(pid: int) -> bool:
-    try:
-        status = Path(f"/proc/{pid}/status").read_text()
-    except OSError:
-        return False
-    return "State:\tZ" not in status
 
 
 def test_parallel_runs_do_not_see_each_other() -> None:

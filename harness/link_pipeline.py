@@ -1,0 +1,81 @@
+"""A suite's links: the next scenarios' started ahead, finished ones left stopping behind.
+
+Bringing a node up (its start, rclpy, discovery) and stopping it take
+longer than running most scenarios. A link that can be isolated from its
+neighbours (each ros2 link has its own ROS domain and its own node process)
+is started a few scenarios ahead and, once its scenario is judged, stops
+while the next one runs. Nothing is shared between them: every scenario
+still gets a fresh node, and lockstep verdicts do not depend on timing.
+The suite waits for every link to close (every process reaped, every
+domain released) before it returns, and reports results in scenario order.
+"""
+
+from __future__ import annotations
+
+import time
+from collections import deque
+from collections.abc import Callable
+
+from harness.links.base import Link
+
+AHEAD = 2  # links started beyond the one running
+BEHIND = 2  # finished links left stopping before the suite waits for the oldest
+
+Closed = Callable[[float], None]  # told the seconds the suite waited for the close
+
+
+class LinkPipeline:
+    """Hands out the links of scenarios 0..count-1 in order, started ahead where allowed."""
+
+    def __init__(self, make: Callable[[int], Link], count: int, *, overlap: bool) -> None:
+        self._make = make
+        self._count = count
+        self._ahead = AHEAD if overlap else 0
+        self._behind = BEHIND if overlap else 0
+        self._started: deque[Link] = deque()  # made and started, not yet taken, in order
+        self._next = 0  # the index of the next link to make
+        self._stopping: deque[tuple[Link, Closed]] = deque()
+
+    def take(self, index: int) -> Link:
+        """The link of scenario `index` (the next in order), started; those after it
+        start too, up to AHEAD. Opening it (waiting until ready) is the caller's."""
+        if index != self._next - len(self._started):
+            raise ValueError(f"links are taken in order: asked for {index}")
+        self._start_until(index)
+        link = self._started.popleft()
+        self._start_until(index + self._ahead)
+        return link
+
+    def _start_until(self, last: int) -> None:
+        while self._next <= min(last, self._count - 1):
+            link = self._make(self._next)
+            self._next += 1
+            self._started.append(link)
+            link.start()
+
+    def retire(self, link: Link, closed: Closed) -> None:
+        """Its scenario is over: ask it to stop now; `closed` runs once it is closed,
+        in scenario order (at once when links do not overlap)."""
+        link.stop()
+        self._stopping.append((link, closed))
+        while len(self._stopping) > self._behind:
+            self._close_oldest()
+
+    def _close_oldest(self) -> None:
+        link, closed = self._stopping.popleft()
+        started = time.perf_counter()
+        link.close()
+        closed(time.perf_counter() - started)
+
+    def drain(self) -> None:
+        """Close every link: stop the ones started ahead and never taken (no more will
+        be started), then wait for all; finished links report in order."""
+        self._next = self._count
+        for link in self._started:
+            link.stop()
+        try:
+            while self._stopping:
+                self._close_oldest()
+        finally:
+            while self._started:
+                self._started.popleft().close()

@@ -1,0 +1,397 @@
+"""Start Python nodes by fork from a process that has imported them already.
+
+A node's interpreter start and imports (rclpy, the message packages, numpy)
+cost about 0.3 s of CPU, paid again for every scenario. The fork server pays
+it once: it imports the node's module (nothing more: no rclpy context, no
+DDS participant, no thread), then forks per request. Each fork is a fresh
+process that has never run a node; it supervises the node exactly as
+``node_reaper.py`` does (``supervise``: subreaper, own session, the same
+stop and the same events), and the node itself is a second fork that runs
+the module as ``python -m MODULE ARGS`` would, with the request's
+environment and arguments. Only ``python -m`` commands of the harness's own
+interpreter are served (the bundled reference node); anything else is
+started by ``node_reaper.py`` as before.
+
+The harness side (`ForkServer`) starts the server lazily, once per process,
+and falls back to the plain start if the server cannot come up. The server
+exits when the harness closes its socket or dies (PDEATHSIG).
+
+Protocol, over a SOCK_SEQPACKET socket pair: the server sends ``ready`` (or
+``error MESSAGE``) once; each request is JSON (module, argv, env, graces)
+with three descriptors (the status pipe, stdout, stderr); the answer is
+JSON (the supervisor's pid, or an error) with a pidfd of the supervisor.
+"""
+
+from __future__ import annotations
+
+import atexit
+import contextlib
+import json
+import os
+import select
+import signal
+import socket
+import subprocess
+import sys
+import threading
+from collections.abc import Iterator
+from dataclasses import dataclass
+
+READY_WAIT_S = 10.0  # for the server's imports (a cold disk cache is slow)
+ANSWER_WAIT_S = 5.0  # for a fork
+MESSAGE_BYTES = 1 << 20  # a request carries the environment
+REAP_EVERY_S = 0.5  # the server collects its exited children this often
+
+
+@dataclass(frozen=True)
+class Forked:
+    """A supervisor the fork server started: its pid and a pidfd to watch and signal it."""
+
+    pid: int
+    pidfd: int
+
+
+class ForkedSupervisor:
+    """The subset of ``subprocess.Popen`` NodeProcess uses, for a supervisor that is
+    not the harness's child: watched and signalled through its pidfd.
+
+    Its exit status belongs to the fork server (its parent), so `returncode`
+    is 0 once it has gone; the supervisor's own events say how the node ended.
+    """
+
+    def __init__(self, forked: Forked) -> None:
+        self.pid = forked.pid
+        self._pidfd: int | None = forked.pidfd
+        self.returncode: int | None = None
+
+    def poll(self) -> int | None:
+        return self.wait(0.0, raise_timeout=False)
+
+    def wait(self, timeout: float | None = None, *, raise_timeout: bool = True) -> int | None:
+        if self.returncode is None and self._pidfd is not None:
+            readable, _, _ = select.select([self._pidfd], [], [], timeout)
+            if readable:
+                self.returncode = 0
+                os.close(self._pidfd)
+                self._pidfd = None
+            elif raise_timeout:
+                raise subprocess.TimeoutExpired(f"supervisor {self.pid}", timeout or 0.0)
+        return self.returncode
+
+    def send_signal(self, sig: int) -> None:
+        if self._pidfd is not None:
+            with contextlib.suppress(ProcessLookupError):
+                signal.pidfd_send_signal(self._pidfd, sig)
+
+    def kill(self) -> None:
+        self.send_signal(signal.SIGKILL)
+
+    def __del__(self) -> None:
+        if self._pidfd is not None:
+            with contextlib.suppress(OSError):
+                os.close(self._pidfd)
+
+
+class ForkServer:
+    """The harness's end: one server per harness process, started on first use."""
+
+    def __init__(self, module: str) -> None:
+        self.module = module
+        self.problem: str | None = None  # why the server is not used, once known
+        self._lock = threading.Lock()
+        ours, theirs = socket.socketpair(socket.AF_UNIX, socket.SOCK_SEQPACKET)
+        self._socket: socket.socket | None = ours
+        try:
+            self._process: subprocess.Popen[bytes] | None = subprocess.Popen(
+                [sys.executable, "-m", __name__, str(theirs.fileno()), str(os.getpid()), module],
+                pass_fds=(theirs.fileno(),),
+                env={**os.environ, "PYTHONUNBUFFERED": "1"},  # what a node started anew gets
+                stdin=subprocess.DEVNULL,
+                stdout=subprocess.DEVNULL,
+                stderr=subprocess.DEVNULL,
+                start_new_session=True,  # a Ctrl-C on the terminal is the harness's to handle
+            )
+        except OSError as err:
+            self._process = None
+            self._fail(f"cannot start the fork server: {err}")
+        finally:
+            theirs.close()
+        self._ready = False
+
+    def _fail(self, problem: str) -> None:
+        self.problem = self.problem or problem
+        if self._socket is not None:
+            self._socket.close()
+            self._socket = None
+
+    def _receive(self, timeout: float) -> tuple[bytes, list[int]]:
+        assert self._socket is not None
+        readable, _, _ = select.select([self._socket], [], [], timeout)
+        if not readable:
+            raise TimeoutError(f"no answer within {timeout:g} s")
+        message, fds, _, _ = socket.recv_fds(self._socket, MESSAGE_BYTES, 1)
+        if not message:
+            raise ConnectionError("the fork server exited")
+        return message, fds
+
+    def _wait_ready(self) -> bool:
+        if not self._ready and self._socket is not None:
+            try:
+                message, _ = self._receive(READY_WAIT_S)
+            except (OSError, TimeoutError) as err:
+                self._fail(f"the fork server did not come up: {err}")
+                return False
+            if message != b"ready":
+                self._fail(message.decode(errors="replace"))
+                return False
+            self._ready = True
+        return self._ready
+
+    def start(
+        self, argv: list[str], env: dict[str, str], graces: tuple[float, float], fds: list[int]
+    ) -> ForkedSupervisor | None:
+        """Fork a supervisor running `self.module` with `argv`; None when the server is
+        not usable (then `problem` says why, and the caller starts the node itself)."""
+        with self._lock:
+            if not self._wait_ready():
+                return None
+            assert self._socket is not None
+            request = {"argv": argv, "env": env, "graces": graces}
+            try:
+                socket.send_fds(self._socket, [json.dumps(request).encode()], fds)
+                message, pidfds = self._receive(ANSWER_WAIT_S)
+            except (OSError, TimeoutError) as err:
+                self._fail(f"the fork server stopped answering: {err}")
+                return None
+            answer = json.loads(message)
+            if "error" in answer or len(pidfds) != 1:
+                for fd in pidfds:
+                    os.close(fd)
+                self._fail(f"the fork server could not fork: {answer.get('error', '?')}")
+                return None
+            return ForkedSupervisor(Forked(int(answer["pid"]), pidfds[0]))
+
+    def close(self) -> None:
+        """Stop the server (its children, supervisors still stopping, carry on alone)."""
+        self._fail("closed")
+        if self._process is not None:
+            with contextlib.suppress(subprocess.TimeoutExpired):
+                self._process.wait(timeout=2.0)
+            if self._process.poll() is None:
+                self._process.kill()
+                self._process.wait()
+            self._process = None
+
+
+_SERVERS: dict[str, ForkServer] = {}
+_SCOPES = [0]  # open `scope()`s
+
+
+@contextlib.contextmanager
+def scope() -> Iterator[None]:
+    """Fork servers started within it stop when the outermost scope ends.
+
+    A command or a suite opens one, so nothing it started outlives it; a
+    server started outside any scope (a test session's runs one by one)
+    lives until the process exits.
+    """
+    _SCOPES[0] += 1
+    try:
+        yield
+    finally:
+        _SCOPES[0] -= 1
+        if not _SCOPES[0]:
+            close_all()
+
+
+def shared(module: str) -> ForkServer:
+    """This process's fork server for `module`, started on first use (closed at exit)."""
+    server = _SERVERS.get(module)
+    if server is None:
+        if not _SERVERS:
+            atexit.register(close_all)
+        server = _SERVERS[module] = ForkServer(module)
+    return server
+
+
+def close_all() -> None:
+    for server in _SERVERS.values():
+        server.close()
+    _SERVERS.clear()
+
+
+# -- the server -------------------------------------------------------------
+
+
+def _serve(sock: socket.socket, module: str) -> int:
+    """Answer fork requests until the harness closes its end."""
+    while True:
+        readable, _, _ = select.select([sock], [], [], REAP_EVERY_S)
+        _reap_children()
+        if not readable:
+            continue
+        try:
+            message, fds, _, _ = socket.recv_fds(sock, MESSAGE_BYTES, 3)
+        except OSError:
+            return 0
+        if not message:
+            return 0
+        try:
+            request = json.loads(message)
+            if len(fds) != 3:
+                raise ValueError(f"expected 3 descriptors, got {len(fds)}")
+            pid = os.fork()
+        except (OSError, ValueError) as err:
+            for fd in fds:
+                os.close(fd)
+            socket.send_fds(sock, [json.dumps({"error": str(err)}).encode()], [])
+            continue
+        if pid == 0:
+            _supervisor(sock, module, request, fds)  # never returns
+        for fd in fds:
+            os.close(fd)
+        pidfd = os.pidfd_open(pid)
+        socket.send_fds(sock, [json.dumps({"pid": pid}).encode()], [pidfd])
+        os.close(pidfd)
+
+
+def _reap_children() -> None:
+    with contextlib.suppress(ChildProcessError):
+        while os.waitpid(-1, os.WNOHANG)[0]:
+            pass
+
+
+def _supervisor(sock: socket.socket, module: str, request: dict, fds: list[int]) -> None:
+    """The forked child: supervise a node that is a fork of this one."""
+    code = 1
+    try:
+        from harness.node_reaper import Reaper, supervise
+
+        sock.close()
+        status_fd, out_fd, err_fd = fds
+        os.setsid()
+        null = os.open(os.devnull, os.O_RDONLY)
+        for fd, target in ((null, 0), (out_fd, 1), (err_fd, 2)):
+            os.dup2(fd, target)
+            os.close(fd)
+        int_grace, term_grace = request["graces"]
+        reaper = Reaper(status_fd, float(int_grace), float(term_grace))
+        parent = os.getppid()
+        code = supervise(reaper, parent, lambda: _fork_node(module, request, status_fd))
+    finally:
+        os._exit(code)
+
+
+def _fork_node(module: str, request: dict, status_fd: int) -> int:
+    """Fork the node: in the child, become what ``python -m MODULE ARGV`` would be."""
+    pid = os.fork()
+    if pid:
+        return pid
+    code = 1
+    try:
+        os.close(status_fd)
+        os.setsid()
+        signal.pthread_sigmask(signal.SIG_SETMASK, [])  # the supervisor blocks its signals
+        os.environ.clear()
+        os.environ.update(request["env"])
+        code = _run_module(module, request["argv"])
+    finally:
+        os._exit(code)
+
+
+def _run_module(module: str, argv: list[str]) -> int:
+    """Run `module` as __main__ with `argv` and exit as the interpreter would."""
+    import runpy
+
+    sys.argv = [module, *argv]
+    try:
+        runpy.run_module(module, run_name="__main__", alter_sys=True)
+        code = 0
+    except SystemExit as stop:
+        code = _exit_code(stop.code)
+    except KeyboardInterrupt:
+        _flush_and_exit_handlers()
+        signal.signal(signal.SIGINT, signal.SIG_DFL)  # as Python does: die by the signal
+        os.kill(os.getpid(), signal.SIGINT)
+        code = 130
+    except BaseException:  # as the interpreter does with any uncaught error
+        import traceback
+
+        traceback.print_exc()
+        code = 1
+    _flush_and_exit_handlers()
+    return code
+
+
+def _exit_code(value: object) -> int:
+    """What ``sys.exit(value)`` makes the interpreter's exit code."""
+    if value is None:
+        return 0
+    if isinstance(value, int):
+        return value & 0xFF
+    print(value, file=sys.stderr)
+    return 1
+
+
+def _flush_and_exit_handlers() -> None:
+    """What the interpreter does on exit that a node may rely on: atexit, flushed output."""
+    with contextlib.suppress(BaseException):
+        atexit._run_exitfuncs()
+    for stream in (sys.stdout, sys.stderr):
+        with contextlib.suppress(BaseException):
+            stream.flush()
+
+
+# What every rclpy node uses besides its own topics' types: parameter
+# services and events, /rosout, /clock (use_sim_time), type descriptions.
+NODE_INTERFACES = (
+    "rcl_interfaces.msg",
+    "rcl_interfaces.srv",
+    "rosgraph_msgs.msg",
+    "type_description_interfaces.srv",
+)
+
+
+def _load_type_support() -> None:
+    """Load the C type support of every ROS interface imported so far (and of those
+    every node uses): each node would otherwise load the same libraries again,
+    at its first publisher, subscription or service."""
+    import importlib
+
+    for name in NODE_INTERFACES:
+        with contextlib.suppress(ImportError):
+            importlib.import_module(name)
+    for loaded in list(sys.modules.values()):
+        for value in list(getattr(loaded, "__dict__", {}).values()):
+            load = getattr(type(value), "__import_type_support__", None)
+            if isinstance(value, type) and load is not None:
+                with contextlib.suppress(Exception):  # a node that needs it will say why
+                    load()
+
+
+def main(argv: list[str]) -> int:
+    """``python -m harness.node_forkserver SOCKET_FD PARENT_PID MODULE``."""
+    import ctypes
+    import importlib
+
+    fd, parent, module = argv
+    sock = socket.socket(fileno=int(fd))
+    libc = ctypes.CDLL(None, use_errno=True)
+    libc.prctl(1, signal.SIGKILL, 0, 0, 0)  # PR_SET_PDEATHSIG: go when the harness goes
+    if os.getppid() != int(parent):
+        return 1
+    try:
+        importlib.import_module(module)
+        # Keep what it imported, not the module itself: each node runs it
+        # afresh as __main__ (runpy warns about a module already imported).
+        del sys.modules[module]
+        _load_type_support()
+    except BaseException as err:  # reported to the harness, which then starts nodes itself
+        socket.send_fds(sock, [f"error cannot import {module}: {err!r}".encode()], [])
+        return 1
+    socket.send_fds(sock, [b"ready"], [])
+    return _serve(sock, module)
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))

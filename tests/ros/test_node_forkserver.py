@@ -1,0 +1,195 @@
+"""The bundled node started by fork from a warm process: the same node, the same hygiene."""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import textwrap
+import time
+from pathlib import Path
+
+import pytest
+from child_process import alive
+
+from harness.links.base import LinkOptions
+from harness.node_forkserver import ForkedSupervisor, ForkServer, _exit_code
+from harness.node_process import (
+    FORK_SERVER_SETTING,
+    NodeCommand,
+    NodeProcess,
+    reference_node,
+    ros_arguments,
+)
+from harness.ros_domain import discovery_environment, reserve_domain
+from harness.runner import run_suite
+from harness.scenario import resolve_scenario
+
+pytestmark = [pytest.mark.ros, pytest.mark.timeout(120)]
+
+
+def wait_until(condition, seconds: float) -> bool:
+    end = time.monotonic() + seconds
+    while time.monotonic() < end:
+        if condition():
+            return True
+        time.sleep(0.02)
+    return condition()
+
+
+def started_node(env: dict[str, str] | None = None) -> NodeProcess:
+    domain = reserve_domain(None)
+    environment = {
+        "ROS_DOMAIN_ID": str(domain.domain_id),
+        **discovery_environment(network=False),
+        **(env or {}),
+    }
+    process = NodeProcess(reference_node(), ros_arguments(("threshold:=0.4",)), environment)
+    process.start()
+    process.domain = domain  # type: ignore[attr-defined]  # released by the test
+    return process
+
+
+def test_the_reference_node_is_forked_and_stops_cleanly() -> None:
+    process = started_node()
+    try:
+        assert isinstance(process._popen, ForkedSupervisor)  # started by the fork server
+        assert process.node_pid is not None and alive(process.node_pid)
+        # A real node: it logs its topics and the threshold it was given.
+        assert wait_until(lambda: "threshold 0.4 m" in process.tail("stderr"), 10), process.tail()
+        node = process.node_pid
+        assert process.stop() == 0
+        assert process.stopped_by == "SIGINT" and not process.leftovers and not process.stop_note()
+        assert not alive(node)
+    finally:
+        process.stop()
+        process.domain.release()  # type: ignore[attr-defined]
+
+
+def test_turned_off_the_node_starts_as_a_command(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv(FORK_SERVER_SETTING, "0")
+    process = started_node()
+    try:
+        assert isinstance(process._popen, subprocess.Popen)
+        assert wait_until(lambda: "threshold 0.4 m" in process.tail("stderr"), 15), process.tail()
+        assert process.stop() == 0
+    finally:
+        process.stop()
+        process.domain.release()  # type: ignore[attr-defined]
+
+
+def test_a_server_that_cannot_import_its_module_is_not_used() -> None:
+    server = ForkServer("harness.no_such_module")
+    try:
+        read, write = os.pipe()
+        try:
+            assert server.start(["x"], dict(os.environ), (1.0, 1.0), [write, write, write]) is None
+        finally:
+            os.close(read)
+            os.close(write)
+        assert "cannot import harness.no_such_module" in (server.problem or "")
+    finally:
+        server.close()
+
+
+@pytest.mark.parametrize(
+    ("body", "code", "stderr"),
+    [
+        ("import sys\nsys.exit(3)", 3, ""),
+        ("raise SystemExit('bad parameter')", 1, "bad parameter"),
+        ("raise RuntimeError('boom')", 1, "RuntimeError: boom"),
+        ("import signal, os\nos.kill(os.getpid(), signal.SIGTERM)", -signal.SIGTERM, ""),
+        ("raise KeyboardInterrupt", -signal.SIGINT, ""),
+    ],
+)
+def test_a_forked_module_exits_as_its_interpreter_would(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, body: str, code: int, stderr: str
+) -> None:
+    """Exit codes and uncaught errors look as they would from ``python -m MODULE``."""
+    main = textwrap.indent(body, "    ")
+    (tmp_path / "ending_node.py").write_text(
+        f"def main():\n{main}\n\n\nif __name__ == '__main__':\n    main()\n"
+    )
+    monkeypatch.setenv("PYTHONPATH", str(tmp_path))
+    server = ForkServer("ending_node")
+    try:
+        monkeypatch.setattr("harness.node_process.shared_fork_server", lambda module: server)
+        command = NodeCommand((sys.executable, "-m", "ending_node"), module="ending_node")
+        process = NodeProcess(command, [], {})
+        process.start()
+        assert isinstance(process._popen, ForkedSupervisor), server.problem
+        assert wait_until(lambda: process.returncode() is not None, 10)
+        assert process.returncode() == code
+        process.stop()
+        assert stderr in process.tail("stderr")
+    finally:
+        server.close()
+
+
+def test_exit_code_of_sys_exit_values() -> None:
+    assert _exit_code(None) == 0
+    assert _exit_code(2) == 2
+    assert _exit_code(256 + 4) == 4
+
+
+def test_a_killed_harness_takes_its_forked_nodes_along(tmp_path: Path) -> None:
+    """SIGKILL the harness: the fork server, each supervisor and each node go too."""
+    script = tmp_path / "harness_that_dies.py"
+    script.write_text(
+        textwrap.dedent(
+            """
+            import os, sys, time
+            from harness.node_process import NodeProcess, reference_node, ros_arguments
+            env = {"ROS_DOMAIN_ID": sys.argv[1], "ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST"}
+            process = NodeProcess(reference_node(), ros_arguments(()), env)
+            process.start()
+            print(process.node_pid, flush=True)
+            time.sleep(60)
+            """
+        )
+    )
+    domain = reserve_domain(None)
+    try:
+        harness = subprocess.Popen(
+            [sys.executable, str(script), str(domain.domain_id)], stdout=subprocess.PIPE, text=True
+        )
+        assert harness.stdout is not None
+        node = int(harness.stdout.readline())
+        assert alive(node)
+        harness.kill()
+        harness.wait()
+        assert wait_until(lambda: not alive(node), 10), f"node {node} outlived its harness"
+    finally:
+        domain.release()
+
+
+def test_overlapping_scenarios_get_fresh_nodes_in_their_own_domains() -> None:
+    """Started ahead and stopped behind, every scenario still has a node of its own."""
+    names = ["approach_wall", "obstacle_at_side", "out_of_range", "reverse_to_wall"]
+    scenarios = [resolve_scenario(n) for n in names]
+    seen: list[tuple[float, int | None, int | None]] = []  # (opened at, node pid, domain)
+    starts: list[float] = []  # when each node was started
+    from harness.links.ros2 import Ros2Link
+
+    opened = Ros2Link.open
+
+    def recording_open(link: Ros2Link) -> None:
+        opened(link)
+        assert link.process is not None and link.domain is not None
+        starts.append(link.process.started_at)
+        seen.append((time.monotonic(), link.process.node_pid, link.domain.domain_id))
+
+    reported: list[str] = []
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(Ros2Link, "open", recording_open)
+        results = run_suite(
+            scenarios, "ros2", LinkOptions(), on_result=lambda r: reported.append(r.scenario)
+        )
+    assert [r.scenario for r in results] == names == reported  # in order
+    assert all(r.ok for r in results), [r.first_failure for r in results]
+    assert len({pid for _, pid, _ in seen}) == len(names)  # a fresh process each
+    assert len({domain for _, _, domain in seen}) == len(names)  # its own domain each
+    assert all(not alive(pid) for _, pid, _ in seen if pid)  # all stopped and reaped
+    # Overlapped: the next scenarios' nodes were started before the first one was ready.
+    assert starts[1] < seen[0][0] and starts[2] < seen[0][0]
