@@ -13,13 +13,11 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
-from harness.bench import machine
+from harness.bench import STAGES, machine
 from harness.bench.figures import OVERHEAD_FORMULA, check_targets, figures
 from harness.bench.stage import StageResult
 from harness.bench.workload import LAB_TRIO, Workload, lab_workload
 from harness.errors import ConfigError, HarnessError
-
-STAGES = ("raycast", "synthesis", "inprocess", "ros2", "serial", "pacing", "suite")
 
 
 @dataclass(frozen=True)
@@ -49,8 +47,13 @@ class BenchPlan:
 
     @property
     def suite_cli(self) -> bool:
-        """Also time the CLI in a fresh process (not in quick runs: another ~5 s)."""
+        """Also time the lab trio's CLI in a fresh process (not in quick runs)."""
         return not self.quick
+
+    @property
+    def suite_runs(self) -> int:
+        """`fossbot-hil run` of the shipped suite: the median of three (quick: one)."""
+        return 1 if self.quick else 3
 
 
 def parse_stages(text: str | None) -> tuple[str, ...]:
@@ -96,7 +99,9 @@ def _measure(name: str, plan: BenchPlan) -> StageResult:
     if name == "suite":
         from harness.bench.lab_suite import measure_suite
 
-        return measure_suite(lab_workload(1, LAB_TRIO), cli=plan.suite_cli)
+        return measure_suite(
+            lab_workload(1, LAB_TRIO), cli=plan.suite_cli, suite_runs=plan.suite_runs
+        )
     raise ValueError(name)
 
 

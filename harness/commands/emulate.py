@@ -7,7 +7,6 @@ import argparse
 from rich.console import Console
 
 from harness.commands.arguments import check_port, fault_list, seed
-from harness.scenario import resolve_scenario
 
 NAME = "emulate"
 HELP = "serve a scenario's scans as a LIDAR device on a serial port"
@@ -31,6 +30,7 @@ def run(args: argparse.Namespace, console: Console) -> int:
     from harness.devices.profiles import profile
     from harness.emulate import emulate
     from harness.runner import RunSettings
+    from harness.scenario import resolve_scenario
 
     if args.port is not None:
         check_port("--port", args.port)

@@ -12,6 +12,7 @@ import importlib.util
 import shutil
 import time
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from rich.console import Console
 
@@ -31,7 +32,9 @@ from harness.grading import LAB_EXECUTABLE, LAB_PACKAGE
 from harness.grading.discover import GRADES_MARKER, Student
 from harness.holder_lock import HolderLock
 from harness.report.folder_lock import lock_folder
-from harness.scenario import Scenario, resolve_scenario, shipped_scenarios
+
+if TYPE_CHECKING:  # imported when grading starts (the parser is built for any command)
+    from harness.scenario import Scenario
 
 NAME = "grade"
 HELP = "build and test every student's node in DIR; write the class table (CSV, HTML)"
@@ -134,6 +137,8 @@ def check_grading_options(args: argparse.Namespace) -> None:
 
 def selected_scenarios(items: list[str]) -> list[Scenario]:
     """`--scenario` items (comma lists allowed), all resolved now; default every shipped one."""
+    from harness.scenario import resolve_scenario, shipped_scenarios
+
     names = [n.strip() for item in items for n in item.split(",") if n.strip()]
     scenarios = [resolve_scenario(n) for n in names] if names else shipped_scenarios()
     seen: set[str] = set()

@@ -6,8 +6,6 @@ import argparse
 
 from rich.console import Console
 
-from harness.scenario import shipped_scenarios
-
 NAME = "list"
 HELP = "list the shipped scenarios"
 
@@ -18,6 +16,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace, console: Console) -> int:
     from harness.report.terminal import scenario_table
+    from harness.scenario import shipped_scenarios
 
     console.print(scenario_table(shipped_scenarios()))
     return 0

@@ -21,12 +21,12 @@ from harness.commands.arguments import (
     given,
 )
 from harness.errors import ConfigError, Interrupted
-from harness.runner import RunSettings
-from harness.scenario import Scenario, resolve_scenario, shipped_scenarios
-from harness.trace import RunResult
 
-if TYPE_CHECKING:
+if TYPE_CHECKING:  # the rest is imported when a run starts (the parser is built for any command)
     from harness.report.outputs import ReportFolder
+    from harness.runner import RunSettings
+    from harness.scenario import Scenario
+    from harness.trace import RunResult
 
 T = TypeVar("T")
 
@@ -61,11 +61,15 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def selected(names: Sequence[str]) -> list[Scenario]:
     """The named scenarios (all resolved before anything runs), or every shipped one."""
+    from harness.scenario import resolve_scenario, shipped_scenarios
+
     return [resolve_scenario(n) for n in names] if names else shipped_scenarios()
 
 
 def settings_from(args: argparse.Namespace) -> RunSettings:
     """The per-run overrides given on the command line."""
+    from harness.runner import RunSettings
+
     return RunSettings(
         seed=args.seed,
         threshold=args.threshold,
@@ -88,10 +92,21 @@ def open_report(out: str | None) -> ReportFolder | None:
 
 
 def run(args: argparse.Namespace, console: Console) -> int:
-    from harness.report.progress import RunProgress
-    from harness.report.terminal import print_results
+    from harness.node_forkserver import scope
+
+    with scope():  # whatever prepare() starts stops with the command
+        return _run(args, console)
+
+
+def _run(args: argparse.Namespace, console: Console) -> int:
+    from harness.links.base import link_class
 
     options = check_link_options(args)  # all before the report folder exists
+    link_class(args.link).prepare(options)  # e.g. a node's fork server, while we load the rest
+    from harness.report.progress import RunProgress
+    from harness.report.terminal import print_results
+    from harness.report.wall_clock import process_seconds
+
     scenarios = selected(args.scenarios)
     check_output_file("--junit-xml", args.junit_xml)
     check_status_regex(args)
@@ -119,9 +134,10 @@ def run(args: argparse.Namespace, console: Console) -> int:
             )
         except Interrupted as stop:  # Ctrl-C or SIGTERM: report what was judged, then stop
             interrupted, results = stop, stop.results
-    print_results(console, results)
+    wall_s = process_seconds()
+    print_results(console, results, wall_s=wall_s)
     if report is not None:
-        index = _write(f"--out {args.out}", report.finish)
+        index = _write(f"--out {args.out}", report.finish, wall_s)
         console.print(f"report: {index}", highlight=False, markup=False, soft_wrap=True)
     if args.junit_xml:
         from harness.report.junit import write_junit
