@@ -56,7 +56,7 @@ def _row(i: int, e: Mapping[str, Any]) -> str:
         f'<td class="n">{e["ticks"]}',
         f'<td class="n">{e["failed"]}',
         _verdict(e["verdict"]),
-        f'<td class="n">{e["wall_s"]:.2f}',
+        f'<td class="n">{e["total_s"]:.2f}',
         f'<td class="n">{_text(e["seed"])}',
         f'<td class="n">{_text(e["threshold"])}',
         _text(e["faults"]),
@@ -92,7 +92,7 @@ def index_html(summary: Mapping[str, Any], *, diagnostics: Sequence[str] = ()) -
     """The page for a run summary (see harness.report.summary.run_summary)."""
     entries = summary["scenarios"]
     headline = f"{summary['passed']} of {summary['total']} scenarios passed"
-    head = ["scenario", "link", "ticks", "failed", "verdict", "wall s", "seed", "threshold"]
+    head = ["scenario", "link", "ticks", "failed", "verdict", "time s", "seed", "threshold"]
     lines = [
         "<!DOCTYPE html>",
         '<html lang="en">',

@@ -182,14 +182,15 @@ class ReportFolder:
             names[name] = relative_path(path, relative_to)
         return names
 
-    def finish(self) -> Path:
-        """Write summary.json, junit.xml and index.html; return the index page."""
+    def finish(self, wall_s: float | None = None) -> Path:
+        """Write summary.json, junit.xml and index.html; return the index page.
+        `wall_s`: the command's wall time, for the totals."""
         from harness.report.html import index_html
         from harness.report.junit import junit_xml
 
         done = self.scenarios
         entries = [scenario_entry(s.result, self._names(s, relative_to=self.root)) for s in done]
-        summary = run_summary(entries)
+        summary = run_summary(entries, wall_s)
         write_atomically(self.root / SUMMARY, json_bytes(summary))
         results = [s.result for s in done]
         xml = junit_xml(results, artifacts=[s.paths for s in done], base=self.root)

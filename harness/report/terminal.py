@@ -46,12 +46,18 @@ def scenario_table(scenarios: Sequence[Scenario]) -> Table:
     return table
 
 
-def results_table(results: Sequence[RunResult]) -> Table:
-    """`fossbot-hil run`: scenario / ticks / failed / verdict."""
+def results_table(results: Sequence[RunResult], wall_s: float | None = None) -> Table:
+    """`fossbot-hil run`: scenario / ticks / failed / verdict / time, and a total row.
+
+    A scenario's time is what it cost the run: waiting for the software
+    under test to come up, the run itself and waiting for it to stop (work
+    done ahead or behind, while another scenario ran, is not counted twice).
+    The total row gives the command's wall time when known.
+    """
     table = Table(box=None, pad_edge=False)
-    for column in ("scenario", "link", "ticks", "failed", "verdict", "wall s"):
+    for column in ("scenario", "link", "ticks", "failed", "verdict", "time s"):
         table.add_column(
-            column, justify="right" if column in ("ticks", "failed", "wall s") else "left"
+            column, justify="right" if column in ("ticks", "failed", "time s") else "left"
         )
     for r in results:
         word = verdict_of(r)
@@ -61,14 +67,29 @@ def results_table(results: Sequence[RunResult]) -> Table:
             str(len(r.records)),
             str(len(r.failed_ticks)),
             Text(word, style=VERDICT_STYLES[word]),
-            f"{r.wall_s:.2f}",
+            f"{r.total_s:.2f}",
+        )
+    if len(results) > 1 or wall_s is not None:
+        total = wall_s if wall_s is not None else sum(r.total_s for r in results)
+        table.add_row(
+            "total",
+            "",
+            str(sum(len(r.records) for r in results)),
+            str(sum(len(r.failed_ticks) for r in results)),
+            "",
+            f"{total:.2f}",
+            style="bold",
+            end_section=False,
         )
     return table
 
 
-def print_results(console: Console, results: Sequence[RunResult]) -> None:
-    """The table, then for each failed scenario its first failure and diagnostics."""
-    console.print(results_table(results))
+def print_results(
+    console: Console, results: Sequence[RunResult], *, wall_s: float | None = None
+) -> None:
+    """The table, then for each failed scenario its first failure and diagnostics;
+    `wall_s`, the command's wall time so far, goes in the total row."""
+    console.print(results_table(results, wall_s))
     failed = [r for r in results if not r.ok]
     shown: set[str] = set()
     for r in failed:
