@@ -35,6 +35,7 @@ class LinkPipeline:
         self._started: deque[Link] = deque()  # made and started, not yet taken, in order
         self._next = 0  # the index of the next link to make
         self._stopping: deque[tuple[Link, Closed]] = deque()
+        self._running: Link | None = None  # taken, not yet retired
 
     def take(self, index: int) -> Link:
         """The link of scenario `index` (the next in order), started; those after it
@@ -42,7 +43,7 @@ class LinkPipeline:
         if index != self._next - len(self._started):
             raise ValueError(f"links are taken in order: asked for {index}")
         self._start_until(index)
-        link = self._started.popleft()
+        link = self._running = self._started.popleft()
         self._start_until(index + self._ahead)
         return link
 
@@ -56,6 +57,8 @@ class LinkPipeline:
     def retire(self, link: Link, closed: Closed) -> None:
         """Its scenario is over: ask it to stop now; `closed` runs once it is closed,
         in scenario order (at once when links do not overlap)."""
+        if link is self._running:
+            self._running = None
         link.stop()
         self._stopping.append((link, closed))
         while len(self._stopping) > self._behind:
@@ -69,13 +72,17 @@ class LinkPipeline:
 
     def drain(self) -> None:
         """Close every link: stop the ones started ahead and never taken (no more will
-        be started), then wait for all; finished links report in order."""
+        be started) and one whose run raised, then wait for all; finished links
+        report in order. Safe to call again."""
         self._next = self._count
-        for link in self._started:
+        running, self._running = self._running, None
+        unused = [*([running] if running is not None else []), *self._started]
+        self._started.clear()
+        for link in unused:
             link.stop()
         try:
             while self._stopping:
                 self._close_oldest()
         finally:
-            while self._started:
-                self._started.popleft().close()
+            for link in unused:
+                link.close()

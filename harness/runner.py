@@ -440,6 +440,8 @@ def run_suite(
             pipeline.drain()  # every process reaped; finished scenarios reported first
             rest = scenarios[index:]
             raise _suite_interrupted(err, results, rest, link_name, on_result) from None
+        finally:  # whatever else ended the suite: nothing it started is left running
+            pipeline.drain()
     return results
 
 

@@ -85,3 +85,11 @@ def test_links_are_taken_in_order() -> None:
     links, _ = pipeline(3, overlap=True)
     with pytest.raises(ValueError, match="in order"):
         links.take(1)
+
+
+def test_drain_closes_a_link_whose_run_raised() -> None:
+    links, log = pipeline(3, overlap=False)
+    links.take(0)  # its run raised: never retired
+    links.drain()
+    links.drain()  # again: nothing more to do
+    assert log == ["start 0", "stop 0", "close 0"]
