@@ -85,8 +85,8 @@ class Held(Exception):
 
 def this_process() -> str:
     """This process, as the message of a run it keeps waiting names it."""
-    worker = os.environ.get("PYTEST_XDIST_WORKER")
-    if worker:
+    worker = os.environ.get("PYTEST_XDIST_WORKER")  # inherited by the processes it starts
+    if worker and "pytest" in sys.modules:
         return f"pytest worker {worker}"
     spec = getattr(sys.modules.get("__main__"), "__spec__", None)
     program = os.path.basename(sys.argv[0])

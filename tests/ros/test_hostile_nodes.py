@@ -268,7 +268,8 @@ class ClockOnlyWhenReady(Ros2Link):
 
 def test_never_ready_says_clock_comes_only_once_the_node_is_ready(pids: Path) -> None:
     """No /clock before it is ready: the clock-waiting node never subscribes, and is told why."""
-    options = LinkOptions(node=node("waits_for_clock", pids), ready_timeout=2.0)
+    # Long enough for the node to publish its status topic on a loaded machine (tests in parallel).
+    options = LinkOptions(node=node("waits_for_clock", pids), ready_timeout=6.0)
     link = ClockOnlyWhenReady(options)
     try:
         with pytest.raises(LinkError) as never:
@@ -277,7 +278,7 @@ def test_never_ready_says_clock_comes_only_once_the_node_is_ready(pids: Path) ->
         link.close()
     message = str(never.value)
     assert (
-        "never became ready within 2 s: the harness waited for it to subscribe to /scan and "
+        "never became ready within 6 s: the harness waited for it to subscribe to /scan and "
         "publish /lidar_status, but it did not subscribe to /scan (the harness publishes /clock "
         "only once the node is ready, so a node that waits for /clock before it subscribes to "
         "/scan never starts) (subscribers on /scan: 0, publishers on /lidar_status: 1"
