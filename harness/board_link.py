@@ -109,6 +109,7 @@ class BoardLink(Ros2Link):
             NodeCommand(
                 (sys.executable, "-m", self.profile.driver_module),
                 description=f"board driver {self.profile.driver_module}",
+                module=self.profile.driver_module,  # forked from a warm process, as the node
             ),
             driver_args,
             env,
