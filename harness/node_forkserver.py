@@ -390,7 +390,8 @@ def main(argv: list[str]) -> int:
         socket.send_fds(sock, [f"error cannot import {module}: {err!r}".encode()], [])
         return 1
     socket.send_fds(sock, [b"ready"], [])
-    return _serve(sock, module)
+    code = _serve(sock, module)
+    os._exit(code)  # nothing to clean up: the harness waits for this exit, so make it quick
 
 
 if __name__ == "__main__":
