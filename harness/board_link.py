@@ -27,7 +27,7 @@ from harness.errors import ConfigError, LinkError
 from harness.link_faults import LineDamage
 from harness.links.base import LinkOptions
 from harness.links.ros2 import CATCH_UP_S, POLL_S, Ros2Link
-from harness.node_process import NodeCommand, NodeProcess, ros_arguments
+from harness.node_process import NodeCommand, NodeProcess, prepare_start, ros_arguments
 from harness.ros.observer import Heard
 from harness.scan import Scan
 
@@ -70,6 +70,22 @@ class BoardLink(Ros2Link):
         self._line_damage: LineDamage | None = None
 
     # -- processes and ports ----------------------------------------------
+    @classmethod
+    def prepare(cls, options: LinkOptions) -> None:
+        """Start the fork servers of the virtual board's driver and of the node."""
+        if options.port is None:
+            prepare_start(cls._driver_command())
+        super().prepare(options)
+
+    @classmethod
+    def _driver_command(cls) -> NodeCommand:
+        module = cls.profile.driver_module
+        return NodeCommand(
+            (sys.executable, "-m", module),
+            description=f"board driver {module}",
+            module=module,  # forked from a warm process, as the node
+        )
+
     def _start_processes(self, env: dict[str, str]) -> None:
         from harness.serial_line.ports import PtyPort, SerialPort
         from harness.serial_line.server import DeviceServer
@@ -105,15 +121,7 @@ class BoardLink(Ros2Link):
             ),
             use_sim_time=False,
         )
-        self.driver = NodeProcess(
-            NodeCommand(
-                (sys.executable, "-m", self.profile.driver_module),
-                description=f"board driver {self.profile.driver_module}",
-                module=self.profile.driver_module,  # forked from a warm process, as the node
-            ),
-            driver_args,
-            env,
-        )
+        self.driver = NodeProcess(self._driver_command(), driver_args, env)
         self.driver.start()
         super()._start_processes(env)
 

@@ -266,7 +266,12 @@ def link_options(args: argparse.Namespace) -> LinkOptions:
     ConfigError names the option when a topic or parameter cannot work
     (`checked_node_options`); topics come back fully qualified.
     """
-    options = LinkOptions(
+    return checked_node_options(unchecked_link_options(args))
+
+
+def unchecked_link_options(args: argparse.Namespace) -> LinkOptions:
+    """Link settings from the command line as given (`link_options` checks them)."""
+    return LinkOptions(
         scan_timeout=args.timeout,
         ready_timeout=args.ready_timeout,
         processor=getattr(args, "processor", None),
@@ -284,7 +289,6 @@ def link_options(args: argparse.Namespace) -> LinkOptions:
         realtime=args.realtime,
         port=getattr(args, "port", None),
     )
-    return checked_node_options(options)
 
 
 def check_link_options(args: argparse.Namespace) -> LinkOptions:

@@ -19,6 +19,7 @@ from harness.commands.arguments import (
     check_status_regex,
     fault_list,
     given,
+    unchecked_link_options,
 )
 from harness.errors import ConfigError, Interrupted
 
@@ -101,8 +102,10 @@ def run(args: argparse.Namespace, console: Console) -> int:
 def _run(args: argparse.Namespace, console: Console) -> int:
     from harness.links.base import link_class
 
+    # First what takes a while in another process (the node's fork server),
+    # then the checks and the rest of the imports.
+    link_class(args.link).prepare(unchecked_link_options(args))
     options = check_link_options(args)  # all before the report folder exists
-    link_class(args.link).prepare(options)  # e.g. a node's fork server, while we load the rest
     from harness.report.progress import RunProgress
     from harness.report.terminal import print_results
     from harness.report.wall_clock import process_seconds
