@@ -64,6 +64,7 @@ class World:
         self.where = shown(scenario.source or "<scenario>")
         if gui and sys.platform.startswith("linux") and not os.environ.get("DISPLAY"):
             raise ConfigError("--gui needs a display")
+        self.gui = gui
         self.client: int = bullet.connect(gui)
         if self.client < 0:
             raise ConfigError("cannot start PyBullet" + (" with a GUI" if gui else ""))
@@ -352,12 +353,9 @@ class World:
     # -- lifetime -----------------------------------------------------------
 
     def close(self) -> None:
-        """Disconnect the physics client (idempotent)."""
+        """Give the physics client back (idempotent)."""
         if getattr(self, "client", -1) >= 0:
-            try:
-                pb.disconnect(physicsClientId=self.client)
-            except pb.error:
-                pass
+            bullet.release(self.client, gui=self.gui)
             self.client = -1
 
     def __enter__(self) -> World:

@@ -259,12 +259,21 @@ def test_worlds_coexist_in_one_process():
 
 
 def test_close_is_idempotent():
-    """close() twice is harmless, and the client is gone after it."""
+    """close() twice is harmless, and the client is gone or empty after it (kept for the
+    next world, which then starts from nothing)."""
     world = World(make_scenario())
     client = world.client
     world.close()
     world.close()
-    assert not pb.isConnected(physicsClientId=client)
+    assert world.client == -1
+    kept = pb.isConnected(physicsClientId=client)
+    assert not kept or pb.getNumBodies(physicsClientId=client) == 0
+    other = World(make_scenario())
+    try:
+        assert other.client == client or not kept  # the spare client is used again
+        assert pb.getNumBodies(physicsClientId=other.client) == len(other.obstacle_bodies) + 2
+    finally:
+        other.close()
 
 
 def test_building_the_world_is_deterministic(tmp_path):
