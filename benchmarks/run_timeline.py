@@ -5,7 +5,7 @@
 Runs the command in this process with timers around the calls that make up
 a scenario (node start, the harness's ROS node, waiting for readiness, the
 warm-up exchange, the run, closing), then prints on stderr when each began
-and how long it took, in seconds since the process started, and the totals
+and how long it took, in seconds since the harness was imported, and the totals
 per phase. Nothing else is changed: the command's own output goes to stdout
 as usual. docs/benchmarks.md shows how to read it.
 """
@@ -19,7 +19,7 @@ from collections import defaultdict
 from collections.abc import Callable
 from typing import Any
 
-from harness.report.wall_clock import process_seconds
+from harness.report.wall_clock import command_seconds
 
 EVENTS: list[tuple[float, float, str]] = []  # (began, seconds, phase)
 
@@ -29,7 +29,7 @@ def timed(owner: Any, name: str, phase: str) -> None:
     original: Callable[..., Any] = getattr(owner, name)
 
     def wrapper(*args: Any, **kwargs: Any) -> Any:
-        began = process_seconds()
+        began = command_seconds()
         started = time.perf_counter()
         try:
             return original(*args, **kwargs)
@@ -49,7 +49,7 @@ def report() -> None:
     print("\nphase totals (calls)", file=sys.stderr)
     for phase, seconds in sorted(totals.items(), key=lambda item: -item[1]):
         print(f"{seconds:7.3f} s  {phase} ({counts[phase]})", file=sys.stderr)
-    print(f"{process_seconds():7.3f} s  process so far", file=sys.stderr)
+    print(f"{command_seconds():7.3f} s  command so far", file=sys.stderr)
 
 
 def main() -> None:

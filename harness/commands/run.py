@@ -108,7 +108,7 @@ def _run(args: argparse.Namespace, console: Console) -> int:
     options = check_link_options(args)  # all before the report folder exists
     from harness.report.progress import RunProgress
     from harness.report.terminal import print_results
-    from harness.report.wall_clock import process_seconds
+    from harness.report.wall_clock import command_seconds
 
     scenarios = selected(args.scenarios)
     check_output_file("--junit-xml", args.junit_xml)
@@ -137,7 +137,7 @@ def _run(args: argparse.Namespace, console: Console) -> int:
             )
         except Interrupted as stop:  # Ctrl-C or SIGTERM: report what was judged, then stop
             interrupted, results = stop, stop.results
-    wall_s = process_seconds()
+    wall_s = command_seconds()
     print_results(console, results, wall_s=wall_s)
     if report is not None:
         index = _write(f"--out {args.out}", report.finish, wall_s)

@@ -1,21 +1,18 @@
-"""How long this command has been running, its interpreter's own start included."""
+"""How long this command has been running: since the harness was first imported.
+
+Not since the process started: a shell may exec the command in a process it
+started long before (``bash -c "pip install ... && fossbot-hil run"`` does),
+and the process's start time then counts the install. The interpreter's own
+start before the first import (about 0.05 s) is not counted.
+"""
 
 from __future__ import annotations
 
-import os
 import time
 
-_IMPORTED = time.perf_counter()
+import harness
 
 
-def process_seconds() -> float:
-    """Seconds since this process started (from /proc; else since this module was imported)."""
-    try:
-        with open("/proc/self/stat", "rb") as handle:
-            fields = handle.read().rpartition(b")")[2].split()
-        with open("/proc/uptime", "rb") as handle:
-            uptime = float(handle.read().split()[0])
-        started = int(fields[19]) / os.sysconf("SC_CLK_TCK")  # field 22: starttime, in ticks
-        return max(0.0, uptime - started)
-    except (OSError, ValueError, IndexError):
-        return time.perf_counter() - _IMPORTED
+def command_seconds() -> float:
+    """Seconds since the harness package was first imported in this process."""
+    return time.monotonic() - harness.IMPORTED_AT
