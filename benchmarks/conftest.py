@@ -1,7 +1,7 @@
 """Fixtures for the pytest-benchmark suite: worlds, scans and opened links, built once.
 
-Run with ``pytest benchmarks/`` (it is outside the default ``testpaths``, so
-a plain ``pytest`` never runs it). Needs the ``bench`` extra; the ROS 2
+Run with ``pytest benchmarks/ -n 0`` (in one process, for timings; it is
+outside the default ``testpaths``, so a plain ``pytest`` never runs it). Needs the ``bench`` extra; the ROS 2
 benchmarks need the ``ros`` extra too.
 """
 
