@@ -81,7 +81,7 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 
 def entry() -> None:
-    """The `fossbot-hil` console script."""
+    """The `fossbot-hil` console script (it exits without the interpreter's teardown)."""
     _interrupt_on_sigterm()
     code = main()
     _exit_now(code)
@@ -104,5 +104,6 @@ def _exit_now(code: int) -> NoReturn:
     os._exit(code)
 
 
-if __name__ == "__main__":
-    entry()
+if __name__ == "__main__":  # python -m harness.cli: a normal exit, so profilers can report
+    _interrupt_on_sigterm()
+    sys.exit(main())
