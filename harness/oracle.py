@@ -361,7 +361,7 @@ def _distance_hint(scan: Scan, expected: float, claimed: float, tol: float) -> s
     for factor, unit in ((100.0, "centimetres"), (1000.0, "millimetres")):
         if abs(claimed - expected * factor) <= tol * factor + 0.5:
             return f" (looks like {unit})"
-    r = scan.ranges
+    r = scan.ranges.astype(np.float64)  # a huge claim must not overflow float32
     bad = np.flatnonzero(np.isfinite(r) & ~scan.valid_mask() & (np.abs(r - claimed) <= tol))
     if bad.size:
         i = int(bad[0])

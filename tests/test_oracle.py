@@ -430,3 +430,16 @@ def test_reference_node_passes_every_profile(profile: str) -> None:
         warn = (True,) if exp.distance is not None and exp.distance < 0.5 else ()
         v = oracle.judge(tick, tick * 0.1, scan, ans(text, warnings=warn))
         assert v.ok, v.explanation
+
+
+def test_a_huge_claimed_distance_is_judged_without_numeric_warnings() -> None:
+    """A claim beyond float32 (1e300 m) is simply wrong: no overflow on the way."""
+    import warnings
+
+    from harness.oracle import _distance_hint
+
+    scan = Scan(0.0, 1.0, 0.5, 0.0, 0.1, 0.12, 12.0, np.array([0.05, 1.0, 20.0], np.float32))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert _distance_hint(scan, 1.0, 1e300, 0.05) == ""
+        assert "below range_min" in _distance_hint(scan, 1.0, 0.05, 0.01)
