@@ -18,7 +18,7 @@ from collections.abc import Callable
 
 from harness.links.base import Link
 
-AHEAD = 2  # links started beyond the one running
+AHEAD = 3  # links started beyond the one running (a node needs 0.3-0.4 s to be ready)
 BEHIND = 2  # finished links left stopping before the suite waits for the oldest
 
 Closed = Callable[[float], None]  # told the seconds the suite waited for the close
