@@ -426,12 +426,15 @@ def run_suite(
                     reason = f"not run: the node did not start in {failed_start}"
                     report(_not_run(scenario, link_name, reason))
                     continue
-                link = pipeline.take(index)
+                started = time.perf_counter()
+                link = pipeline.take(index)  # starts it (unless started ahead), and the next ones
+                taking = time.perf_counter() - started
                 result = run_through(
                     link,
                     lambda link, s=scenario: run_scenario(s, link, settings, on_tick=on_tick),
                     _not_started_as(scenario, link_name, settings),
                 )
+                result.startup_s += taking  # starting links is start-up too
                 if result.not_started:
                     failed_start = scenario.name
                 pipeline.retire(link, _reporter(result, link, report))
