@@ -27,7 +27,6 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from harness.errors import ConfigError
-from harness.links.base import LinkOptions
 from harness.node_forkserver import ForkedSupervisor
 from harness.node_forkserver import shared as shared_fork_server
 
@@ -462,25 +461,3 @@ class NodeProcess:
             output.join(1.0)
         _LIVE.discard(self)
         return self.returncode()
-
-
-def node_command(options: LinkOptions) -> NodeCommand:
-    """The node the options name: a command, a package in a workspace, or the reference."""
-    if options.node and options.package:
-        raise ConfigError("give either --node or --package/--executable, not both")
-    if options.node:
-        return shell_node(options.node)
-    if options.package or options.executable:
-        if not (options.package and options.executable):
-            raise ConfigError("--package and --executable go together")
-        return package_node(options.package, options.executable, options.workspace)
-    return reference_node()
-
-
-def node_parameters(options: LinkOptions) -> tuple[str, ...]:
-    """The user's --param items, plus the threshold unless the user set it."""
-    params = tuple(options.params)
-    name = options.threshold_param
-    if name and not any(p.split(":=", 1)[0] == name for p in params):
-        params = (f"{name}:={options.threshold!r}", *params)
-    return params

@@ -33,11 +33,13 @@ from harness.answers import Answers, Received
 from harness.errors import ConfigError, LinkError
 from harness.links.base import Link, LinkOptions, register
 from harness.node_process import (
+    NodeCommand,
     NodeProcess,
-    node_command,
-    node_parameters,
+    package_node,
     prepare_start,
+    reference_node,
     ros_arguments,
+    shell_node,
 )
 from harness.ros_domain import DomainReservation, discovery_environment, reserve_domain
 from harness.scan import Scan
@@ -55,6 +57,28 @@ FLOOD_PER_SCAN = 5  # more than this many messages a scan,
 FLOOD_MIN = 30  # this many at least,
 FLOOD_RATE_HZ = 200.0  # and this many a second (a 10 Hz timer during long waits is no flood)
 LOUD_BYTES = 1 << 20  # a node that wrote more than this is told how much, in the diagnostics
+
+
+def node_command(options: LinkOptions) -> NodeCommand:
+    """The node the options name: a command, a package in a workspace, or the reference."""
+    if options.node and options.package:
+        raise ConfigError("give either --node or --package/--executable, not both")
+    if options.node:
+        return shell_node(options.node)
+    if options.package or options.executable:
+        if not (options.package and options.executable):
+            raise ConfigError("--package and --executable go together")
+        return package_node(options.package, options.executable, options.workspace)
+    return reference_node()
+
+
+def node_parameters(options: LinkOptions) -> tuple[str, ...]:
+    """The user's --param items, plus the threshold unless the user set it."""
+    params = tuple(options.params)
+    name = options.threshold_param
+    if name and not any(p.split(":=", 1)[0] == name for p in params):
+        params = (f"{name}:={options.threshold!r}", *params)
+    return params
 
 
 @register("ros2")
