@@ -7,18 +7,16 @@ configuration error (one line on stderr naming the file or field).
 from __future__ import annotations
 
 import argparse
-import atexit
-import os
 import signal
 import sys
 from collections.abc import Sequence
-from typing import NoReturn
 
 from rich.console import Console
 
 from harness import __version__
 from harness.commands import command_modules
 from harness.errors import ConfigError, HarnessError, Interrupted
+from harness.quick_exit import exit_now
 
 EXIT_OK, EXIT_FAILED, EXIT_USAGE = 0, 1, 2
 
@@ -83,25 +81,7 @@ def main(argv: Sequence[str] | None = None) -> int:
 def entry() -> None:
     """The `fossbot-hil` console script (it exits without the interpreter's teardown)."""
     _interrupt_on_sigterm()
-    code = main()
-    _exit_now(code)
-
-
-def _exit_now(code: int) -> NoReturn:
-    """Exit without tearing the interpreter down.
-
-    By now every record is written and closed, every process the command
-    started is stopped and reaped, and the exit handlers (which stop any
-    left) run here; what remains is freeing memory, which took a quarter of
-    a second with rclpy and PyBullet loaded. Output is flushed first.
-    """
-    atexit._run_exitfuncs()
-    for stream in (sys.stdout, sys.stderr):
-        try:
-            stream.flush()
-        except (OSError, ValueError):  # a closed pipe: nothing more can be said
-            pass
-    os._exit(code)
+    exit_now(main())  # records are closed and processes reaped by now: skip the teardown
 
 
 if __name__ == "__main__":  # python -m harness.cli: a normal exit, so profilers can report

@@ -33,22 +33,14 @@ import signal
 import socket
 import subprocess
 import sys
-import threading
 from collections.abc import Iterator
-from dataclasses import dataclass
+
+from harness.quick_exit import exit_now, finish_interpreter
 
 READY_WAIT_S = 10.0  # for the server's imports (a cold disk cache is slow)
 ANSWER_WAIT_S = 5.0  # for a fork
 MESSAGE_BYTES = 1 << 20  # a request carries the environment
 REAP_EVERY_S = 0.5  # the server collects its exited children this often
-
-
-@dataclass(frozen=True)
-class Forked:
-    """A supervisor the fork server started: its pid and a pidfd to watch and signal it."""
-
-    pid: int
-    pidfd: int
 
 
 class ForkedSupervisor:
@@ -59,9 +51,9 @@ class ForkedSupervisor:
     is 0 once it has gone; the supervisor's own events say how the node ended.
     """
 
-    def __init__(self, forked: Forked) -> None:
-        self.pid = forked.pid
-        self._pidfd: int | None = forked.pidfd
+    def __init__(self, pid: int, pidfd: int) -> None:
+        self.pid = pid
+        self._pidfd: int | None = pidfd
         self.returncode: int | None = None
 
     def poll(self) -> int | None:
@@ -93,12 +85,12 @@ class ForkedSupervisor:
 
 
 class ForkServer:
-    """The harness's end: one server per harness process, started on first use."""
+    """The harness's end: one server per harness process, started on first use, used from
+    the main thread only (see ``node_process.fork_server_enabled``)."""
 
     def __init__(self, module: str) -> None:
         self.module = module
         self.problem: str | None = None  # why the server is not used, once known
-        self._lock = threading.Lock()
         ours, theirs = socket.socketpair(socket.AF_UNIX, socket.SOCK_SEQPACKET)
         self._socket: socket.socket | None = ours
         try:
@@ -152,24 +144,23 @@ class ForkServer:
     ) -> ForkedSupervisor | None:
         """Fork a supervisor running `self.module` with `argv`; None when the server is
         not usable (then `problem` says why, and the caller starts the node itself)."""
-        with self._lock:
-            if not self._wait_ready():
-                return None
-            assert self._socket is not None
-            request = {"argv": argv, "env": env, "graces": graces}
-            try:
-                socket.send_fds(self._socket, [json.dumps(request).encode()], fds)
-                message, pidfds = self._receive(ANSWER_WAIT_S)
-            except (OSError, TimeoutError) as err:
-                self._fail(f"the fork server stopped answering: {err}")
-                return None
-            answer = json.loads(message)
-            if "error" in answer or len(pidfds) != 1:
-                for fd in pidfds:
-                    os.close(fd)
-                self._fail(f"the fork server could not fork: {answer.get('error', '?')}")
-                return None
-            return ForkedSupervisor(Forked(int(answer["pid"]), pidfds[0]))
+        if not self._wait_ready():
+            return None
+        assert self._socket is not None
+        request = {"argv": argv, "env": env, "graces": graces}
+        try:
+            socket.send_fds(self._socket, [json.dumps(request).encode()], fds)
+            message, pidfds = self._receive(ANSWER_WAIT_S)
+        except (OSError, TimeoutError) as err:
+            self._fail(f"the fork server stopped answering: {err}")
+            return None
+        answer = json.loads(message)
+        if "error" in answer or len(pidfds) != 1:
+            for fd in pidfds:
+                os.close(fd)
+            self._fail(f"the fork server could not fork: {answer.get('error', '?')}")
+            return None
+        return ForkedSupervisor(int(answer["pid"]), pidfds[0])
 
     def close(self) -> None:
         """Stop the server (its children, supervisors still stopping, carry on alone)."""
@@ -296,11 +287,11 @@ def _fork_node(module: str, request: dict, status_fd: int) -> int:
         os.environ.update(request["env"])
         code = _run_module(module, request["argv"])
     finally:
-        os._exit(code)
+        exit_now(code)
 
 
 def _run_module(module: str, argv: list[str]) -> int:
-    """Run `module` as __main__ with `argv` and exit as the interpreter would."""
+    """Run `module` as __main__ with `argv`; the exit code the interpreter would give."""
     import runpy
 
     sys.argv = [module, *argv]
@@ -310,16 +301,15 @@ def _run_module(module: str, argv: list[str]) -> int:
     except SystemExit as stop:
         code = _exit_code(stop.code)
     except KeyboardInterrupt:
-        _flush_and_exit_handlers()
+        finish_interpreter()
         signal.signal(signal.SIGINT, signal.SIG_DFL)  # as Python does: die by the signal
         os.kill(os.getpid(), signal.SIGINT)
-        code = 130
+        code = 128 + signal.SIGINT  # not reached
     except BaseException:  # as the interpreter does with any uncaught error
         import traceback
 
         traceback.print_exc()
         code = 1
-    _flush_and_exit_handlers()
     return code
 
 
@@ -331,15 +321,6 @@ def _exit_code(value: object) -> int:
         return value & 0xFF
     print(value, file=sys.stderr)
     return 1
-
-
-def _flush_and_exit_handlers() -> None:
-    """What the interpreter does on exit that a node may rely on: atexit, flushed output."""
-    with contextlib.suppress(BaseException):
-        atexit._run_exitfuncs()
-    for stream in (sys.stdout, sys.stderr):
-        with contextlib.suppress(BaseException):
-            stream.flush()
 
 
 # What every rclpy node uses besides its own topics' types: parameter
