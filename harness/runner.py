@@ -438,12 +438,11 @@ def run_suite(
                 if result.not_started:
                     failed_start = scenario.name
                 pipeline.retire(link, _reporter(result, link, report))
-            pipeline.drain()
         except KeyboardInterrupt as err:
             pipeline.drain()  # every process reaped; finished scenarios reported first
             rest = scenarios[index:]
             raise _suite_interrupted(err, results, rest, link_name, on_result) from None
-        finally:  # whatever else ended the suite: nothing it started is left running
+        finally:  # every link closed (in order: the last results are reported here)
             pipeline.drain()
     return results
 
