@@ -2,12 +2,14 @@
 
 from __future__ import annotations
 
+import contextlib
 import os
 import signal
 import subprocess
 import sys
 import textwrap
 import time
+from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
@@ -38,22 +40,22 @@ def wait_until(condition, seconds: float) -> bool:
     return condition()
 
 
-def started_node(env: dict[str, str] | None = None) -> NodeProcess:
+@contextlib.contextmanager
+def started_node() -> Iterator[NodeProcess]:
+    """The reference node, started in a domain of its own; stopped and released after."""
     domain = reserve_domain(None)
-    environment = {
-        "ROS_DOMAIN_ID": str(domain.domain_id),
-        **discovery_environment(network=False),
-        **(env or {}),
-    }
+    environment = {"ROS_DOMAIN_ID": str(domain.domain_id), **discovery_environment(network=False)}
     process = NodeProcess(reference_node(), ros_arguments(("threshold:=0.4",)), environment)
-    process.start()
-    process.domain = domain  # type: ignore[attr-defined]  # released by the test
-    return process
+    try:
+        process.start()
+        yield process
+    finally:
+        process.stop()
+        domain.release()
 
 
 def test_the_reference_node_is_forked_and_stops_cleanly() -> None:
-    process = started_node()
-    try:
+    with started_node() as process:
         assert isinstance(process._popen, ForkedSupervisor)  # started by the fork server
         assert process.node_pid is not None and alive(process.node_pid)
         # A real node: it logs its topics and the threshold it was given.
@@ -62,21 +64,14 @@ def test_the_reference_node_is_forked_and_stops_cleanly() -> None:
         assert process.stop() == 0
         assert process.stopped_by == "SIGINT" and not process.leftovers and not process.stop_note()
         assert not alive(node)
-    finally:
-        process.stop()
-        process.domain.release()  # type: ignore[attr-defined]
 
 
 def test_turned_off_the_node_starts_as_a_command(monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setenv(FORK_SERVER_SETTING, "0")
-    process = started_node()
-    try:
+    with started_node() as process:
         assert isinstance(process._popen, subprocess.Popen)
         assert wait_until(lambda: "threshold 0.4 m" in process.tail("stderr"), 15), process.tail()
         assert process.stop() == 0
-    finally:
-        process.stop()
-        process.domain.release()  # type: ignore[attr-defined]
 
 
 def test_a_server_that_cannot_import_its_module_is_not_used() -> None:
