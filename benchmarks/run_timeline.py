@@ -53,11 +53,13 @@ def report() -> None:
 
 
 def main() -> None:
-    from harness import cli, node_process, runner
+    from harness import cli, node_forkserver, node_process, runner
     from harness.links import ros2
     from harness.ros import observer
     from harness.sim import simulation
 
+    timed(node_forkserver.ForkServer, "__init__", "fork server: spawn")
+    timed(node_forkserver.ForkServer, "_wait_ready", "fork server: wait until it has imported")
     timed(node_process.NodeProcess, "start", "node start (until its supervisor reports)")
     timed(observer.Observer, "__init__", "harness ROS node: create")
     timed(ros2.Ros2Link, "open", "link open: wait until the node is ready")

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+from typing import TYPE_CHECKING
 
 from rich.console import Console
 
@@ -20,7 +21,9 @@ from harness.commands.arguments import (
     topic_option,
 )
 from harness.errors import ConfigError, Interrupted
-from harness.link_faults import NO_LINK_FAULTS, LinkFaults
+
+if TYPE_CHECKING:  # numpy comes with it: not needed to build the parser
+    from harness.link_faults import LinkFaults
 
 NAME = "replay"
 HELP = "re-inject a recorded /scan stream (ours or a robot's rosbag2) and judge the node"
@@ -61,6 +64,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def replay_link_faults(text: str | None) -> LinkFaults:
     """--faults for a replay: link faults only, and no re-timing of recorded scans."""
     from harness.faults import build_profile
+    from harness.link_faults import NO_LINK_FAULTS
 
     items = fault_list(text)
     if not items:
