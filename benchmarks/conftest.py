@@ -1,8 +1,8 @@
 """Fixtures for the pytest-benchmark suite: worlds, scans and opened links, built once.
 
 Run with ``pytest benchmarks/ -n 0`` (in one process, for timings; it is
-outside the default ``testpaths``, so a plain ``pytest`` never runs it). Needs the ``bench`` extra; the ROS 2
-benchmarks need the ``ros`` extra too.
+outside the default ``testpaths``, so a plain ``pytest`` never runs it). Needs
+the ``bench`` extra; the ROS 2 benchmarks need the ``ros`` extra too.
 """
 
 from __future__ import annotations
@@ -14,8 +14,8 @@ import numpy as np
 import pytest
 
 from harness.bench.workload import lab_workload, prepared_frames
+from harness.lidar.scan import Scan
 from harness.links.base import Link, LinkOptions, create_link
-from harness.scan import Scan
 
 
 def pytest_configure(config: pytest.Config) -> None:
@@ -33,7 +33,7 @@ def scans() -> list[Scan]:
 @pytest.fixture(scope="session")
 def truths() -> list[np.ndarray]:
     """The true ranges of approach_wall, tick by tick."""
-    from harness.scenario import resolve_scenario
+    from harness.scenario.files import resolve_scenario
     from harness.sim.simulation import Simulation
 
     with Simulation(resolve_scenario("approach_wall")) as sim:
@@ -43,7 +43,7 @@ def truths() -> list[np.ndarray]:
 @pytest.fixture(scope="module")
 def captured_rays() -> Iterator[tuple[object, list[tuple[np.ndarray, np.ndarray]]]]:
     """An approach_wall simulation, run to its end, with every tick's rays."""
-    from harness.scenario import resolve_scenario
+    from harness.scenario.files import resolve_scenario
     from harness.sim.simulation import Simulation
 
     with Simulation(resolve_scenario("approach_wall")) as sim:

@@ -53,19 +53,21 @@ def report() -> None:
 
 
 def main() -> None:
-    from harness import cli, node_forkserver, node_process, runner
+    from harness import cli
     from harness.links import ros2
+    from harness.nodes import forkserver, process
     from harness.ros import observer
+    from harness.runner import scenario_run
     from harness.sim import simulation
 
-    timed(node_forkserver.ForkServer, "__init__", "fork server: spawn")
-    timed(node_forkserver.ForkServer, "_wait_ready", "fork server: wait until it has imported")
-    timed(node_process.NodeProcess, "start", "node start (until its supervisor reports)")
+    timed(forkserver.ForkServer, "__init__", "fork server: spawn")
+    timed(forkserver.ForkServer, "_wait_ready", "fork server: wait until it has imported")
+    timed(process.NodeProcess, "start", "node start (until its supervisor reports)")
     timed(observer.Observer, "__init__", "harness ROS node: create")
     timed(ros2.Ros2Link, "open", "link open: wait until the node is ready")
     timed(simulation.Simulation, "__init__", "world build")
     timed(ros2.Ros2Link, "warm_up", "warm-up exchange")
-    timed(runner, "judge_frames", "ticking (simulate, exchange, judge)")
+    timed(scenario_run, "judge_frames", "ticking (simulate, exchange, judge)")
     timed(ros2.Ros2Link, "close", "link close: wait for the node to stop")
     atexit.register(report)
     sys.argv = ["fossbot-hil", "run", *sys.argv[1:]]

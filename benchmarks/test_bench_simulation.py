@@ -5,10 +5,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from harness.answers import Answers, Received
 from harness.bench.workload import lab_workload, prepared_frames
-from harness.faults import build_profile
-from harness.oracle import Oracle
+from harness.faults.sensor import build_profile
+from harness.judge.answers import Answers, Received
+from harness.judge.oracle import Oracle
 from harness.reference.scan_logic import analyse_message, status_text
 
 
@@ -43,7 +43,7 @@ def test_lidar_truth(benchmark, captured_rays) -> None:
 def test_fault_emit(benchmark, truths, profile: str) -> None:
     """One scan through a fault profile (harsh: every random draw)."""
     faults = build_profile([profile])
-    from harness.scenario import resolve_scenario
+    from harness.scenario.files import resolve_scenario
 
     spec = resolve_scenario("approach_wall").lidar_spec
     rng = np.random.default_rng(7)

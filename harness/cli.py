@@ -16,7 +16,7 @@ from rich.console import Console
 from harness import __version__
 from harness.commands import command_modules
 from harness.errors import ConfigError, HarnessError, Interrupted
-from harness.quick_exit import exit_now
+from harness.nodes.quick_exit import exit_now
 
 EXIT_OK, EXIT_FAILED, EXIT_USAGE = 0, 1, 2
 

@@ -14,7 +14,9 @@ safe per medium:
   (``\\x1b``, ``\\u202e``, ``\\ud800``); newline and tab stay. Its result
   is safe on a terminal and valid in XML 1.0;
 - ``for_terminal``, ``for_xml``, ``for_html``, ``for_csv``: per medium.
-  A terminal writer must still print with markup off (or as rich Text).
+  A terminal writer must still print with markup off (or as rich Text);
+- ``shown``: a file name, YAML key or model link name quoted inside a
+  one-line error message.
 """
 
 from __future__ import annotations
@@ -32,6 +34,7 @@ __all__ = [
     "for_storage",
     "for_terminal",
     "for_xml",
+    "shown",
     "visible",
 ]
 
@@ -100,3 +103,12 @@ def for_csv(text: str) -> str:
     """A CSV cell that a spreadsheet shows as text, never runs as a formula."""
     text = visible(text)
     return f"'{text}" if text.startswith(CSV_FORMULA_STARTS) else text
+
+
+def shown(text: str, limit: int = 200) -> str:
+    """`text` for a one-line message: non-printable characters escaped, long text shortened."""
+    if not text.isprintable():
+        text = repr(text)[1:-1]
+    if len(text) > limit:
+        text = f"{text[: limit // 2]}...{text[-(limit // 4) :]}"
+    return text

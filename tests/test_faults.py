@@ -10,7 +10,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from harness.errors import ConfigError
-from harness.faults import (
+from harness.faults.sensor import (
     CONVENTIONS,
     NAMED_PROFILES,
     RETURN_INTENSITY,
@@ -21,7 +21,7 @@ from harness.faults import (
     Spurious,
     build_profile,
 )
-from harness.lidar_spec import PRESETS, LidarSpec
+from harness.lidar.spec import PRESETS, LidarSpec
 
 GAZEBO = PRESETS["gazebo"]
 BIG = LidarSpec("big", 10000, 0.0, 2 * math.pi / 10000, 0.12, 12.0, 10.0)

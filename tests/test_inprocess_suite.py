@@ -6,10 +6,11 @@ from pathlib import Path
 
 import pytest
 
+from harness.judge.records import RunResult
 from harness.links import LinkOptions, create_link
-from harness.runner import RunSettings, effective_threshold, run_scenario
-from harness.scenario import resolve_scenario, shipped_scenarios
-from harness.trace import RunResult
+from harness.runner.scenario_run import run_scenario
+from harness.runner.settings import RunSettings, effective_threshold
+from harness.scenario.files import resolve_scenario, shipped_scenarios
 
 STUDENTS = Path(__file__).parent / "student_functions.py"
 

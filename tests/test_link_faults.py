@@ -10,9 +10,7 @@ import numpy as np
 import pytest
 
 from harness.errors import ConfigError
-from harness.faults import Noise, build_profile, split_fault_text
-from harness.lidar_spec import PRESETS
-from harness.link_faults import (
+from harness.faults.link import (
     Delay,
     Delivery,
     Drop,
@@ -29,6 +27,8 @@ from harness.link_faults import (
     plan_deliveries,
     scan_periods,
 )
+from harness.faults.sensor import Noise, build_profile, split_fault_text
+from harness.lidar.spec import PRESETS
 
 GAZEBO = PRESETS["gazebo"]
 N = 5000  # frames or periods for the rate checks: about 4.7 sigma of room at 10%

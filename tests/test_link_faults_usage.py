@@ -11,8 +11,9 @@ from command_line import fossbot_hil
 from harness.errors import ConfigError
 from harness.links.base import LinkOptions
 from harness.record.reader import read_scans
-from harness.runner import RunSettings, run
-from harness.scenario import load_scenario_file, resolve_scenario
+from harness.runner.scenario_run import run
+from harness.runner.settings import RunSettings
+from harness.scenario.files import load_scenario_file, resolve_scenario
 
 pytest_plugins = ["pytester"]
 pytestmark = pytest.mark.timeout(120)

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import pytest
 
-from harness.link_pipeline import AHEAD, BEHIND, LinkPipeline
 from harness.links.base import Link, LinkOptions
+from harness.runner.link_pipeline import AHEAD, BEHIND, LinkPipeline
 
 
 class Recorded(Link):

@@ -8,12 +8,12 @@ import re
 import numpy as np
 import pytest
 
-from harness.answers import Answers, Received
 from harness.errors import ConfigError
-from harness.faults import NAMED_PROFILES
-from harness.lidar_spec import PRESETS
-from harness.oracle import Oracle, summarise_scan
-from harness.scan import Scan
+from harness.faults.sensor import NAMED_PROFILES
+from harness.judge.answers import Answers, Received
+from harness.judge.oracle import Oracle, summarise_scan
+from harness.lidar.scan import Scan
+from harness.lidar.spec import PRESETS
 
 N = 360
 INC = 2 * math.pi / (N - 1)  # the gazebo preset: -pi..pi inclusive
@@ -436,7 +436,7 @@ def test_a_huge_claimed_distance_is_judged_without_numeric_warnings() -> None:
     """A claim beyond float32 (1e300 m) is simply wrong: no overflow on the way."""
     import warnings
 
-    from harness.oracle import _distance_hint
+    from harness.judge.oracle import _distance_hint
 
     scan = Scan(0.0, 1.0, 0.5, 0.0, 0.1, 0.12, 12.0, np.array([0.05, 1.0, 20.0], np.float32))
     with warnings.catch_warnings():

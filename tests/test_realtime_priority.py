@@ -1,4 +1,4 @@
-"""harness.realtime_priority: SCHED_FIFO for the calling thread only, or a plain False."""
+"""serial_line.realtime_priority: SCHED_FIFO for the calling thread only, or a plain False."""
 
 from __future__ import annotations
 
@@ -7,7 +7,7 @@ import threading
 
 import pytest
 
-from harness import realtime_priority
+from harness.serial_line import realtime_priority
 
 
 def test_only_the_calling_thread_is_raised() -> None:

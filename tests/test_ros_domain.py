@@ -16,7 +16,7 @@ import pytest
 
 from harness.errors import ConfigError
 from harness.holder_lock import held_here, take
-from harness.ros_domain import lock_file, reserve_domain
+from harness.ros.domain import lock_file, reserve_domain
 
 pytestmark = pytest.mark.timeout(30)
 
@@ -53,7 +53,7 @@ def children() -> Iterator[list[subprocess.Popen[str]]]:
 
 EXPLICIT = """
 import sys
-from harness.ros_domain import reserve_domain
+from harness.ros.domain import reserve_domain
 reservation = reserve_domain(int(sys.argv[1]))
 print("held", flush=True)
 sys.stdin.readline()
@@ -80,7 +80,7 @@ def test_an_explicit_id_another_run_holds_is_refused_naming_it(
 
 AUTOMATIC_SKIPS_EXPLICIT = """
 import sys
-import harness.ros_domain as domains
+import harness.ros.domain as domains
 from harness.errors import LinkError
 explicit = int(sys.argv[1])
 held = domains.reserve_domain(explicit)
@@ -122,7 +122,7 @@ def test_an_explicit_id_is_free_again_once_its_run_lets_go() -> None:
 
 JOIN = """
 import sys
-from harness.ros_domain import reserve_domain
+from harness.ros.domain import reserve_domain
 print(reserve_domain(int(sys.argv[1])).domain_id, flush=True)
 """
 

@@ -1,4 +1,4 @@
-"""ROS 2 names (harness.ros_names): the pure rules agree with rclpy's, and the harness's policy.
+"""ROS 2 names (harness.ros.names): the pure rules agree with rclpy's, and the harness's policy.
 
 The pure-Python rules decide where rclpy is not installed; where it is,
 rclpy is asked too. The property tests below generate names that are
@@ -15,8 +15,8 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from harness import ros_names
-from harness.ros_names import (
+from harness.ros import names as ros_names
+from harness.ros.names import (
     InvalidName,
     check_parameter_name,
     check_parameter_rule,

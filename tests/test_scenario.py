@@ -8,7 +8,7 @@ from pathlib import Path
 import pytest
 
 from harness.errors import ConfigError
-from harness.scenario import load_scenario_file, resolve_scenario, shipped_scenarios
+from harness.scenario.files import load_scenario_file, resolve_scenario, shipped_scenarios
 
 GOOD = """\
 description: A wall ahead.

@@ -8,7 +8,7 @@ import re
 import pytest
 
 from harness.errors import ConfigError
-from harness.status import find_numbers, half_unit, parse_status
+from harness.judge.status import find_numbers, half_unit, parse_status
 
 INF, NAN = math.inf, math.nan
 NONE = (False, None, None)

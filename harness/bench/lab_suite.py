@@ -27,8 +27,8 @@ from harness.bench.stage import StageResult
 from harness.bench.workload import Workload
 from harness.errors import HarnessError
 from harness.links.base import LinkOptions
-from harness.runner import run_suite
-from harness.scenario import shipped_scenarios
+from harness.runner.suite import run_suite
+from harness.scenario.files import shipped_scenarios
 
 CLI_TIMEOUT_S = 120.0
 

@@ -6,7 +6,7 @@ SECONDS pass, recording the monotonic time and size of every read. Prints
 one JSON object: ``{"reads": [[t, n], ...], "data": "<hex>", "realtime": bool}``.
 A separate process, as the board's driver is: the harness's threads (and its
 GIL) do not delay the reads it times. Where the system allows it, the
-reader runs under SCHED_FIFO (``harness.realtime_priority``), as a board's
+reader runs under SCHED_FIFO (``harness.serial_line.realtime_priority``), as a board's
 UART interrupt would: then its read times are the line's, not the moments
 the scheduler got round to waking it; ``realtime`` says whether it did.
 Standard library only, so it starts fast.
@@ -20,7 +20,7 @@ import select
 import sys
 import time
 
-from harness.realtime_priority import raise_to_realtime
+from harness.serial_line.realtime_priority import raise_to_realtime
 
 SCAN_REQUEST = bytes((0xA5, 0x20))
 POLL_S = 0.05

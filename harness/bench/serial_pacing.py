@@ -38,8 +38,8 @@ from harness.bench.stats import (
     rplidar_revolution_starts,
 )
 from harness.errors import LinkError
-from harness.runner import RunSettings, fault_profile
-from harness.scenario import Scenario
+from harness.runner.settings import RunSettings, fault_profile
+from harness.scenario.schema import Scenario
 
 if TYPE_CHECKING:
     from harness.devices.revolution import Sample

@@ -12,9 +12,9 @@ from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 
 from harness.bench.workload import Workload, prepared_frames
+from harness.judge.records import RunResult, TickRecord
 from harness.links.base import Link
-from harness.runner import Frame, judge_frames
-from harness.trace import RunResult, TickRecord
+from harness.runner.frames import Frame, judge_frames
 
 
 @dataclass

@@ -18,10 +18,12 @@ from typing import TYPE_CHECKING, TypeVar
 import numpy as np
 
 from harness.errors import ConfigError
-from harness.faults import FaultProfile
-from harness.oracle import Oracle
-from harness.runner import Frame, RunSettings, effective_threshold, fault_profile
-from harness.scenario import Scenario, resolve_scenario
+from harness.faults.sensor import FaultProfile
+from harness.judge.oracle import Oracle
+from harness.runner.frames import Frame
+from harness.runner.settings import RunSettings, effective_threshold, fault_profile
+from harness.scenario.files import resolve_scenario
+from harness.scenario.schema import Scenario
 
 if TYPE_CHECKING:
     from harness.sim.simulation import Simulation

@@ -4,7 +4,7 @@ Every type turns bad input into a one-line argparse error (exit 2). The
 checks that look at several options at once (a topic used twice, a
 parameter that would set the threshold behind the oracle's back) are
 `checked_node_options`, which the pytest plugin calls too; the rules for
-ROS 2 names themselves live in harness.ros_names.
+ROS 2 names themselves live in harness.ros.names.
 """
 
 from __future__ import annotations
@@ -19,7 +19,7 @@ from dataclasses import replace
 
 from harness.errors import ConfigError
 from harness.links.base import LinkOptions, known_links
-from harness.ros_names import (
+from harness.ros.names import (
     InvalidName,
     check_parameter_name,
     check_parameter_rule,
@@ -78,7 +78,7 @@ def domain_id(text: str) -> int:
 
 
 def param(text: str) -> str:
-    """NAME:=VALUE that ROS 2 itself can parse (harness.ros_names has the rules).
+    """NAME:=VALUE that ROS 2 itself can parse (harness.ros.names has the rules).
 
     A rule rcl cannot parse would stop the node before it starts; better a
     usage error now than a failed run.
@@ -121,7 +121,7 @@ def check_port(option: str, path: str) -> None:
 
 def fault_list(text: str | None) -> list[str] | None:
     """`--faults a,b` as a list; None keeps the scenarios' own."""
-    from harness.faults import split_fault_text
+    from harness.faults.sensor import split_fault_text
 
     return split_fault_text(text) if text else None
 
@@ -314,7 +314,7 @@ def check_link_options(args: argparse.Namespace) -> LinkOptions:
 def check_status_regex(args: argparse.Namespace) -> None:
     """A bad regex is a usage error now, not a failure on every tick."""
     if args.status_regex:
-        from harness.status import parse_status
+        from harness.judge.status import parse_status
 
         parse_status("", args.status_regex)
 

@@ -28,9 +28,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace, console: Console) -> int:
     from harness.devices.profiles import profile
-    from harness.emulate import emulate
-    from harness.runner import RunSettings
-    from harness.scenario import resolve_scenario
+    from harness.runner.emulate import emulate
+    from harness.runner.settings import RunSettings
+    from harness.scenario.files import resolve_scenario
 
     if args.port is not None:
         check_port("--port", args.port)

@@ -34,7 +34,7 @@ from harness.holder_lock import HolderLock
 from harness.report.folder_lock import lock_folder
 
 if TYPE_CHECKING:  # imported when grading starts (the parser is built for any command)
-    from harness.scenario import Scenario
+    from harness.scenario.schema import Scenario
 
 NAME = "grade"
 HELP = "build and test every student's node in DIR; write the class table (CSV, HTML)"
@@ -137,7 +137,7 @@ def check_grading_options(args: argparse.Namespace) -> None:
 
 def selected_scenarios(items: list[str]) -> list[Scenario]:
     """`--scenario` items (comma lists allowed), all resolved now; default every shipped one."""
-    from harness.scenario import resolve_scenario, shipped_scenarios
+    from harness.scenario.files import resolve_scenario, shipped_scenarios
 
     names = [n.strip() for item in items for n in item.split(",") if n.strip()]
     scenarios = [resolve_scenario(n) for n in names] if names else shipped_scenarios()
@@ -200,12 +200,12 @@ def _progress(console: Console, student: Student, grade: object) -> None:
 
 
 def run(args: argparse.Namespace, console: Console) -> int:
+    from harness.atomic_write import write_atomically
     from harness.grading.build import colcon_executable
     from harness.grading.class_table import class_csv, class_html, class_rich_table
     from harness.grading.discover import discover
     from harness.grading.grade import GradeConfig, grade_class
-    from harness.report.files import write_atomically
-    from harness.runner import RunSettings, check_settings
+    from harness.runner.settings import RunSettings, check_settings
 
     check_grading_options(args)
     options = link_options(args)  # topics and parameters: refused now, before any folder

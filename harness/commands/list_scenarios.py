@@ -16,7 +16,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace, console: Console) -> int:
     from harness.report.terminal import scenario_table
-    from harness.scenario import shipped_scenarios
+    from harness.scenario.files import shipped_scenarios
 
     console.print(scenario_table(shipped_scenarios()))
     return 0

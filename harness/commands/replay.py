@@ -23,7 +23,7 @@ from harness.commands.arguments import (
 from harness.errors import ConfigError, Interrupted
 
 if TYPE_CHECKING:  # numpy comes with it: not needed to build the parser
-    from harness.link_faults import LinkFaults
+    from harness.faults.link import LinkFaults
 
 NAME = "replay"
 HELP = "re-inject a recorded /scan stream (ours or a robot's rosbag2) and judge the node"
@@ -63,8 +63,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def replay_link_faults(text: str | None) -> LinkFaults:
     """--faults for a replay: link faults only, and no re-timing of recorded scans."""
-    from harness.faults import build_profile
-    from harness.link_faults import NO_LINK_FAULTS
+    from harness.faults.link import NO_LINK_FAULTS
+    from harness.faults.sensor import build_profile
 
     items = fault_list(text)
     if not items:
@@ -85,8 +85,8 @@ def replay_link_faults(text: str | None) -> LinkFaults:
 
 def run(args: argparse.Namespace, console: Console) -> int:
     from harness.record import read_scans
-    from harness.replay import replay
     from harness.report.terminal import print_results
+    from harness.runner.replay import replay
 
     options = check_link_options(args)
     check_status_regex(args)

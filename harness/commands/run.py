@@ -24,10 +24,10 @@ from harness.commands.arguments import (
 from harness.errors import ConfigError, Interrupted
 
 if TYPE_CHECKING:  # the rest is imported when a run starts (the parser is built for any command)
+    from harness.judge.records import RunResult
     from harness.report.outputs import ReportFolder
-    from harness.runner import RunSettings
-    from harness.scenario import Scenario
-    from harness.trace import RunResult
+    from harness.runner.settings import RunSettings
+    from harness.scenario.schema import Scenario
 
 T = TypeVar("T")
 
@@ -62,14 +62,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def selected(names: Sequence[str]) -> list[Scenario]:
     """The named scenarios (all resolved before anything runs), or every shipped one."""
-    from harness.scenario import resolve_scenario, shipped_scenarios
+    from harness.scenario.files import resolve_scenario, shipped_scenarios
 
     return [resolve_scenario(n) for n in names] if names else shipped_scenarios()
 
 
 def settings_from(args: argparse.Namespace) -> RunSettings:
     """The per-run overrides given on the command line."""
-    from harness.runner import RunSettings
+    from harness.runner.settings import RunSettings
 
     return RunSettings(
         seed=args.seed,
@@ -93,7 +93,7 @@ def open_report(out: str | None) -> ReportFolder | None:
 
 
 def run(args: argparse.Namespace, console: Console) -> int:
-    from harness.node_forkserver import scope
+    from harness.nodes.forkserver import scope
 
     with scope():  # whatever prepare() starts stops with the command
         return _run(args, console)
@@ -113,7 +113,8 @@ def _run(args: argparse.Namespace, console: Console) -> int:
     scenarios = selected(args.scenarios)
     check_output_file("--junit-xml", args.junit_xml)
     check_status_regex(args)
-    from harness.runner import check_settings, run_suite
+    from harness.runner.settings import check_settings
+    from harness.runner.suite import run_suite
 
     check_settings(scenarios, settings_from(args))
     report = open_report(args.out)

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from harness.scan import Scan
+from harness.lidar.scan import Scan
 
 # The quality the vendor SDK gives every express-scan sample (0x2F): a
 # plausible mid-range RPLIDAR quality for returns. LD devices want a higher

@@ -21,15 +21,15 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
+from harness.atomic_write import write_atomically
 from harness.grading.build import build_student
 from harness.grading.class_table import ERROR, NOT_RUN, PASS, StudentGrade
 from harness.grading.discover import Student
 from harness.grading.process import Finished, run_bounded
 from harness.grading.worker import write_job
+from harness.judge.records import RunResult
 from harness.links.base import LinkOptions
-from harness.report.files import write_atomically
-from harness.runner import RunSettings
-from harness.trace import RunResult
+from harness.runner.settings import RunSettings
 
 __all__ = ["GradeConfig", "grade_class", "grade_student"]
 

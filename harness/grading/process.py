@@ -25,7 +25,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
-from harness.process_group import signal_group, wait_group_gone
+from harness.nodes.process_group import signal_group, wait_group_gone
 
 __all__ = ["Finished", "run_bounded"]
 

@@ -18,10 +18,10 @@ from dataclasses import asdict, fields
 from pathlib import Path
 from typing import Any
 
+from harness.atomic_write import write_atomically
 from harness.errors import ConfigError
-from harness.report.files import write_atomically
+from harness.judge.records import RunResult
 from harness.report.summary import verdict_of
-from harness.trace import RunResult
 
 __all__ = ["result_entry", "write_job"]
 
@@ -79,7 +79,7 @@ def _options(data: dict[str, Any]) -> Any:
 
 
 def _settings(data: dict[str, Any]) -> Any:
-    from harness.runner import RunSettings
+    from harness.runner.settings import RunSettings
 
     known = {f.name for f in fields(RunSettings)}
     return RunSettings(**{k: v for k, v in data.items() if k in known})
@@ -91,8 +91,8 @@ def run_job(job: dict[str, Any]) -> int:
 
     from harness.report.junit import write_junit
     from harness.report.terminal import print_results
-    from harness.runner import run_suite
-    from harness.scenario import resolve_scenario
+    from harness.runner.suite import run_suite
+    from harness.scenario.files import resolve_scenario
 
     results_path = Path(job["results"])
     entries: list[dict[str, Any]] = []

@@ -13,9 +13,9 @@ from typing import TYPE_CHECKING, ClassVar, TypeVar
 from harness.errors import ConfigError
 
 if TYPE_CHECKING:  # naming the links and their options needs none of these (nor numpy)
-    from harness.answers import Answers, Received
-    from harness.link_faults import LineDamage
-    from harness.scan import Scan
+    from harness.faults.link import LineDamage
+    from harness.judge.answers import Answers, Received
+    from harness.lidar.scan import Scan
 
 
 @dataclass(frozen=True)
@@ -148,11 +148,17 @@ def _where(cls: type[Link]) -> str:
     return f"{cls.__module__}.{cls.__qualname__}"
 
 
+# Modules of this package that are not links themselves: the contract, and
+# what several links share.
+HELPER_MODULES = ("base", "board", "processor_child")
+
+
 def known_links() -> list[str]:
     """Names of the link modules shipped in this package."""
     import harness.links as package
 
-    return sorted(m.name for m in pkgutil.iter_modules(package.__path__) if m.name not in ("base",))
+    found = pkgutil.iter_modules(package.__path__)
+    return sorted(m.name for m in found if m.name not in HELPER_MODULES)
 
 
 def create_link(name: str, options: LinkOptions) -> Link:

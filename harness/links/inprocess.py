@@ -13,11 +13,11 @@ import importlib.util
 from collections.abc import Callable
 from pathlib import Path
 
-from harness.answers import Answers, Received
 from harness.errors import ConfigError
+from harness.judge.answers import Answers, Received
+from harness.lidar.scan import Scan
 from harness.links.base import Link, LinkOptions, register
-from harness.processor_child import ProcessorChild
-from harness.scan import Scan
+from harness.links.processor_child import ProcessorChild
 
 DIAGNOSTIC_LINES = 14  # with the heading, what the terminal summary shows
 
@@ -63,7 +63,7 @@ class InprocessLink(Link):
     """Feed each scan to a Python function: no ROS, and nothing it does can end the harness.
 
     The function runs in a child forked when the link opens (see
-    ``harness.processor_child``): the scan goes out on `send`, the runner
+    ``harness.links.processor_child``): the scan goes out on `send`, the runner
     simulates the next one meanwhile, and `collect` waits for the answer
     within the per-scan deadline. Raising, exiting, hanging or crashing is
     a problem that ends the run as an ERROR at that tick, never a pass.

@@ -29,20 +29,19 @@ from collections import deque
 from collections.abc import Callable, Iterable
 from typing import TYPE_CHECKING
 
-from harness.answers import Answers, Received
 from harness.errors import ConfigError, LinkError
+from harness.judge.answers import Answers, Received
+from harness.lidar.scan import Scan
 from harness.links.base import Link, LinkOptions, register
-from harness.node_process import (
+from harness.nodes.command import (
     NodeCommand,
-    NodeProcess,
     package_node,
-    prepare_start,
     reference_node,
     ros_arguments,
     shell_node,
 )
-from harness.ros_domain import DomainReservation, discovery_environment, reserve_domain
-from harness.scan import Scan
+from harness.nodes.process import NodeProcess, prepare_start
+from harness.ros.domain import DomainReservation, discovery_environment, reserve_domain
 
 if TYPE_CHECKING:  # rclpy is imported when the first link starts, after its node
     from harness.ros.observer import Heard, Observer

@@ -2,9 +2,9 @@
 
 from __future__ import annotations
 
-from harness.board_link import BoardLink
 from harness.devices.profiles import PROFILES
 from harness.links.base import register
+from harness.links.board import BoardLink
 
 
 @register("rplidar")

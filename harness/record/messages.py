@@ -13,8 +13,8 @@ from typing import Any
 from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 from rosbags.typesys.store import Typestore
 
-from harness.oracle import Verdict
-from harness.scan import Scan
+from harness.judge.oracle import Verdict
+from harness.lidar.scan import Scan
 
 LASER_SCAN = "sensor_msgs/msg/LaserScan"
 CLOCK = "rosgraph_msgs/msg/Clock"

@@ -10,9 +10,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from harness.errors import ConfigError
+from harness.lidar.scan import Scan
 from harness.record import messages as msg
 from harness.record.writer import METADATA_NAME, RecordTopics
-from harness.scan import Scan
 
 
 @dataclass(frozen=True)

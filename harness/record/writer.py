@@ -18,9 +18,9 @@ from typing import Any
 from mcap.writer import CompressionType, Writer
 
 from harness import __version__
+from harness.atomic_write import write_atomically
+from harness.judge.records import RunResult, TickRecord
 from harness.record import messages as msg
-from harness.report.files import write_atomically
-from harness.trace import RunResult, TickRecord
 
 METADATA_NAME = "fossbot_hil_run"
 

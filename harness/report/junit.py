@@ -18,10 +18,10 @@ import xml.etree.ElementTree as ET
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
-from harness.report.files import relative_path, write_atomically
+from harness.atomic_write import relative_path, write_atomically
+from harness.judge.records import RunResult
 from harness.report.summary import verdict_of
 from harness.safe_text import DIAGNOSTICS_LIMIT, TEXT_LIMIT, clip, for_xml
-from harness.trace import RunResult
 
 MAX_LISTED_FAILURES = 50
 

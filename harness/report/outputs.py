@@ -22,12 +22,12 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
+from harness.atomic_write import fill_atomically, relative_path, write_atomically
 from harness.errors import ConfigError
-from harness.report.files import fill_atomically, relative_path, write_atomically
+from harness.judge.records import RunResult
 from harness.report.folder_lock import lock_folder
 from harness.report.summary import json_bytes, run_summary, scenario_details, scenario_entry
 from harness.safe_text import DIAGNOSTICS_LIMIT, for_storage
-from harness.trace import RunResult
 
 __all__ = [
     "ArtifactWriter",

@@ -15,10 +15,10 @@ from pathlib import Path
 
 import numpy as np
 
-from harness.report.files import write_atomically
+from harness.atomic_write import write_atomically
+from harness.judge.records import RunResult
 from harness.report.summary import verdict_of
 from harness.safe_text import visible
-from harness.trace import RunResult
 
 __all__ = ["PlotSeries", "plot_series", "render_plot", "write_plot"]
 

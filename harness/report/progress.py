@@ -22,8 +22,8 @@ from rich.progress import (
     TimeElapsedColumn,
 )
 
+from harness.judge.records import RunResult, TickRecord
 from harness.safe_text import clip, for_terminal
-from harness.trace import RunResult, TickRecord
 
 __all__ = ["RunProgress"]
 

@@ -14,7 +14,7 @@ from collections.abc import Mapping, Sequence
 from typing import Any
 
 from harness import __version__
-from harness.trace import RunResult, TickRecord
+from harness.judge.records import RunResult, TickRecord
 
 __all__ = [
     "FORMAT",

@@ -13,10 +13,10 @@ from rich.console import Console
 from rich.table import Table
 from rich.text import Text
 
+from harness.judge.records import RunResult
 from harness.report.summary import verdict_of
 from harness.safe_text import DIAGNOSTICS_LIMIT, TEXT_LIMIT, clip, for_terminal
-from harness.scenario import Scenario
-from harness.trace import RunResult
+from harness.scenario.schema import Scenario
 
 DIAGNOSTIC_LINES = 15
 VERDICT_STYLES = {"PASS": "green", "FAIL": "red", "ERROR": "red", "NOT RUN": "yellow"}

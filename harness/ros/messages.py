@@ -9,7 +9,7 @@ from builtin_interfaces.msg import Time
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import LaserScan
 
-from harness.scan import Scan
+from harness.lidar.scan import Scan
 
 
 def stamp(seconds: float) -> Time:

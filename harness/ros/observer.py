@@ -30,9 +30,9 @@ from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import LaserScan
 from std_msgs.msg import Bool, String
 
+from harness.lidar.scan import Scan
+from harness.ros.domain import discovery_environment
 from harness.ros.messages import clock_message, scan_from_message, scan_message
-from harness.ros_domain import discovery_environment
-from harness.scan import Scan
 
 QOS = QoSProfile(depth=50, reliability=ReliabilityPolicy.RELIABLE)
 INBOX_LIMIT = 10_000  # messages kept between two collects: more is a flood, not answers

@@ -61,9 +61,9 @@ from dataclasses import dataclass
 from typing import Any, Literal
 
 from harness.errors import LinkError
-from harness.realtime_priority import raise_to_realtime
 from harness.serial_line.pacing import LinePacer, PacingReport
 from harness.serial_line.ports import DevicePort
+from harness.serial_line.realtime_priority import raise_to_realtime
 
 Mode = Literal["lockstep", "realtime"]
 NextStart = Literal["extra", "replace"]
@@ -168,7 +168,7 @@ class DeviceServer:
         self.request_gap_s = request_gap_s  # line quiet this long: a partial request is dropped
         self.poll_s = poll_s
         self._unit_override = unit_samples
-        self.damage: Any = None  # a harness.link_faults.LineDamage, set before the run starts
+        self.damage: Any = None  # a harness.faults.link.LineDamage, set before the run starts
         self._encode = self._encoder(device)
         self._ld_style = "start_ms" in self._encode_params
         self.pacer = LinePacer(baudrate, bits_per_byte) if mode == "realtime" else None

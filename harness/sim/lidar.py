@@ -17,7 +17,7 @@ import math
 
 import numpy as np
 
-from harness.lidar_spec import LidarSpec
+from harness.lidar.spec import LidarSpec
 from harness.sim.bullet import pb
 from harness.sim.world import RAY_MASK, World, link_frame_pose
 

@@ -23,12 +23,10 @@ from typing import NamedTuple, Protocol
 import numpy as np
 
 from harness.errors import ConfigError
-from harness.lidar_spec import LidarSpec
-from harness.messages import shown
-from harness.scenario import WHEEL_JOINTS, Motion, Segment
+from harness.safe_text import shown
+from harness.scenario.schema import WHEEL_JOINTS, Motion, Segment
 
 EPS_TIME = 1e-9  # s; segment ends closer than this to a step boundary fall on it
-AHEAD_HALF_WIDTH = math.radians(10.0)  # obstacle_ahead_* look within +-10 deg of +x
 WHEEL_MAX_TORQUE = 0.5  # N m per wheel motor in wheels mode
 SETTLE_STEPS = 24  # physics steps (0.1 s) the robot rests on its wheels before t = 0
 
@@ -96,13 +94,6 @@ def wheel_speeds(linear: float, angular: float, radius: float, track: float) -> 
         (linear - angular * track / 2.0) / radius,
         (linear + angular * track / 2.0) / radius,
     )
-
-
-def ahead_mask(spec: LidarSpec, half_width: float = AHEAD_HALF_WIDTH) -> np.ndarray:
-    """Beams within +-half_width of the LIDAR's forward axis (any angle_min)."""
-    angles = spec.angle_min + np.arange(spec.samples) * spec.angle_increment
-    wrapped = np.remainder(angles + np.pi, 2.0 * np.pi) - np.pi
-    return np.abs(wrapped) <= half_width + 1e-9
 
 
 def nearest_ahead(truth: np.ndarray, mask: np.ndarray) -> float:

@@ -13,17 +13,11 @@ from types import TracebackType
 
 import numpy as np
 
-from harness.lidar_spec import LidarSpec
-from harness.scenario import Scenario
+from harness.lidar.spec import LidarSpec
+from harness.scenario.ahead import ahead_mask
+from harness.scenario.schema import Scenario
 from harness.sim.lidar import LidarModel
-from harness.sim.motion import (
-    KinematicDriver,
-    MotionScript,
-    Pose,
-    WheelDriver,
-    ahead_mask,
-    nearest_ahead,
-)
+from harness.sim.motion import KinematicDriver, MotionScript, Pose, WheelDriver, nearest_ahead
 from harness.sim.world import TIME_STEP, World
 
 

@@ -24,12 +24,12 @@ from types import TracebackType
 import numpy as np
 
 from harness.errors import ConfigError
-from harness.messages import shown
-from harness.model_files import check_model_file, find_model_file, robot_models_dir
-from harness.scenario import Box, Cylinder, Model, Scenario, Wall
+from harness.safe_text import shown
+from harness.scenario.geometry import cylinder_segments
+from harness.scenario.model_files import check_model_file, find_model_file, robot_models_dir
+from harness.scenario.schema import Box, Cylinder, Model, Scenario, Wall
 from harness.sim import bullet
 from harness.sim.bullet import pb
-from harness.sim.geometry import cylinder_segments
 from harness.sim.motion import WheelGeometry
 
 TIME_STEP = 1.0 / 240.0  # s; the only physics step the harness uses
@@ -200,7 +200,7 @@ class World:
     def _loading(self, field: str, ref: str) -> Iterator[None]:
         """Run a PyBullet loader with its chatter captured; its failures become ConfigErrors.
 
-        The file was checked (``harness.model_files``) before, so this only
+        The file was checked (``harness.scenario.model_files``) before, so this only
         catches what PyBullet still refuses: a mesh it cannot read, say.
         """
         prefix = f"{self.where}: {field}: cannot load {ref!r}: PyBullet"
@@ -238,7 +238,7 @@ class World:
 
         The rules (relative paths that stay inside the folder they are found
         in; files PyBullet can load without crashing) are
-        ``harness.model_files``'s.
+        ``harness.scenario.model_files``'s.
         """
         what = f"{self.where}: {field}: cannot load {ref!r}"
         model = find_model_file(ref, [self.scenario.base_dir, robot_models_dir()], what=what)

@@ -11,7 +11,7 @@ from ld_crc_reference import ld_crc8_bitwise
 
 from harness.devices import ldlidar as ld
 from harness.devices.revolution import Sample, samples_from_scan
-from harness.scan import Scan
+from harness.lidar.scan import Scan
 
 # The example packet of the LD19 development manual (CRC 0x50).
 MANUAL_PACKET = bytes.fromhex(

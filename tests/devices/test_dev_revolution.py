@@ -11,8 +11,8 @@ from hypothesis import strategies as st
 from hypothesis.extra import numpy as hnp
 
 from harness.devices.revolution import Sample, device_angle_deg, samples_from_scan
-from harness.lidar_spec import PRESETS
-from harness.scan import Scan
+from harness.lidar.scan import Scan
+from harness.lidar.spec import PRESETS
 
 
 def scan_of(ranges, *, angle_min=0.0, increment=None, range_min=0.15, range_max=12.0) -> Scan:

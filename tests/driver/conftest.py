@@ -20,7 +20,7 @@ from typing import Any
 
 import pytest
 
-from harness.ros_domain import reserve_domain
+from harness.ros.domain import reserve_domain
 
 pytest.register_assert_rewrite("child_process", "colcon_workspace", "driver_checks")
 

@@ -10,7 +10,7 @@ import pytest
 from harness.grading.grade import GradeConfig, verdicts_from
 from harness.grading.process import Finished
 from harness.links.base import LinkOptions
-from harness.runner import RunSettings
+from harness.runner.settings import RunSettings
 
 SCENARIOS = ("approach_wall", "drive_past_10m", "out_of_range")
 FOLDER = Path("/grades/students/ana")

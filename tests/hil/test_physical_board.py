@@ -10,8 +10,8 @@ from __future__ import annotations
 
 import pytest
 
-from harness.plugin import HilBoard, HilCase
-from harness.pytest_run import Hil
+from harness.pytest_plugin.hil import Hil
+from harness.pytest_plugin.plugin import HilBoard, HilCase
 
 pytestmark = [pytest.mark.hil, pytest.mark.ros, pytest.mark.timeout(900)]
 

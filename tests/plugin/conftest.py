@@ -11,9 +11,9 @@ from __future__ import annotations
 import contextlib
 
 import harness.commands.arguments  # noqa: F401 - numpy, through the links
-import harness.faults  # noqa: F401
-import harness.runner  # noqa: F401
-import harness.scenario  # noqa: F401
+import harness.faults.sensor  # noqa: F401
+import harness.runner.suite  # noqa: F401
+import harness.scenario.files  # noqa: F401
 
 with contextlib.suppress(ImportError):
     import hypothesis  # noqa: F401

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from harness.scenario import shipped_scenarios
+from harness.scenario.files import shipped_scenarios
 
 pytest_plugins = ["pytester"]
 pytestmark = pytest.mark.timeout(60)

@@ -65,7 +65,7 @@ def test_relative_topics_resolve_and_no_threshold_param_frees_the_name(
 ) -> None:
     """`scan` is `/scan`; with threshold_param=None the node's threshold is the user's."""
     pytester.makepyfile(
-        "from harness.pytest_run import Hil\n"
+        "from harness.pytest_plugin.hil import Hil\n"
         "def test_ok(hil):\n"
         "    options = hil._checked('approach_wall', None, None, None, 'inprocess', None,\n"
         "        {'scan_topic': 'robot/scan', 'threshold_param': None,\n"

@@ -110,7 +110,7 @@ def test_a_conftest_overrides_the_node_fixture(pytester: pytest.Pytester) -> Non
     pytester.makeconftest(
         """
         import pytest
-        from harness.plugin import NodeUnderTest
+        from harness.pytest_plugin.plugin import NodeUnderTest
 
         @pytest.fixture
         def hil_node():
@@ -187,7 +187,7 @@ def test_the_plugin_loads_no_ros_simulator_or_numpy(pytester: pytest.Pytester) -
         import sys
 
         def test_modules():
-            assert "harness.plugin" in sys.modules
+            assert "harness.pytest_plugin.plugin" in sys.modules
             heavy = [m for m in ("rclpy", "pybullet", "numpy") if m in sys.modules]
             assert heavy == []
         """

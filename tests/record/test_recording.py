@@ -12,11 +12,11 @@ import pytest
 from mcap.reader import make_reader
 from mcap_ros2.decoder import DecoderFactory
 
+from harness.judge.records import RunResult
 from harness.links.base import LinkOptions
 from harness.record import read_scans, write_recording
-from harness.runner import run
-from harness.scenario import resolve_scenario
-from harness.trace import RunResult
+from harness.runner.scenario_run import run
+from harness.scenario.files import resolve_scenario
 
 STUDENTS = Path(__file__).parents[1] / "student_functions.py"
 PROCESSOR = f"{STUDENTS}:min_over_raw_ranges"

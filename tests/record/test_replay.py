@@ -10,12 +10,12 @@ import numpy as np
 import pytest
 from command_line import fossbot_hil
 
+from harness.judge.records import RunResult
 from harness.links.base import LinkOptions
 from harness.record import read_scans, write_recording
-from harness.replay import replay
-from harness.runner import run
-from harness.scenario import resolve_scenario
-from harness.trace import RunResult
+from harness.runner.replay import replay
+from harness.runner.scenario_run import run
+from harness.scenario.files import resolve_scenario
 
 TESTS = Path(__file__).parents[1]
 STUDENTS = TESTS / "student_functions.py"

@@ -6,10 +6,10 @@ from pathlib import Path
 
 import pytest
 
+from harness.judge.records import RunResult
 from harness.links.base import LinkOptions
-from harness.runner import run_suite
-from harness.scenario import resolve_scenario
-from harness.trace import RunResult
+from harness.runner.suite import run_suite
+from harness.scenario.files import resolve_scenario
 
 STUDENTS = Path(__file__).parents[1] / "student_functions.py"
 

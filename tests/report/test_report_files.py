@@ -11,10 +11,10 @@ from pathlib import Path
 
 import pytest
 
-from harness.report.files import write_atomically
+from harness.atomic_write import write_atomically
+from harness.judge.records import RunResult
 from harness.report.junit import write_junit
 from harness.report.outputs import write_report
-from harness.trace import RunResult
 
 
 def modes(folder: Path) -> dict[str, int]:
@@ -82,7 +82,7 @@ def test_stale_temporary_files_are_removed_by_the_next_write(tmp_path: Path) -> 
 
 WRITER = """
 import os, sys, time
-from harness.report.files import write_atomically
+from harness.atomic_write import write_atomically
 
 def stuck(handle):  # the data is written; the writer is killed before it is renamed
     print("writing", flush=True)

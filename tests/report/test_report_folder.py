@@ -11,10 +11,10 @@ from pathlib import Path
 import pytest
 
 from harness.errors import ConfigError
+from harness.judge.records import RunResult
 from harness.record import read_scans
 from harness.report.junit import write_junit
 from harness.report.outputs import ArtifactWriter, ReportFolder, artifact_writers, write_report
-from harness.trace import RunResult
 
 HOSTILE = '<script>alert("x")</script> & <b>co</b>'
 

@@ -9,11 +9,11 @@ from dataclasses import replace
 
 import numpy as np
 
-from harness.answers import Answers, Received
-from harness.oracle import Oracle
+from harness.judge.answers import Answers, Received
+from harness.judge.oracle import Oracle
+from harness.judge.records import RunResult, TickRecord
+from harness.lidar.scan import Scan
 from harness.report.plot import FAILED_COLOUR, plot_series, render_plot, write_plot
-from harness.scan import Scan
-from harness.trace import RunResult, TickRecord
 
 
 def _scan(ranges: list[float]) -> Scan:

@@ -8,8 +8,8 @@ from rich.console import Console
 
 from harness.links.base import LinkOptions
 from harness.report.progress import RunProgress
-from harness.runner import run_suite
-from harness.scenario import resolve_scenario
+from harness.runner.suite import run_suite
+from harness.scenario.files import resolve_scenario
 
 NAMES = ("approach_wall", "obstacle_at_side")
 

@@ -28,19 +28,19 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from rich.console import Console
 
-from harness.answers import Answers, Received
 from harness.cli import _print_error
 from harness.grading.class_table import StudentGrade, class_csv, class_html, class_rich_table
-from harness.oracle import Oracle
-from harness.pytest_result import HilResult
+from harness.judge.answers import Answers, Received
+from harness.judge.oracle import Oracle
+from harness.judge.records import RunResult, TickRecord
+from harness.lidar.scan import Scan
+from harness.pytest_plugin.result import HilResult
 from harness.report.html import index_html
 from harness.report.junit import junit_xml
 from harness.report.outputs import stored
 from harness.report.summary import json_bytes, run_summary, scenario_details, scenario_entry
 from harness.report.terminal import print_results
 from harness.safe_text import TEXT_LIMIT
-from harness.scan import Scan
-from harness.trace import RunResult, TickRecord
 
 ROS_TESTS = Path(__file__).parents[1] / "ros"
 HOSTILE = ROS_TESTS / "hostile_node.py"

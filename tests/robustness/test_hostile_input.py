@@ -25,7 +25,7 @@ from hostile_checks import (
     run_in_process,
 )
 
-from harness.model_files import robot_models_dir
+from harness.scenario.model_files import robot_models_dir
 
 pytestmark = pytest.mark.timeout(90)
 

@@ -1,7 +1,7 @@
 """Whatever a processing function does, the inprocess link gives a true verdict.
 
 The function runs in a forked child with a deadline per call
-(`harness.processor_child`): exiting, raising a BaseException, hanging,
+(`harness.links.processor_child`): exiting, raising a BaseException, hanging,
 crashing or rewriting the scan ends as an ERROR or FAIL verdict naming the
 scenario and tick, never as the harness's exit code 0, a hang, or a pass.
 """
@@ -20,8 +20,8 @@ import pytest
 from hostile_checks import COMMAND, marked_processes, run_command
 
 from harness.links import LinkOptions
-from harness.runner import run
-from harness.scenario import resolve_scenario
+from harness.runner.scenario_run import run
+from harness.scenario.files import resolve_scenario
 
 HOSTILE = Path(__file__).with_name("hostile_processors.py")
 

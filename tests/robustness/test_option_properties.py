@@ -32,7 +32,7 @@ from hypothesis import strategies as st
 from mcap.reader import make_reader
 from mcap_ros2.decoder import DecoderFactory
 
-from harness.report.files import TEMPORARY_NAME
+from harness.atomic_write import TEMPORARY_NAME
 from harness.report.folder_lock import LOCK_NAME
 
 pytestmark = pytest.mark.timeout(300)

@@ -25,7 +25,7 @@ from hypothesis import strategies as st
 from mcap.reader import make_reader
 from mcap_ros2.decoder import DecoderFactory
 
-from harness.report.files import TEMPORARY_NAME
+from harness.atomic_write import TEMPORARY_NAME
 from harness.safe_text import TEXT_LIMIT
 
 pytestmark = pytest.mark.timeout(600)

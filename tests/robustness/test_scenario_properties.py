@@ -1,7 +1,7 @@
 """Generated scenario files: the harness runs each one or refuses it in one line, nothing else.
 
 Hypothesis builds scenarios that are valid or nearly so (every field, fault
-profiles and inline faults from harness/faults.py), then mutates some of
+profiles and inline faults from harness/faults/sensor.py), then mutates some of
 them: wrong types, missing and extra keys, extreme numbers, random text,
 and corrupted YAML text. Some are hostile in ways a loader may quietly get
 wrong: numbers written as text, YAML 1.1 number forms (`1_0`, `1:20`,
@@ -35,12 +35,13 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from harness.errors import ConfigError
-from harness.faults import CONVENTIONS, DROPOUT_VALUES, NAMED_PROFILES
-from harness.lidar_spec import PRESETS
+from harness.faults.sensor import CONVENTIONS, DROPOUT_VALUES, NAMED_PROFILES
+from harness.lidar.spec import PRESETS
 from harness.links.base import LinkOptions
-from harness.runner import run
-from harness.scenario import Cylinder, Scenario, load_scenario_file
-from harness.sim.geometry import cylinder_segments
+from harness.runner.scenario_run import run
+from harness.scenario.files import load_scenario_file
+from harness.scenario.geometry import cylinder_segments
+from harness.scenario.schema import Cylinder, Scenario
 
 IN_PROCESS_EXAMPLES = 520
 CLI_EXAMPLES = 30

@@ -4,10 +4,11 @@ from __future__ import annotations
 
 import pytest
 
+from harness.judge.records import RunResult
 from harness.links.base import LinkOptions
-from harness.runner import RunSettings, run
-from harness.scenario import resolve_scenario
-from harness.trace import RunResult
+from harness.runner.scenario_run import run
+from harness.runner.settings import RunSettings
+from harness.scenario.files import resolve_scenario
 
 pytestmark = [pytest.mark.ros, pytest.mark.timeout(120)]
 

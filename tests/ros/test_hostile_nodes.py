@@ -18,11 +18,11 @@ import pytest
 from command_line import COMMAND, fossbot_hil
 
 from harness.errors import LinkError
+from harness.judge.records import RunResult
 from harness.links.base import LinkOptions
 from harness.links.ros2 import Ros2Link
-from harness.runner import run
-from harness.scenario import resolve_scenario
-from harness.trace import RunResult
+from harness.runner.scenario_run import run
+from harness.scenario.files import resolve_scenario
 
 pytestmark = [pytest.mark.ros, pytest.mark.timeout(60)]
 

@@ -17,13 +17,14 @@ from pathlib import Path
 
 import pytest
 
+from harness.judge.oracle import Oracle
+from harness.judge.records import RunResult
 from harness.links.base import LinkOptions
-from harness.oracle import Oracle
 from harness.record import read_scans, write_recording
 from harness.report.summary import json_bytes, scenario_details
-from harness.runner import RunSettings, run
-from harness.scenario import resolve_scenario
-from harness.trace import RunResult
+from harness.runner.scenario_run import run
+from harness.runner.settings import RunSettings
+from harness.scenario.files import resolve_scenario
 
 pytestmark = [pytest.mark.ros, pytest.mark.timeout(60)]
 

@@ -16,17 +16,12 @@ import pytest
 from child_process import alive
 
 from harness.links.base import LinkOptions
-from harness.node_forkserver import ForkedSupervisor, ForkServer, _exit_code
-from harness.node_process import (
-    FORK_SERVER_SETTING,
-    NodeCommand,
-    NodeProcess,
-    reference_node,
-    ros_arguments,
-)
-from harness.ros_domain import discovery_environment, reserve_domain
-from harness.runner import run_suite
-from harness.scenario import resolve_scenario
+from harness.nodes.command import NodeCommand, reference_node, ros_arguments
+from harness.nodes.forkserver import ForkedSupervisor, ForkServer, _exit_code
+from harness.nodes.process import FORK_SERVER_SETTING, NodeProcess
+from harness.ros.domain import discovery_environment, reserve_domain
+from harness.runner.suite import run_suite
+from harness.scenario.files import resolve_scenario
 
 pytestmark = [pytest.mark.ros, pytest.mark.timeout(120)]
 
@@ -109,7 +104,7 @@ def test_a_forked_module_exits_as_its_interpreter_would(
     monkeypatch.setenv("PYTHONPATH", str(tmp_path))
     server = ForkServer("ending_node")
     try:
-        monkeypatch.setattr("harness.node_process.shared_fork_server", lambda module: server)
+        monkeypatch.setattr("harness.nodes.process.shared_fork_server", lambda module: server)
         command = NodeCommand((sys.executable, "-m", "ending_node"), module="ending_node")
         process = NodeProcess(command, [], {})
         process.start()
@@ -135,7 +130,8 @@ def test_a_killed_harness_takes_its_forked_nodes_along(tmp_path: Path) -> None:
         textwrap.dedent(
             """
             import os, sys, time
-            from harness.node_process import NodeProcess, reference_node, ros_arguments
+            from harness.nodes.command import reference_node, ros_arguments
+            from harness.nodes.process import NodeProcess
             env = {"ROS_DOMAIN_ID": sys.argv[1], "ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST"}
             process = NodeProcess(reference_node(), ros_arguments(()), env)
             process.start()

@@ -178,7 +178,7 @@ def test_unknown_package_and_executable_in_workspace(workspace: Path) -> None:
 
 def test_domain_reservations_are_exclusive() -> None:
     """Two reservations in one process never share an id; release frees it."""
-    from harness.ros_domain import reserve_domain
+    from harness.ros.domain import reserve_domain
 
     with reserve_domain() as a, reserve_domain() as b:
         assert a.domain_id != b.domain_id

@@ -20,7 +20,7 @@ from command_line import COMMAND, fossbot_hil
 
 from harness.holder_lock import Held, Holder, take
 from harness.report.folder_lock import LOCK_NAME
-from harness.ros_domain import FIRST_ID, LAST_ID, lock_file
+from harness.ros.domain import FIRST_ID, LAST_ID, lock_file
 
 pytestmark = [pytest.mark.ros, pytest.mark.timeout(120)]
 

@@ -17,8 +17,8 @@ from pty_clients import tolerate_missing_dtr_on_pty
 
 from harness.devices.profiles import profile
 from harness.devices.revolution import samples_from_scan
-from harness.runner import RunSettings, fault_profile
-from harness.scenario import resolve_scenario
+from harness.runner.settings import RunSettings, fault_profile
+from harness.scenario.files import resolve_scenario
 from harness.sim.simulation import Simulation
 
 pytestmark = pytest.mark.timeout(90)

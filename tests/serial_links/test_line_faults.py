@@ -18,15 +18,16 @@ import numpy as np
 import pytest
 from command_line import fossbot_hil
 
-from harness.answers import Answers, Received
-from harness.link_faults import LineCorruption, LineDamage, LineDrops, LineNoise, LinkFaults
+from harness.faults.link import LineCorruption, LineDamage, LineDrops, LineNoise, LinkFaults
+from harness.judge.answers import Answers, Received
+from harness.judge.oracle import Oracle
+from harness.judge.records import RunResult
+from harness.lidar.scan import Scan
 from harness.links.base import Link, LinkOptions
-from harness.oracle import Oracle
 from harness.report.summary import tick_entry
-from harness.runner import RunSettings, run_scenario, with_link
-from harness.scan import Scan
-from harness.scenario import resolve_scenario
-from harness.trace import RunResult
+from harness.runner.scenario_run import run_scenario, with_link
+from harness.runner.settings import RunSettings
+from harness.scenario.files import resolve_scenario
 
 STUDENT = Path(__file__).resolve().parents[1] / "ros" / "student_node.py"
 SCENARIO = "approach_wall"  # ~95 revolutions, crossing the 0.5 m threshold
@@ -56,7 +57,7 @@ class LineRun:
 def run_on_line(
     link_name: str, faults: list[str], *, seed: int | None = None, node: str | None = None
 ) -> LineRun:
-    """`harness.runner.run`, opened by hand to read the server's LineDamage counters."""
+    """`scenario_run.run`, opened by hand to read the server's LineDamage counters."""
     scenario = resolve_scenario(SCENARIO)
     options = LinkOptions(
         node=node, threshold=scenario.threshold, scan_rate_hz=scenario.lidar_spec.rate_hz
@@ -247,7 +248,7 @@ def test_each_answer_is_judged_against_the_driver_scan_it_answered() -> None:
 def test_answers_are_paired_with_driver_scans_in_order() -> None:
     """Scans published back to back: the i-th status answers the i-th scan, a Bool goes
     with the status published nearest to it."""
-    from harness.board_link import _pair_with_driver_scans
+    from harness.links.board import _pair_with_driver_scans
     from harness.ros.observer import Heard
 
     late, own = driver_scan(0.508), driver_scan(0.486)

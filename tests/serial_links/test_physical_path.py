@@ -18,7 +18,7 @@ from pathlib import Path
 import pytest
 from pty_clients import NullModem
 
-from harness.ros_domain import reserve_domain
+from harness.ros.domain import reserve_domain
 
 pytestmark = [pytest.mark.ros, pytest.mark.timeout(120)]
 

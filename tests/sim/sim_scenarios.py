@@ -4,7 +4,8 @@ from __future__ import annotations
 
 from typing import Any
 
-from harness.scenario import Scenario, parse_scenario
+from harness.scenario.files import parse_scenario
+from harness.scenario.schema import Scenario
 
 
 def make_scenario(

@@ -1,4 +1,4 @@
-"""Outlines on the floor (harness.sim.footprint): pure geometry, and the FOSSBot's body."""
+"""Outlines on the floor (harness.scenario.footprint): pure geometry, and the FOSSBot's body."""
 
 from __future__ import annotations
 
@@ -7,8 +7,8 @@ import xml.etree.ElementTree as ET
 
 import pytest
 
-from harness.model_files import robot_models_dir
-from harness.sim.footprint import Outline, disc, overlap, rectangle, robot_outlines
+from harness.scenario.footprint import Outline, disc, overlap, rectangle, robot_outlines
+from harness.scenario.model_files import robot_models_dir
 
 
 def square(x: float, y: float, half: float = 0.5, yaw: float = 0.0, height: float = 1.0) -> Outline:

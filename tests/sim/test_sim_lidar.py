@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from sim_scenarios import make_scenario
 
-from harness.lidar_spec import PRESETS
+from harness.lidar.spec import PRESETS
 from harness.sim import lidar as lidar_module
 from harness.sim.lidar import LidarModel, beam_angles
 from harness.sim.world import World

@@ -10,13 +10,13 @@ import numpy as np
 import pytest
 
 from harness.errors import ConfigError
-from harness.lidar_spec import PRESETS
-from harness.scenario import Motion
+from harness.lidar.spec import PRESETS
+from harness.scenario.ahead import ahead_mask
+from harness.scenario.schema import Motion
 from harness.sim.motion import (
     MotionScript,
     Piece,
     Pose,
-    ahead_mask,
     integrate,
     integrate_pieces,
     nearest_ahead,

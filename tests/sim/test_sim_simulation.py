@@ -13,9 +13,10 @@ import pytest
 from sim_scenarios import make_scenario
 
 from harness.errors import ConfigError
-from harness.scenario import parse_scenario
+from harness.scenario.ahead import ahead_mask
+from harness.scenario.files import parse_scenario
 from harness.sim import SimTick, Simulation
-from harness.sim.motion import ahead_mask, nearest_ahead
+from harness.sim.motion import nearest_ahead
 
 WALL_AT_2 = {"type": "wall", "start": [2.0, -2.0], "end": [2.0, 2.0], "thickness": 0.1}
 CLUTTER = [
@@ -166,7 +167,7 @@ def test_same_scenario_gives_byte_identical_truth(mode):
 
 _DIGEST = """
 import hashlib, json, sys
-from harness.scenario import parse_scenario
+from harness.scenario.files import parse_scenario
 from harness.sim import Simulation
 with Simulation(parse_scenario(json.loads(sys.argv[1]), source="test.yaml")) as sim:
     h = hashlib.sha256()

@@ -11,7 +11,7 @@ import pytest
 from sim_scenarios import make_scenario
 
 from harness.errors import ConfigError
-from harness.scenario import parse_scenario
+from harness.scenario.files import parse_scenario
 from harness.sim.bullet import pb
 from harness.sim.lidar import LidarModel
 from harness.sim.world import World, robot_models_dir

@@ -17,9 +17,9 @@ import numpy as np
 from harness.devices.profiles import DeviceProfile
 from harness.devices.revolution import samples_from_scan
 from harness.errors import ConfigError
-from harness.link_faults import LINE_KINDS, LineDamage, LinkFaults, scan_periods
-from harness.runner import RunSettings, fault_profile
-from harness.scenario import Scenario
+from harness.faults.link import LINE_KINDS, LineDamage, LinkFaults, scan_periods
+from harness.runner.settings import RunSettings, fault_profile
+from harness.scenario.schema import Scenario
 
 IDLE_WAIT_S = 5.0  # after the last revolution: let the line drain
 

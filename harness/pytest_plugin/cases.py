@@ -57,15 +57,15 @@ def _fault_items(faults: Any) -> list[str | None]:
 
 def split_faults(text: str) -> list[str]:
     """ "noisy,drop(rate=0.1)" -> ["noisy", "drop(rate=0.1)"]."""
-    from harness.faults import split_fault_text
+    from harness.faults.sensor import split_fault_text
 
     return split_fault_text(text)
 
 
 def cases_from_marker(args: Sequence[Any], kwargs: dict[str, Any]) -> list[HilCase]:
     """The cases a marker names, checked: unknown names raise ConfigError (one line)."""
-    from harness.faults import build_profile
-    from harness.scenario import resolve_scenario, shipped_scenarios
+    from harness.faults.sensor import build_profile
+    from harness.scenario.files import resolve_scenario, shipped_scenarios
 
     unknown = sorted(set(kwargs) - {"faults"})
     if unknown:

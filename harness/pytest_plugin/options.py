@@ -277,7 +277,7 @@ def resolve_node(
 ) -> None:
     """Find the node now (a missing file or package is a usage error), as the link will."""
     from harness.errors import ConfigError
-    from harness.node_process import package_node, shell_node
+    from harness.nodes.command import package_node, shell_node
 
     try:
         if node:

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
 
+from harness.lidar.scan import Scan
 from harness.safe_text import TEXT_LIMIT, for_storage
-from harness.scan import Scan
 
 
 @dataclass(frozen=True)

@@ -26,8 +26,8 @@ from typing import TYPE_CHECKING, Any
 
 import pytest
 
-from harness.pytest_cases import MARKER, MARKER_HELP, HilCase
-from harness.pytest_options import (
+from harness.pytest_plugin.cases import MARKER, MARKER_HELP, HilCase
+from harness.pytest_plugin.options import (
     SERIAL_LINKS,
     HilConfig,
     add_options,
@@ -37,7 +37,7 @@ from harness.pytest_options import (
 
 if TYPE_CHECKING:
     from harness.links.base import LinkOptions
-    from harness.pytest_run import Hil
+    from harness.pytest_plugin.hil import Hil
 
 __all__ = ["HilBoard", "HilCase", "NodeUnderTest"]
 
@@ -88,7 +88,7 @@ class HilBoard:
 
 # -- hooks --------------------------------------------------------------------
 def pytest_addoption(parser: pytest.Parser) -> None:
-    """The --hil-* options and their ini twins (harness.pytest_options)."""
+    """The --hil-* options and their ini twins (harness.pytest_plugin.options)."""
     add_options(parser)
 
 
@@ -122,7 +122,7 @@ def pytest_generate_tests(metafunc: pytest.Metafunc) -> None:
     if marker is None:
         return
     from harness.errors import ConfigError
-    from harness.pytest_cases import cases_from_marker
+    from harness.pytest_plugin.cases import cases_from_marker
 
     if "hil_case" not in metafunc.fixturenames:
         pytest.fail(
@@ -193,7 +193,7 @@ def hil(
     hil_link_options: LinkOptions,
 ) -> Hil:
     """Runs scenarios: ``hil.run("approach_wall", threshold=0.4, faults="noisy")``."""
-    from harness.pytest_run import Hil
+    from harness.pytest_plugin.hil import Hil
 
     return Hil(
         hil_link,

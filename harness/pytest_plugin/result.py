@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING
 from harness.safe_text import DIAGNOSTICS_LIMIT, TEXT_LIMIT, clip, for_terminal
 
 if TYPE_CHECKING:
-    from harness.trace import RunResult, TickRecord
+    from harness.judge.records import RunResult, TickRecord
 
 __all__ = ["HilResult"]
 

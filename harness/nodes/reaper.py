@@ -1,6 +1,6 @@
 """Run one command so that nothing it starts outlives it: a child subreaper.
 
-``harness.node_process`` starts every node under test through this small
+``harness.nodes.process`` starts every node under test through this small
 program (by path, stdlib only, never imported by the harness). It marks
 itself a child subreaper (``PR_SET_CHILD_SUBREAPER``), so every process the
 node starts stays its descendant even after a double fork and ``setsid``.
@@ -9,9 +9,9 @@ SIGINT or SIGHUP; also sent by Linux if the harness dies) it stops the node
 (SIGINT, then SIGTERM, then SIGKILL, each after a bounded wait), kills
 every descendant still running, reaps them all and exits.
 
-Usage: ``python3 node_reaper.py STATUS_FD PARENT_PID INT_GRACE TERM_GRACE -- ARGV...``
+Usage: ``python3 reaper.py STATUS_FD PARENT_PID INT_GRACE TERM_GRACE -- ARGV...``
 
-The node fork server (``node_forkserver.py``) runs the same supervision
+The node fork server (``forkserver.py``) runs the same supervision
 (``supervise``) in a forked child instead, starting the node by a second
 fork rather than by ``posix_spawn``.
 

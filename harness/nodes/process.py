@@ -1,9 +1,9 @@
-"""The node under test as a separate process: resolve, start, watch, stop, reap.
+"""The node under test as a separate process: start, watch, stop, reap.
 
-The node is started the way a user would start it (a shell command, a
-colcon workspace's package/executable as ``ros2 run`` finds it, or the
-bundled reference node), with ``--ros-args`` appended. It runs under a
-small reaper process (``node_reaper.py``, a child subreaper) in its own
+The node is started the way a user would start it (``command``: a shell
+command, a colcon workspace's package/executable, or the bundled reference
+node), with ``--ros-args`` appended. It runs under a
+small reaper process (``reaper.py``, a child subreaper) in its own
 session, so stopping it also stops everything it started, even processes
 that left its process group or session, and so does the harness dying. Its
 stdout and stderr are read as they come and only their tails kept, so a
@@ -16,26 +16,23 @@ import atexit
 import contextlib
 import os
 import select
-import shlex
-import shutil
 import signal
 import subprocess
 import sys
 import threading
 import time
-from dataclasses import dataclass, field
 from pathlib import Path
 
 from harness.errors import ConfigError
-from harness.node_forkserver import ForkedSupervisor
-from harness.node_forkserver import shared as shared_fork_server
+from harness.nodes.command import NodeCommand
+from harness.nodes.forkserver import ForkedSupervisor
+from harness.nodes.forkserver import shared as shared_fork_server
 
-AMENT_MARKERS = Path("share/ament_index/resource_index/packages")
-REAPER = Path(__file__).with_name("node_reaper.py")
+REAPER = Path(__file__).with_name("reaper.py")
 INT_GRACE_S = 2.0  # a ROS 2 node stops on SIGINT well within this
 TERM_GRACE_S = 1.0  # then SIGTERM; then SIGKILL
 START_WAIT_S = 10.0  # for the reaper (a Python start-up) to report the node started
-# The reaper's own bounds (node_reaper.py: graces, SIGKILL wait, leftovers), plus slack.
+# The reaper's own bounds (reaper.py: graces, SIGKILL wait, leftovers), plus slack.
 STOP_WAIT_S = INT_GRACE_S + TERM_GRACE_S + 5.0 + 0.5 + 5.0 + 2.0
 POLL_S = 0.05
 TAIL_BYTES = 16384
@@ -51,134 +48,10 @@ def fork_server_enabled() -> bool:
     return on and threading.current_thread() is threading.main_thread()
 
 
-@dataclass(frozen=True)
-class NodeCommand:
-    """How to start a node: argv before --ros-args, extra environment, a name for messages."""
-
-    argv: tuple[str, ...]
-    env: dict[str, str] = field(default_factory=dict)
-    description: str = ""
-    # Set when argv is ``sys.executable -m MODULE``: the fork server may start it.
-    module: str | None = None
-
-
 def prepare_start(command: NodeCommand) -> None:
     """Start what starting `command` will use (its fork server), so it is ready sooner."""
     if command.module is not None and fork_server_enabled():
         shared_fork_server(command.module)
-
-
-def reference_node() -> NodeCommand:
-    """The bundled reference solution, runnable without colcon."""
-    module = "harness.reference.lidar_node"
-    return NodeCommand(
-        (sys.executable, "-m", module),
-        description="the bundled reference node (fossbot_lidar_processing)",
-        module=module,
-    )
-
-
-def shell_node(command: str) -> NodeCommand:
-    """A user's command line, e.g. ``python3 my_node.py``, split like a shell does."""
-    try:
-        argv = shlex.split(command)
-    except ValueError as err:
-        raise ConfigError(f"--node {command!r}: {err}") from None
-    if not argv:
-        raise ConfigError("--node: the command is empty")
-    program = argv[0]
-    if "/" in program:
-        if not Path(program).is_file():
-            raise ConfigError(f"--node {command!r}: no such file {program}")
-        if not os.access(program, os.X_OK):
-            raise ConfigError(f"--node {command!r}: {program} is not executable")
-    elif shutil.which(program) is None:
-        raise ConfigError(f"--node {command!r}: {program!r} not found on PATH")
-    return NodeCommand(tuple(argv), description=command)
-
-
-def _prefixes(install: Path) -> list[Path]:
-    """Install prefixes of a colcon install folder (isolated or merged layout)."""
-    if (install / AMENT_MARKERS).is_dir():
-        return [install]
-    return sorted(p for p in install.iterdir() if (p / AMENT_MARKERS).is_dir())
-
-
-def _site_packages(prefix: Path) -> list[Path]:
-    return sorted(prefix.glob("lib/python3*/site-packages")) + sorted(
-        prefix.glob("local/lib/python3*/dist-packages")
-    )
-
-
-def _env_for(prefixes: list[Path]) -> dict[str, str]:
-    """What sourcing the workspace's setup script would add, for these prefixes."""
-
-    def joined(name: str, parts: list[Path]) -> str:
-        old = os.environ.get(name, "")
-        return os.pathsep.join([*(str(p) for p in parts), *([old] if old else [])])
-
-    return {
-        "AMENT_PREFIX_PATH": joined("AMENT_PREFIX_PATH", prefixes),
-        "PYTHONPATH": joined("PYTHONPATH", [s for p in prefixes for s in _site_packages(p)]),
-        "PATH": joined("PATH", [p / "bin" for p in prefixes if (p / "bin").is_dir()]),
-        "LD_LIBRARY_PATH": joined("LD_LIBRARY_PATH", [p / "lib" for p in prefixes]),
-    }
-
-
-def package_node(package: str, executable: str, workspace: str | None) -> NodeCommand:
-    """Find `executable` of `package` as ``ros2 run`` does: through the ament index."""
-    if workspace is not None:
-        root = Path(workspace)
-        if not root.is_dir():
-            raise ConfigError(f"--workspace {workspace}: no such folder")
-        install = root / "install" if (root / "install").is_dir() else root
-        prefixes = _prefixes(install)
-        where = f"workspace {install}"
-        if not prefixes:
-            raise ConfigError(
-                f"--workspace {workspace}: no colcon install folder with packages "
-                f"(run 'colcon build' in {root} first)"
-            )
-    else:
-        prefixes = [Path(p) for p in os.environ.get("AMENT_PREFIX_PATH", "").split(os.pathsep) if p]
-        where = "AMENT_PREFIX_PATH"
-        if not prefixes:
-            raise ConfigError("--package needs --workspace DIR (or a sourced ROS 2 / workspace)")
-    owner = next((p for p in prefixes if (p / AMENT_MARKERS / package).is_file()), None)
-    if owner is None:
-        found = sorted(
-            {
-                m.name
-                for p in prefixes
-                if (p / AMENT_MARKERS).is_dir()
-                for m in (p / AMENT_MARKERS).iterdir()
-            }
-        )
-        listed = ", ".join(found[:20]) or "none"
-        raise ConfigError(f"--package {package}: not found in {where} (packages: {listed})")
-    program = owner / "lib" / package / executable
-    if not program.is_file():
-        there = (
-            sorted(p.name for p in (owner / "lib" / package).glob("*"))
-            if (owner / "lib" / package).is_dir()
-            else []
-        )
-        raise ConfigError(
-            f"--executable {executable}: not in package {package} "
-            f"(executables: {', '.join(there) or 'none'})"
-        )
-    env = _env_for(prefixes) if workspace is not None else {}
-    return NodeCommand((str(program),), env, f"{package}/{executable} from {where}")
-
-
-def ros_arguments(params: tuple[str, ...], *, use_sim_time: bool = True) -> list[str]:
-    """``--ros-args -p use_sim_time:=true -p NAME:=VALUE ...`` (the user's items verbatim)."""
-    args = ["--ros-args"]
-    if use_sim_time:
-        args += ["-p", "use_sim_time:=true"]
-    for item in params:
-        args += ["-p", item]
-    return args
 
 
 _LIVE: set[NodeProcess] = set()
@@ -246,7 +119,7 @@ def signal_name(number: int) -> str:
 
 
 class NodeProcess:
-    """One running node under test, started under node_reaper.py (see there)."""
+    """One running node under test, started under reaper.py (see there)."""
 
     def __init__(self, command: NodeCommand, args: list[str], env: dict[str, str]) -> None:
         self.command = command

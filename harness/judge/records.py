@@ -4,10 +4,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from harness.answers import Answers
-from harness.link_faults import ON_TIME, Delivery
-from harness.oracle import Verdict
-from harness.scan import Scan
+from harness.faults.link import ON_TIME, Delivery
+from harness.judge.answers import Answers
+from harness.judge.oracle import Verdict
+from harness.lidar.scan import Scan
 
 
 @dataclass(frozen=True)

@@ -1,6 +1,6 @@
 """Seeded faults of the link between the LIDAR and the node (pure: numpy only).
 
-Scan faults (``harness.faults``) change what a scan says; link faults change
+Scan faults (``harness.faults.sensor``) change what a scan says; link faults change
 how scans travel: late, lost, twice, out of order, at a drifting rate, with
 old stamps, and on a serial line damaged bytes. A scenario names both kinds
 in one ``faults:`` list; this module holds the link kinds, plans each

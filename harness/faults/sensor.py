@@ -25,8 +25,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from harness.errors import ConfigError
-from harness.lidar_spec import LidarSpec
-from harness.link_faults import (
+from harness.faults.link import (
     LINK_KINDS,
     Delay,
     Drop,
@@ -40,7 +39,8 @@ from harness.link_faults import (
     Reorder,
     StaleStamps,
 )
-from harness.scan import Scan
+from harness.lidar.scan import Scan
+from harness.lidar.spec import LidarSpec
 
 __all__ = [
     "CONVENTIONS",
@@ -190,7 +190,7 @@ class FaultProfile:
     faults: tuple[Fault, ...] = ()
     convention: str = "rep117"
     name: str = "clean"
-    link: LinkFaults = LinkFaults()  # how scans travel (see harness.link_faults)
+    link: LinkFaults = LinkFaults()  # how scans travel (see harness.faults.link)
 
     def __post_init__(self) -> None:
         _check_convention(self.convention)

@@ -23,12 +23,12 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from harness.answers import Answers
 from harness.errors import ConfigError
-from harness.link_faults import ON_TIME, Delivery
+from harness.faults.link import ON_TIME, Delivery
+from harness.judge.answers import Answers
+from harness.judge.status import StatusClaim, compile_status_pattern, half_unit, parse_status
+from harness.lidar.scan import Scan
 from harness.safe_text import QUOTE_LIMIT, TEXT_LIMIT, clip, for_storage
-from harness.scan import Scan
-from harness.status import StatusClaim, compile_status_pattern, half_unit, parse_status
 
 __all__ = ["Expectation", "Oracle", "Verdict", "summarise_scan"]
 

@@ -21,15 +21,16 @@ import time
 from dataclasses import replace
 from typing import Any, ClassVar
 
-from harness.answers import Answers
 from harness.devices.profiles import DeviceProfile
 from harness.errors import ConfigError, LinkError
-from harness.link_faults import LineDamage
+from harness.faults.link import LineDamage
+from harness.judge.answers import Answers
+from harness.lidar.scan import Scan
 from harness.links.base import LinkOptions
 from harness.links.ros2 import CATCH_UP_S, POLL_S, Ros2Link
-from harness.node_process import NodeCommand, NodeProcess, prepare_start, ros_arguments
+from harness.nodes.command import NodeCommand, ros_arguments
+from harness.nodes.process import NodeProcess, prepare_start
 from harness.ros.observer import Heard
-from harness.scan import Scan
 
 SCAN_CATCH_UP_S = 0.05  # a driver scan published before its answer reaches us within this
 LATE_SCAN_WAIT_S = 0.2  # after a lost revolution: how long a second driver scan may follow

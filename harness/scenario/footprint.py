@@ -158,7 +158,7 @@ def _hull(points: Iterable[Point]) -> tuple[Point, ...]:
 
 
 def _floats(text: str | None, default: Vector) -> Vector:
-    """Three numbers from a URDF attribute (checked by harness.model_files), or `default`."""
+    """Three numbers from a URDF attribute (checked in scenario.model_files), or `default`."""
     parts = (text or "").split()
     return (float(parts[0]), float(parts[1]), float(parts[2])) if len(parts) == 3 else default
 

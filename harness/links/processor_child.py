@@ -29,8 +29,8 @@ from multiprocessing.connection import Connection, Pipe
 from pathlib import Path
 from typing import Any
 
-from harness.node_process import OutputTail, signal_name
-from harness.process_group import signal_group, wait_group_gone
+from harness.nodes.process import OutputTail, signal_name
+from harness.nodes.process_group import signal_group, wait_group_gone
 
 __all__ = ["Outcome", "ProcessorChild"]
 

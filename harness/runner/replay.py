@@ -14,12 +14,13 @@ from collections.abc import Callable, Iterator
 from dataclasses import replace
 
 from harness.errors import ConfigError
-from harness.link_faults import NO_LINK_FAULTS, LinkFaults
+from harness.faults.link import NO_LINK_FAULTS, LinkFaults
+from harness.judge.oracle import Oracle
+from harness.judge.records import RunResult, TickRecord
 from harness.links.base import Link, LinkOptions
-from harness.oracle import Oracle
 from harness.record import RecordedScans
-from harness.runner import Frame, check_link_faults, judge_frames, with_link
-from harness.trace import RunResult, TickRecord
+from harness.runner.frames import Frame, check_link_faults, judge_frames
+from harness.runner.scenario_run import with_link
 
 
 def _recorded_float(recording: RecordedScans, key: str) -> float | None:

@@ -22,13 +22,13 @@ from typing import TYPE_CHECKING, Any, NoReturn
 import pytest
 
 from harness.errors import ConfigError, HarnessError
-from harness.pytest_cases import HilCase, split_faults
-from harness.pytest_options import DEFAULT_PORT_WAIT_S, SERIAL_LINKS
-from harness.pytest_result import HilResult
+from harness.pytest_plugin.cases import HilCase, split_faults
+from harness.pytest_plugin.options import DEFAULT_PORT_WAIT_S, SERIAL_LINKS
+from harness.pytest_plugin.result import HilResult
 
 if TYPE_CHECKING:
     from harness.links.base import LinkOptions
-    from harness.scenario import Scenario
+    from harness.scenario.schema import Scenario
 
     ScenarioRef = str | os.PathLike[str] | HilCase | Scenario
     Faults = str | Sequence[str | dict[str, Any]] | None
@@ -76,7 +76,7 @@ def _fail(message: str) -> NoReturn:
 
 def _fault_list(faults: Faults) -> list[str | dict[str, Any]] | None:
     """A name, "a,b", or a list of names and inline fault mappings; checked now."""
-    from harness.faults import build_profile
+    from harness.faults.sensor import build_profile
 
     if faults is None:
         return None
@@ -122,7 +122,8 @@ class Hil:
 
     # -- arguments ----------------------------------------------------------
     def _scenario(self, ref: ScenarioRef) -> Scenario:
-        from harness.scenario import Scenario, resolve_scenario
+        from harness.scenario.files import resolve_scenario
+        from harness.scenario.schema import Scenario
 
         if isinstance(ref, Scenario):
             return ref
@@ -176,7 +177,7 @@ class Hil:
         if seed is not None and not (isinstance(seed, int) and 0 <= seed < 2**32):
             raise ConfigError(f"seed must be a whole number in 0..2**32-1, got {seed!r}")
         if status_regex is not None:
-            from harness.status import compile_status_pattern
+            from harness.judge.status import compile_status_pattern
 
             compile_status_pattern(status_regex)
         from harness.commands.arguments import checked_node_options
@@ -202,7 +203,7 @@ class Hil:
         `overrides` are LinkOptions fields (``node=``, ``params=``,
         ``scan_timeout=`` ...). Returns the result; it does not assert.
         """
-        from harness.runner import RunSettings
+        from harness.runner.settings import RunSettings
 
         link = link if link is not None else self.link
         if isinstance(scenario, HilCase) and faults is None:
@@ -233,7 +234,7 @@ class Hil:
         return result
 
     def _run(self, scenario: Scenario, link: str, options: LinkOptions, settings: Any) -> HilResult:
-        from harness.runner import run
+        from harness.runner.scenario_run import run
 
         physical = link in SERIAL_LINKS and options.port is not None
         domain_id = options.domain_id
@@ -246,7 +247,7 @@ class Hil:
                     label = f"--hil-port {options.port}"
                     held.enter_context(hold_port(options.port, self.port_wait, label=label))
                 elif link != "inprocess" and domain_id is None:
-                    from harness.ros_domain import reserve_domain
+                    from harness.ros.domain import reserve_domain
 
                     domain_id = held.enter_context(reserve_domain()).domain_id
                     options = replace(options, domain_id=domain_id)

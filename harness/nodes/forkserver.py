@@ -5,12 +5,12 @@ cost about 0.3 s of CPU, paid again for every scenario. The fork server pays
 it once: it imports the node's module (nothing more: no rclpy context, no
 DDS participant, no thread), then forks per request. Each fork is a fresh
 process that has never run a node; it supervises the node exactly as
-``node_reaper.py`` does (``supervise``: subreaper, own session, the same
+``reaper.py`` does (``supervise``: subreaper, own session, the same
 stop and the same events), and the node itself is a second fork that runs
 the module as ``python -m MODULE ARGS`` would, with the request's
 environment and arguments. Only ``python -m`` commands of the harness's own
 interpreter are served (the bundled reference node); anything else is
-started by ``node_reaper.py`` as before.
+started by ``reaper.py`` as before.
 
 The harness side (`ForkServer`) starts the server lazily, once per process,
 and falls back to the plain start if the server cannot come up. The server
@@ -35,7 +35,7 @@ import subprocess
 import sys
 from collections.abc import Iterator
 
-from harness.quick_exit import exit_now, finish_interpreter
+from harness.nodes.quick_exit import exit_now, finish_interpreter
 
 READY_WAIT_S = 10.0  # for the server's imports (a cold disk cache is slow)
 ANSWER_WAIT_S = 5.0  # for a fork
@@ -86,7 +86,7 @@ class ForkedSupervisor:
 
 class ForkServer:
     """The harness's end: one server per harness process, started on first use, used from
-    the main thread only (see ``node_process.fork_server_enabled``)."""
+    the main thread only (see ``nodes.process.fork_server_enabled``)."""
 
     def __init__(self, module: str) -> None:
         self.module = module
@@ -256,7 +256,7 @@ def _supervisor(sock: socket.socket, module: str, request: dict, fds: list[int])
     """The forked child: supervise a node that is a fork of this one."""
     code = 1
     try:
-        from harness.node_reaper import Reaper, supervise
+        from harness.nodes.reaper import Reaper, supervise
 
         sock.close()
         status_fd, out_fd, err_fd = fds
@@ -351,7 +351,7 @@ def _load_type_support() -> None:
 
 
 def main(argv: list[str]) -> int:
-    """``python -m harness.node_forkserver SOCKET_FD PARENT_PID MODULE``."""
+    """``python -m harness.nodes.forkserver SOCKET_FD PARENT_PID MODULE``."""
     import ctypes
     import importlib
 

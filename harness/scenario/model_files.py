@@ -34,7 +34,7 @@ from importlib import resources
 from pathlib import Path, PurePosixPath
 
 from harness.errors import ConfigError
-from harness.messages import shown
+from harness.safe_text import shown
 
 __all__ = [
     "MAX_MESH_BYTES",

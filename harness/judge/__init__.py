@@ -1,0 +1,26 @@
+"""How an answer is judged: the node's words read, held against the truth, recorded.
+
+- ``answers``: what came back for one scan (status Strings, warning Bools);
+- ``status``: reading the free-text status a student node publishes;
+- ``oracle``: per-tick expectations from the scan the node was sent, and
+  the verdict with its explanation;
+- ``records``: what one run produced, tick by tick (``RunResult``).
+
+Pure: numpy only, no rclpy, no pybullet. Add a check to the ``Oracle``; teach
+``status`` a new way students write their status.
+"""
+
+from harness import lazy_exports
+
+_EXPORTS = {
+    "Answers": "answers",
+    "Received": "answers",
+    "StatusClaim": "status",
+    "parse_status": "status",
+    "Oracle": "oracle",
+    "Verdict": "oracle",
+    "RunResult": "records",
+    "TickRecord": "records",
+}
+__all__ = sorted(_EXPORTS)
+__getattr__ = lazy_exports(__name__, _EXPORTS)

@@ -1,0 +1,185 @@
+"""One scenario: simulated, spoiled by its faults and judged through a link.
+
+The same engine serves the CLI, the pytest plugin and CI; only the link
+differs.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import replace
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from harness.errors import ConfigError, LinkError
+from harness.faults.link import (
+    scan_periods,
+)
+from harness.faults.sensor import FaultProfile
+from harness.judge.oracle import Oracle
+from harness.judge.records import RunResult, TickRecord
+from harness.lidar.scan import Scan
+from harness.links.base import Link, LinkOptions, create_link
+from harness.runner.frames import Frame, check_link_faults, judge_frames
+from harness.runner.settings import RunSettings, effective_threshold, fault_profile, faults_origin
+from harness.scenario.schema import Scenario
+
+if TYPE_CHECKING:
+    from harness.lidar.spec import LidarSpec
+    from harness.sim.simulation import SimTick
+
+
+def run_scenario(
+    scenario: Scenario,
+    link: Link,
+    settings: RunSettings = RunSettings(),
+    *,
+    on_tick: Callable[[TickRecord], None] | None = None,
+) -> RunResult:
+    """Run `scenario` through an already opened `link` and judge every tick."""
+    from harness.sim.simulation import Simulation  # imports pybullet
+
+    started = time.perf_counter()
+    seed = settings.seed if settings.seed is not None else scenario.seed
+    threshold = effective_threshold(scenario, settings)
+    profile = fault_profile(scenario, settings)
+    oracle = Oracle(
+        threshold, noise_sigma=profile.noise_sigma, status_pattern=settings.status_pattern
+    )
+    rng = np.random.default_rng(seed)
+    result = RunResult(
+        scenario=scenario.name,
+        link=link.name,
+        seed=seed,
+        threshold=threshold,
+        faults=profile.name,
+        noise_sigma=profile.noise_sigma,
+    )
+    try:
+        check_link_faults(profile.link, link)
+    except ConfigError as err:
+        raise ConfigError(f"{faults_origin(scenario, settings)}: {err}") from None
+    drift = profile.link.get("rate_drift")
+    periods = scan_periods(drift, scenario.lidar_spec.rate_hz, seed) if drift else None
+    try:
+        with Simulation(scenario, gui=settings.gui) as sim:
+            frames = (
+                Frame(s.tick, s.t, s.x, s.y, s.yaw, _emit(profile, s, sim.spec, rng, bool(drift)))
+                for s in sim.ticks(periods)
+            )
+            judge_frames(frames, link, oracle, result, on_tick=on_tick, link_faults=profile.link)
+    finally:  # an interrupted run reports its time too
+        result.wall_s = time.perf_counter() - started
+    return result
+
+
+def _emit(
+    profile: FaultProfile,
+    tick: SimTick,
+    spec: LidarSpec,
+    rng: np.random.Generator,
+    drifting: bool,
+) -> Scan:
+    """The scan a driver publishes for one tick; a drifting rate also sets its timing fields."""
+    scan = profile.emit(tick.truth, spec, rng, stamp=tick.t)
+    if drifting:
+        scan = replace(scan, scan_time=tick.period, time_increment=tick.period / spec.samples)
+    return scan
+
+
+def with_link(
+    link_name: str,
+    options: LinkOptions,
+    body: Callable[[Link], RunResult],
+    not_started: Callable[[str, str], RunResult],
+) -> RunResult:
+    """Open the named link, run `body` through it, always close it.
+
+    A link that cannot bring the software under test up gives
+    ``not_started(reason, diagnostics)`` instead of an exception.
+    """
+    link = create_link(link_name, options)
+    try:
+        result = run_through(link, body, not_started)
+    finally:
+        started = time.perf_counter()
+        link.close()
+    closed(result, link, time.perf_counter() - started)
+    return result
+
+
+def run_through(
+    link: Link,
+    body: Callable[[Link], RunResult],
+    not_started: Callable[[str, str], RunResult],
+) -> RunResult:
+    """Open `link` (waiting until it is ready) and run `body` through it; the caller closes it.
+
+    The result says how long the run waited for the link to come up.
+    """
+    started = time.perf_counter()
+    try:
+        link.open()
+        ready = time.perf_counter() - started
+        result = body(link)
+    except LinkError as err:
+        ready = time.perf_counter() - started
+        result = not_started(str(err), link.diagnostics())
+        result.not_started = True
+    result.startup_s = ready
+    return result
+
+
+def closed(result: RunResult, link: Link, waited: float) -> None:
+    """The link is closed: the time waited for it, and how its stop went, join the result."""
+    result.stop_s = waited
+    note = link.stop_note()
+    if note:
+        result.diagnostics = "\n".join(part for part in (result.diagnostics, note) if part)
+
+
+def scenario_options(
+    scenario: Scenario, options: LinkOptions, settings: RunSettings
+) -> LinkOptions:
+    """The link options for one scenario: its threshold and its LIDAR's rate."""
+    threshold = effective_threshold(scenario, settings)
+    return replace(options, threshold=threshold, scan_rate_hz=scenario.lidar_spec.rate_hz)
+
+
+def not_started_as(
+    scenario: Scenario, link_name: str, settings: RunSettings
+) -> Callable[[str, str], RunResult]:
+    """How a scenario whose link never came up is recorded."""
+    threshold = effective_threshold(scenario, settings)
+    seed = settings.seed if settings.seed is not None else scenario.seed
+    faults = fault_profile(scenario, settings).name
+
+    def failed(reason: str, diagnostics: str) -> RunResult:
+        return RunResult(
+            scenario.name, link_name, seed, threshold, faults, error=reason, diagnostics=diagnostics
+        )
+
+    return failed
+
+
+def run(
+    scenario: Scenario,
+    link_name: str,
+    options: LinkOptions,
+    settings: RunSettings = RunSettings(),
+    *,
+    on_tick: Callable[[TickRecord], None] | None = None,
+) -> RunResult:
+    """Open the named link, run the scenario through it, always close it.
+
+    A link that cannot bring the software under test up gives a result with
+    the reason and ``not_started`` set, not an exception.
+    """
+    return with_link(
+        link_name,
+        scenario_options(scenario, options, settings),
+        lambda link: run_scenario(scenario, link, settings, on_tick=on_tick),
+        not_started_as(scenario, link_name, settings),
+    )

@@ -1,0 +1,140 @@
+"""A suite of scenarios, each with a fresh link, the next ones started ahead (link_pipeline)."""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Sequence
+from contextlib import AbstractContextManager, nullcontext
+from typing import TYPE_CHECKING
+
+from harness.errors import Interrupted
+from harness.judge.records import RunResult, TickRecord
+from harness.links.base import Link, LinkOptions, create_link, link_class
+from harness.nodes.forkserver import scope as fork_servers
+from harness.runner.link_pipeline import LinkPipeline
+from harness.runner.scenario_run import (
+    closed,
+    not_started_as,
+    run_scenario,
+    run_through,
+    scenario_options,
+)
+from harness.runner.settings import RunSettings
+from harness.scenario.schema import Scenario
+
+if TYPE_CHECKING:
+    pass
+
+
+def run_suite(
+    scenarios: Sequence[Scenario],
+    link_name: str,
+    options: LinkOptions,
+    settings: RunSettings = RunSettings(),
+    *,
+    on_tick: Callable[[TickRecord], None] | None = None,
+    on_result: Callable[[RunResult], None] | None = None,
+) -> list[RunResult]:
+    """Run each scenario in turn, each through a link of its own, and report the
+    results in order.
+
+    Where links can overlap (their own ROS domains), the next scenarios'
+    links start while one runs and finished ones stop behind it
+    (``harness.runner.link_pipeline``). Once the software under test fails to come
+    up, the rest are marked not run instead of each waiting out its start.
+    """
+    results: list[RunResult] = []
+
+    def report(result: RunResult) -> None:
+        results.append(result)
+        if on_result is not None:
+            on_result(result)
+
+    def make(index: int) -> Link:
+        return create_link(link_name, scenario_options(scenarios[index], options, settings))
+
+    link_class(link_name).prepare(options)
+    with fork_servers(), _explicit_domain(link_name, options):
+        pipeline = LinkPipeline(make, len(scenarios), overlap=_links_overlap(link_name, options))
+        failed_start: str | None = None
+        index = 0
+        try:
+            for index, scenario in enumerate(scenarios):
+                if failed_start is not None:
+                    pipeline.drain()
+                    reason = f"not run: the node did not start in {failed_start}"
+                    report(_not_run(scenario, link_name, reason))
+                    continue
+                started = time.perf_counter()
+                link = pipeline.take(index)  # starts it (unless started ahead), and the next ones
+                taking = time.perf_counter() - started
+                result = run_through(
+                    link,
+                    lambda link, s=scenario: run_scenario(s, link, settings, on_tick=on_tick),
+                    not_started_as(scenario, link_name, settings),
+                )
+                result.startup_s += taking  # starting links is start-up too
+                if result.not_started:
+                    failed_start = scenario.name
+                pipeline.retire(link, _reporter(result, link, report))
+        except KeyboardInterrupt as err:
+            pipeline.drain()  # every process reaped; finished scenarios reported first
+            rest = scenarios[index:]
+            raise _suite_interrupted(err, results, rest, link_name, on_result) from None
+        finally:  # every link closed (in order: the last results are reported here)
+            pipeline.drain()
+    return results
+
+
+def _reporter(
+    result: RunResult, link: Link, report: Callable[[RunResult], None]
+) -> Callable[[float], None]:
+    """Once `link` is closed: complete `result` (`closed`) and report it."""
+
+    def on_closed(waited: float) -> None:
+        closed(result, link, waited)
+        report(result)
+
+    return on_closed
+
+
+def _links_overlap(link_name: str, options: LinkOptions) -> bool:
+    """Start links ahead and stop them behind? Only where each has a domain of its own."""
+    return link_class(link_name).starts_ahead and options.domain_id is None
+
+
+def _explicit_domain(link_name: str, options: LinkOptions) -> AbstractContextManager[object]:
+    """An explicit domain id held for the whole suite (each scenario's link takes it again):
+    no other run slips in between two scenarios, and an id in use fails before the first."""
+    if options.domain_id is None or link_name == "inprocess":
+        return nullcontext()
+    from harness.ros.domain import reserve_domain
+
+    return reserve_domain(options.domain_id)
+
+
+def _suite_interrupted(
+    err: KeyboardInterrupt,
+    done: list[RunResult],
+    rest: Sequence[Scenario],
+    link_name: str,
+    on_result: Callable[[RunResult], None] | None,
+) -> Interrupted:
+    """What the suite judged before the signal: the finished scenarios, the
+    interrupted one (its judged ticks, an error saying where it stopped), and
+    the others not run."""
+    stop = Interrupted.of(err)
+    partial = list(stop.results)
+    if not partial:  # interrupted before its first tick (starting the node, building the world)
+        why = f"interrupted by {stop.name} before its first tick"
+        partial = [RunResult(rest[0].name, link_name, 0, 0.0, "", error=why)]
+    reason = f"not run: interrupted by {stop.name}"
+    skipped = [_not_run(s, link_name, reason) for s in rest[1:]]
+    if on_result is not None:
+        for result in [*partial, *skipped]:
+            on_result(result)
+    return Interrupted(stop.signum, [*done, *partial, *skipped])
+
+
+def _not_run(scenario: Scenario, link_name: str, reason: str) -> RunResult:
+    return RunResult(scenario.name, link_name, 0, 0.0, "", error=reason, not_run=True)

@@ -1,0 +1,152 @@
+"""From a name or a file to a checked Scenario: parse, load, look up the shipped ones."""
+
+from __future__ import annotations
+
+import os
+import stat
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+import yaml
+from pydantic import (
+    ValidationError,
+)
+
+from harness.errors import ConfigError
+from harness.faults.sensor import build_profile
+from harness.safe_text import shown
+from harness.scenario.checks import (
+    check_lidar_fits,
+    check_model_files,
+    check_reachable,
+    check_run_length,
+    check_start_clear,
+)
+from harness.scenario.limits import MAX_FILE_BYTES
+from harness.scenario.schema import Scenario, first_error
+from harness.scenario.yaml_loader import load_yaml, yaml_problem
+
+SCENARIO_SUFFIXES = (".yaml", ".yml")
+
+
+def parse_scenario(data: Any, *, source: str = "<scenario>") -> Scenario:
+    """Validate already-loaded YAML data; ConfigError names the source and field.
+
+    Checks the schema, the bounds and the cost of the run; the model files
+    it names are checked by ``check_model_files`` (``load_scenario_file``
+    does both).
+    """
+    where = shown(source)
+    if not isinstance(data, dict):
+        got = {type(None): "nothing (an empty file?)", list: "a list", str: "text"}.get(
+            type(data), type(data).__name__
+        )
+        raise ConfigError(f"{where}: a scenario must be a mapping of fields, got {got}")
+    if "source" in data:  # the harness's own field: where the file is, never the file's say
+        raise ConfigError(f"{where}: source: unknown key")
+    try:
+        scenario = Scenario.model_validate({**data, "source": source})
+        scenario.lidar.spec()
+    except ValidationError as err:
+        raise ConfigError(f"{where}: {first_error(err)}") from None
+    except ConfigError as err:
+        raise ConfigError(f"{where}: lidar: {err}") from None
+    except RecursionError:
+        raise ConfigError(f"{where}: nested too deeply (or refers to itself)") from None
+    try:
+        check_run_length(scenario, build_profile(scenario.faults))
+        check_lidar_fits(scenario)
+    except ConfigError as err:
+        raise ConfigError(f"{where}: {err}") from None
+    if not scenario.name:
+        scenario = scenario.model_copy(update={"name": Path(source).stem[:100]})
+    return scenario
+
+
+def _read_text(path: Path) -> str:
+    """The file's text: a regular file, at most MAX_FILE_BYTES, UTF-8; never blocks on a FIFO."""
+    name = shown(str(path))
+    try:
+        mode = os.stat(path).st_mode
+    except FileNotFoundError:
+        raise ConfigError(f"{name}: no such scenario file") from None
+    except (OSError, ValueError) as err:
+        reason = getattr(err, "strerror", None) or err
+        raise ConfigError(f"{name}: cannot read: {reason}") from None
+    if stat.S_ISDIR(mode):
+        raise ConfigError(f"{name}: is a folder, not a scenario file")
+    if not stat.S_ISREG(mode):
+        raise ConfigError(f"{name}: not a regular file")
+    try:
+        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | os.O_NOCTTY)
+        try:
+            if not stat.S_ISREG(os.fstat(fd).st_mode):  # replaced since the stat above
+                raise ConfigError(f"{name}: not a regular file")
+            with os.fdopen(os.dup(fd), "rb") as handle:
+                data = handle.read(MAX_FILE_BYTES + 1)
+        finally:
+            os.close(fd)
+    except OSError as err:
+        raise ConfigError(f"{name}: cannot read: {err.strerror or err}") from None
+    if len(data) > MAX_FILE_BYTES:
+        raise ConfigError(f"{name}: larger than {MAX_FILE_BYTES >> 20} MiB; not a scenario file")
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError as err:
+        line = data[: err.start].count(b"\n") + 1
+        raise ConfigError(
+            f"{name}: not UTF-8 text (byte 0x{data[err.start]:02x} at line {line})"
+        ) from None
+
+
+def load_scenario_file(path: str | Path) -> Scenario:
+    """Read and validate one scenario file, and the model files it names."""
+    path = Path(path)
+    name = shown(str(path))
+    text = _read_text(path)
+    try:
+        data = load_yaml(text)
+    except yaml.YAMLError as err:
+        raise ConfigError(f"{name}: {yaml_problem(err)}") from None
+    except RecursionError:
+        raise ConfigError(f"{name}: YAML error: nested too deeply") from None
+    except ValueError as err:  # e.g. an integer with more digits than Python converts
+        raise ConfigError(f"{name}: YAML error: {' '.join(str(err).split())[:200]}") from None
+    scenario = parse_scenario(data, source=str(path))
+    check_reachable(scenario)
+    check_start_clear(scenario, check_model_files(scenario))
+    return scenario
+
+
+def shipped_dir() -> Path:
+    """Folder of the scenarios installed with the harness."""
+    return Path(str(resources.files("harness.scenarios")))
+
+
+def shipped_scenarios() -> list[Scenario]:
+    """Every shipped scenario, sorted by name."""
+    files = sorted(p for p in shipped_dir().iterdir() if p.suffix in SCENARIO_SUFFIXES)
+    return sorted((load_scenario_file(p) for p in files), key=lambda s: s.name)
+
+
+def _exists(path: Path) -> bool:
+    """Whether anything is at `path`; a name the OS refuses (too long, a NUL) is nothing."""
+    try:
+        os.stat(path)
+    except (OSError, ValueError):
+        return False
+    return True
+
+
+def resolve_scenario(ref: str) -> Scenario:
+    """A shipped scenario name or a path to a scenario file."""
+    candidate = Path(ref)
+    if candidate.suffix in SCENARIO_SUFFIXES or _exists(candidate) or "/" in ref:
+        return load_scenario_file(candidate)
+    for suffix in SCENARIO_SUFFIXES:
+        shipped = shipped_dir() / f"{ref}{suffix}"
+        if _exists(shipped):
+            return load_scenario_file(shipped)
+    known = ", ".join(s.name for s in shipped_scenarios())
+    raise ConfigError(f"unknown scenario {ref[:100]!r} (shipped: {known}; or give a .yaml path)")
