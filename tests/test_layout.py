@@ -31,7 +31,7 @@ LAYERS: list[set[str]] = [
     {"scenario", "judge"},
     {"sim", "record"},
     {"links", "report"},
-    {"runner"},
+    {"runner", "live"},
     {"bench", "grading"},
     {"commands"},
     {"pytest_plugin", "cli"},
