@@ -31,8 +31,8 @@ LAYERS: list[set[str]] = [
     {"scenario", "judge"},
     {"sim", "record"},
     {"links", "report"},
-    {"runner", "live"},
-    {"bench", "grading"},
+    {"runner"},
+    {"bench", "grading", "live"},
     {"commands"},
     {"pytest_plugin", "cli"},
 ]

@@ -13,6 +13,7 @@ from types import ModuleType
 COMMAND_MODULES = (
     "list_scenarios",
     "run",
+    "sim",
     "ports",
     "emulate",
     "replay",

@@ -159,9 +159,12 @@ def add_judging_options(parser: argparse.ArgumentParser) -> None:
     )
 
 
-def add_node_options(parser: argparse.ArgumentParser) -> None:
+def add_node_options(
+    parser: argparse.ArgumentParser,
+    title: str = "node under test (ros2 link; default: the reference node)",
+) -> None:
     """The node under test and its ROS graph (ros2 link and virtual boards)."""
-    node = parser.add_argument_group("node under test (ros2 link; default: the reference node)")
+    node = parser.add_argument_group(title)
     node.add_argument(
         "--node",
         type=given("--node"),

@@ -265,14 +265,15 @@ class WheelDriver:
         self.wheels = world.wheel_geometry(*WHEEL_JOINTS)
         self._steps = 0
         self._command: tuple[float, float] | None = None
-        self._drive(0.0, 0.0)
+        self.drive(0.0, 0.0)
         world.step(SETTLE_STEPS)
 
     def pose(self) -> Pose:
         """The robot's pose now, as the physics has it."""
         return Pose(*self.world.base_pose())
 
-    def _drive(self, linear: float, angular: float) -> None:
+    def drive(self, linear: float, angular: float) -> None:
+        """Command a body velocity (m/s, rad/s) through the wheel motors; holds until changed."""
         if self._command == (linear, angular):
             return
         self._command = (linear, angular)
@@ -287,6 +288,6 @@ class WheelDriver:
             pieces = script.advance(self.time_step)
             # The command holding for most of this step (segment ends rarely fall mid-step).
             best = max(pieces, key=lambda p: p.duration) if pieces else Piece(0.0, 0.0, 0.0)
-            self._drive(best.linear, best.angular)
+            self.drive(best.linear, best.angular)
             self.world.step()
             self._steps += 1

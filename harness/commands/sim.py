@@ -1,0 +1,183 @@
+"""`fossbot-hil sim`: the lab's world in real time, driven over /cmd_vel, judged while driving."""
+
+from __future__ import annotations
+
+import argparse
+import os
+from dataclasses import replace
+from typing import TYPE_CHECKING
+
+from rich.console import Console
+
+from harness.commands.arguments import (
+    add_node_options,
+    check_output_file,
+    domain_id,
+    given,
+    link_options,
+    positive,
+    seed,
+)
+from harness.errors import ConfigError
+
+if TYPE_CHECKING:
+    from harness.judge.records import RunResult
+    from harness.live.session import LiveSession
+
+NAME = "sim"
+HELP = "run a world live: drive the robot over /cmd_vel or the keyboard, watch it, judge a node"
+DEFAULT_WORLD = "single_wall"
+FOXGLOVE_PORT = 8765  # the Foxglove app's default
+
+
+def foxglove_port(text: str) -> int | None:
+    """--foxglove-port: a TCP port, or ``off``."""
+    if text.strip().lower() == "off":
+        return None
+    try:
+        port = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not a port number or 'off': {text[:40]!r}") from None
+    if not 1 <= port <= 65535:
+        raise argparse.ArgumentTypeError(f"a port is 1-65535, got {port}")
+    return port
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "world",
+        nargs="?",
+        default=DEFAULT_WORLD,
+        metavar="WORLD",
+        help=f"a world (default {DEFAULT_WORLD}, the lab's), a shipped scenario's world, "
+        "or a scenario file",
+    )
+    parser.add_argument(
+        "--rate",
+        type=positive("rate", 100.0),
+        default=1.0,
+        metavar="X",
+        help="simulated seconds per second (default 1: real time)",
+    )
+    parser.add_argument(
+        "--duration",
+        type=positive("duration", 86400.0),
+        metavar="S",
+        help="stop after S simulated seconds (default: run until Ctrl-C)",
+    )
+    parser.add_argument(
+        "--teleop",
+        action="store_true",
+        help="drive with the keyboard (teleop_twist_keyboard's keys), publishing /cmd_vel",
+    )
+    parser.add_argument(
+        "--foxglove-port",
+        type=foxglove_port,
+        default=FOXGLOVE_PORT,
+        metavar="PORT|off",
+        help=f"serve the live view to the Foxglove app here (default {FOXGLOVE_PORT}; off: none)",
+    )
+    parser.add_argument(
+        "--record",
+        type=given("--record"),
+        metavar="FILE",
+        help="write the judged session as an MCAP recording (needs a node that answers)",
+    )
+    parser.add_argument(
+        "--seed", type=seed, help="seed of the LIDAR's faults (default: the world's)"
+    )
+    parser.add_argument(
+        "--faults",
+        metavar="NAME[,NAME]",
+        help="sensor fault profiles or inline faults (docs/faults.md); link faults are for `run`",
+    )
+    parser.add_argument(
+        "--threshold",
+        type=positive("threshold"),
+        metavar="M",
+        help="the warning threshold in metres, for the node and the judge (default: the world's)",
+    )
+    parser.add_argument(
+        "--status-regex",
+        metavar="REGEX",
+        help="parse the status with this regex (named groups distance, angle)",
+    )
+    add_node_options(
+        parser, "node under test (default: none; a node started elsewhere is judged too)"
+    )
+
+
+def run(args: argparse.Namespace, console: Console) -> int:
+    from harness.commands.arguments import check_status_regex, fault_list
+    from harness.live.session import LiveSession, LiveSettings
+    from harness.live.world import resolve_world
+    from harness.runner.settings import RunSettings
+
+    if args.realtime:
+        raise ConfigError("--realtime: a live session always runs in real time (see --rate)")
+    args.timeout = 1.0  # read by the shared option checks; a live session has no deadline
+    check_status_regex(args)
+    check_output_file("--record", args.record)
+    options = replace(link_options(args), domain_id=_domain(args.domain_id))
+    scenario = resolve_world(args.world)
+    node = bool(args.node or args.package or args.executable)
+    settings = LiveSettings(
+        rate=args.rate,
+        duration=args.duration,
+        node=node,
+        run=RunSettings(
+            seed=args.seed,
+            threshold=args.threshold,
+            faults=fault_list(args.faults),
+            status_pattern=args.status_regex,
+        ),
+    )
+
+    def ready(domain: int) -> None:
+        reach = "this machine" if not options.ros_network else "the network"
+        console.print(
+            f"{scenario.name} is live on ROS_DOMAIN_ID={domain} ({reach}): /cmd_vel in; "
+            "/scan, /odom, /clock out. Ctrl-C ends it.",
+            highlight=False,
+        )
+
+    session = LiveSession(scenario, options, settings, on_ready=ready)
+    result = session.run()
+    _summary(console, session, result)
+    if args.record and result is not None:
+        from harness.record.writer import write_recording
+
+        write_recording(args.record, result)
+        console.print(f"recording: {args.record}", highlight=False)
+    return 0 if result is None or result.ok else 1
+
+
+def _domain(given_id: int | None) -> int:
+    """The session's domain: --domain-id, else the shell's ROS_DOMAIN_ID (0 if unset), so
+    the user's own ROS tools in another terminal (teleop, rviz2) see the robot."""
+    if given_id is not None:
+        return given_id
+    text = os.environ.get("ROS_DOMAIN_ID", "").strip() or "0"
+    try:
+        return domain_id(text)
+    except argparse.ArgumentTypeError as err:
+        raise ConfigError(f"ROS_DOMAIN_ID={text[:20]!r} in the environment: {err}") from None
+
+
+def _summary(console: Console, session: LiveSession, result: RunResult | None) -> None:
+    """How the session went: its speed, what it heard, and the judge's verdict."""
+    stats = session.stats
+    console.print(
+        f"{session.scenario.name}: {stats.sim_s:.1f} s simulated in {stats.wall_s:.1f} s "
+        f"({stats.real_time_factor:.2f}x real time, asked {session.settings.rate:g}x), "
+        f"{stats.scans} scans, {stats.commands} /cmd_vel commands; ended by {stats.stopped_by}",
+        highlight=False,
+    )
+    for note in session.notes:
+        console.print(f"note: {note}", highlight=False)
+    if result is None:
+        console.print("no node answered: nothing was judged", highlight=False)
+        return
+    from harness.report.terminal import print_results
+
+    print_results(console, [result])

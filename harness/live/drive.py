@@ -1,0 +1,66 @@
+"""What a /cmd_vel command becomes on the FOSSBot's wheels (pure).
+
+A differential drive cannot do everything a Twist asks: each wheel has a
+top speed. A command beyond it is scaled down whole, so the robot still
+drives the arc it was asked for (the curvature), only slower. Sideways and
+vertical parts of a Twist are ignored, as the lab's Gazebo plugin does.
+A robot that stops hearing commands stops (``CommandWatchdog``), as the
+lab's teleop expects.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+TOP_SPEED = 0.4  # m/s at the wheel rim: a sensible top speed for the v2's small gear motors
+COMMAND_TIMEOUT_S = 0.5  # no /cmd_vel for this long: the robot stops
+
+
+@dataclass(frozen=True)
+class DriveLimits:
+    """The robot's wheels: radius and track (m), each wheel's top rim speed (m/s)."""
+
+    wheel_radius: float
+    track: float
+    top_speed: float = TOP_SPEED
+
+    @property
+    def top_turn(self) -> float:
+        """rad/s when turning on the spot at top wheel speed."""
+        return 2.0 * self.top_speed / self.track
+
+    def limit(self, linear: float, angular: float) -> tuple[float, float]:
+        """The body velocity the wheels can give for a command: (m/s, rad/s).
+
+        Not finite parts count as 0 (a Twist can carry NaN); a command beyond a
+        wheel's top speed is scaled down as a whole, keeping its curvature.
+        """
+        linear = linear if math.isfinite(linear) else 0.0
+        angular = angular if math.isfinite(angular) else 0.0
+        left = linear - angular * self.track / 2.0
+        right = linear + angular * self.track / 2.0
+        fastest = max(abs(left), abs(right))
+        if fastest <= self.top_speed:
+            return linear, angular
+        scale = self.top_speed / fastest
+        return linear * scale, angular * scale
+
+
+class CommandWatchdog:
+    """The command in force: the last one heard, or a stop once they stop coming."""
+
+    def __init__(self, timeout: float = COMMAND_TIMEOUT_S) -> None:
+        self.timeout = timeout
+        self._command = (0.0, 0.0)
+        self._heard_at: float | None = None
+
+    def heard(self, linear: float, angular: float, now: float) -> None:
+        self._command = (linear, angular)
+        self._heard_at = now
+
+    def command(self, now: float) -> tuple[float, float]:
+        """(m/s, rad/s) in force at `now` (the same clock as `heard`)."""
+        if self._heard_at is None or now - self._heard_at > self.timeout:
+            return 0.0, 0.0
+        return self._command
