@@ -22,7 +22,7 @@ from harness.errors import ConfigError
 
 if TYPE_CHECKING:
     from harness.judge.records import RunResult
-    from harness.live.session import LiveSession
+    from harness.live.session import LiveSession, LiveState
 
 NAME = "sim"
 HELP = "run a world live: drive the robot over /cmd_vel or the keyboard, watch it, judge a node"
@@ -141,8 +141,10 @@ def run(args: argparse.Namespace, console: Console) -> int:
             highlight=False,
         )
 
-    session = LiveSession(scenario, options, settings, on_ready=ready)
-    result = session.run()
+    shown = _Panel(console, judging=node)
+    session = LiveSession(scenario, options, settings, on_ready=ready, on_update=shown.update)
+    with shown:
+        result = session.run()
     _summary(console, session, result)
     if args.record and result is not None:
         from harness.record.writer import write_recording
@@ -150,6 +152,32 @@ def run(args: argparse.Namespace, console: Console) -> int:
         write_recording(args.record, result)
         console.print(f"recording: {args.record}", highlight=False)
     return 0 if result is None or result.ok else 1
+
+
+class _Panel:
+    """The live panel on a terminal (redrawn by rich a few times a second); nothing elsewhere."""
+
+    def __init__(self, console: Console, *, judging: bool) -> None:
+        from rich.live import Live
+
+        self.judging = judging
+        self._live = Live(console=console, refresh_per_second=4) if console.is_terminal else None
+
+    def update(self, state: LiveState) -> None:
+        if self._live is not None:
+            from harness.live.panel import panel
+
+            judging = self.judging or state.judged > 0
+            self._live.update(panel(state, judging=judging), refresh=False)
+
+    def __enter__(self) -> _Panel:
+        if self._live is not None:
+            self._live.start()
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        if self._live is not None:
+            self._live.stop()
 
 
 def _domain(given_id: int | None) -> int:

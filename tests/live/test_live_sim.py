@@ -1,0 +1,186 @@
+"""`fossbot-hil sim` for real: its own process, driven over /cmd_vel from this one, over DDS.
+
+The robot must move as the physics says: forward while commanded (the
+nearest return falls as it nears the wall), stopped half a second after
+the commands stop, and stopped by the wall however long it is pushed.
+The live judge passes the reference node and catches a node that reports
+its angle in degrees.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import signal
+import subprocess
+import sys
+import time
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass, field
+
+import pytest
+from command_line import COMMAND, fossbot_hil
+
+pytestmark = [pytest.mark.ros, pytest.mark.slow, pytest.mark.timeout(120)]
+
+WALL_FACE_X = 1.95  # single_wall: the wall's centre line is x = 2.0, 0.1 m thick
+SIM_SECONDS = 40.0  # long enough for every step below; the test ends it with Ctrl-C
+
+
+@dataclass
+class Seen:
+    """What the test process heard from the simulator."""
+
+    odom: list[tuple[float, float, float]] = field(default_factory=list)  # (when, x, speed)
+    nearest: list[float] = field(default_factory=list)  # each scan's nearest finite return
+
+
+def _nearest(ranges: list[float]) -> float:
+    return min((r for r in ranges if math.isfinite(r)), default=math.inf)
+
+
+@pytest.fixture
+def driver() -> Iterator[tuple[subprocess.Popen[str], Callable[..., None], Seen]]:
+    """A running `fossbot-hil sim single_wall` and a way to drive it and hear it."""
+    import rclpy
+    from geometry_msgs.msg import Twist
+    from nav_msgs.msg import Odometry
+    from rclpy.context import Context
+    from rclpy.executors import SingleThreadedExecutor
+    from sensor_msgs.msg import LaserScan
+
+    from harness.ros.domain import discovery_environment, reserve_domain
+
+    with reserve_domain() as domain:
+        sim = subprocess.Popen(
+            [*COMMAND, "sim", "single_wall", "--duration", str(SIM_SECONDS)]
+            + ["--foxglove-port", "off", "--domain-id", str(domain.domain_id)],
+            stdout=subprocess.PIPE,
+            stderr=subprocess.STDOUT,
+            text=True,
+            env={**os.environ, **discovery_environment(network=False)},
+        )
+        context = Context()
+        rclpy.init(context=context, domain_id=domain.domain_id)
+        node = rclpy.create_node("test_driver", context=context)
+        seen = Seen()
+        node.create_subscription(
+            Odometry,
+            "/odom",
+            lambda m: seen.odom.append(
+                (time.monotonic(), m.pose.pose.position.x, m.twist.twist.linear.x)
+            ),
+            50,
+        )
+        node.create_subscription(
+            LaserScan,
+            "/scan",
+            lambda m: seen.nearest.append(
+                min((r for r in m.ranges if math.isfinite(r)), default=math.inf)
+            ),
+            50,
+        )
+        cmd = node.create_publisher(Twist, "/cmd_vel", 10)
+        executor = SingleThreadedExecutor(context=context)
+        executor.add_node(node)
+
+        def drive(
+            linear: float, seconds: float, *, until: Callable[[], bool] | None = None
+        ) -> None:
+            """Publish `linear` at 20 Hz (none when None) for `seconds`, hearing all the while."""
+            end = time.monotonic() + seconds
+            due = 0.0
+            while time.monotonic() < end and not (until and until()):
+                assert sim.poll() is None, sim.stdout.read() if sim.stdout else ""
+                if linear is not None and time.monotonic() >= due:
+                    twist = Twist()
+                    twist.linear.x = linear
+                    cmd.publish(twist)
+                    due = time.monotonic() + 0.05
+                executor.spin_once(timeout_sec=0.01)
+
+        try:
+            yield sim, drive, seen
+        finally:
+            if sim.poll() is None:
+                sim.send_signal(signal.SIGINT)
+            try:
+                sim.wait(timeout=20)
+            finally:
+                if sim.poll() is None:
+                    sim.kill()
+            executor.shutdown()
+            node.destroy_node()
+            rclpy.shutdown(context=context)
+
+
+def test_cmd_vel_drives_the_robot_and_the_wall_stops_it(driver) -> None:
+    sim, drive, seen = driver
+    drive(None, 20.0, until=lambda: len(seen.odom) > 5)  # the simulator is up
+    assert seen.odom, "no /odom within 20 s"
+    x0, near0 = seen.odom[-1][1], seen.nearest[-1]
+
+    drive(0.3, 2.0)
+    x1 = seen.odom[-1][1]
+    assert x1 - x0 > 0.3, f"0.3 m/s for 2 s moved the robot {x1 - x0:.3f} m"
+    assert seen.nearest[-1] < near0 - 0.3, (near0, seen.nearest[-1])
+
+    drive(None, 1.0)  # no commands: stopped after about half a second
+    resting = [x for when, x, _ in seen.odom if when > time.monotonic() - 0.3]
+    assert resting and max(resting) - min(resting) < 0.005, resting
+    assert abs(seen.odom[-1][2]) < 0.01
+
+    drive(1.0, 10.0)  # flat out at the wall, for longer than it takes to reach it
+    x_end = max(x for _, x, _ in seen.odom)
+    assert x_end < WALL_FACE_X, f"the robot went through the wall: x = {x_end:.3f}"
+    assert seen.nearest[-1] < 0.25, "the robot stopped short of the wall"
+    assert min(seen.nearest) > 0.0
+
+    sim.send_signal(signal.SIGINT)  # Ctrl-C is the normal end
+    out, _ = sim.communicate(timeout=20)
+    assert sim.returncode == 0, out
+    assert "ended by Ctrl-C" in out and "/cmd_vel commands" in out
+
+
+@pytest.mark.parametrize(
+    "node, code, says",
+    [
+        (f"{sys.executable} -m harness.reference.lidar_node", 0, "PASS"),
+        (f"{sys.executable} tests/ros/student_node.py angle_in_degrees", 1, "looks like degrees"),
+    ],
+    ids=["reference", "degrees"],
+)
+def test_the_live_judge_passes_a_right_node_and_explains_a_wrong_one(
+    node: str, code: int, says: str
+) -> None:
+    done = fossbot_hil(
+        "sim",
+        "obstacle_at_side",
+        "--duration",
+        "2",
+        "--foxglove-port",
+        "off",
+        "--node",
+        node,
+        timeout=90,
+    )
+    assert done.returncode == code, done.stdout + done.stderr
+    assert says in done.stdout
+    assert "live" in done.stdout  # the table's link column
+
+
+@pytest.mark.parametrize(
+    "args, message",
+    [
+        (["--rate", "0"], "--rate"),
+        (["--foxglove-port", "70000"], "1-65535"),
+        (["no_such_world"], "unknown world 'no_such_world'"),
+        (["--realtime"], "--realtime"),
+        (["--faults", "drop(rate=0.1)"], "link faults apply to `run`"),
+    ],
+)
+def test_bad_input_is_one_line_and_exit_2(args: list[str], message: str) -> None:
+    done = fossbot_hil("sim", "--duration", "1", "--foxglove-port", "off", *args, timeout=60)
+    assert done.returncode == 2, done.stdout + done.stderr
+    lines = done.stderr.strip().splitlines()
+    assert len(lines) == 1 and message in lines[0], done.stderr
