@@ -4,8 +4,9 @@ from __future__ import annotations
 
 import argparse
 import os
+from contextlib import AbstractContextManager, nullcontext
 from dataclasses import replace
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from rich.console import Console
 
@@ -142,8 +143,16 @@ def run(args: argparse.Namespace, console: Console) -> int:
         )
 
     shown = _Panel(console, judging=node)
-    session = LiveSession(scenario, options, settings, on_ready=ready, on_update=shown.update)
-    with shown:
+    with _keys(args.teleop) as keys, shown:
+        session = LiveSession(
+            scenario,
+            options,
+            settings,
+            on_ready=ready,
+            on_update=shown.update,
+            keys=keys,
+            show=lambda line: console.print(line, highlight=False, markup=False),
+        )
         result = session.run()
     _summary(console, session, result)
     if args.record and result is not None:
@@ -152,6 +161,15 @@ def run(args: argparse.Namespace, console: Console) -> int:
         write_recording(args.record, result)
         console.print(f"recording: {args.record}", highlight=False)
     return 0 if result is None or result.ok else 1
+
+
+def _keys(teleop: bool) -> AbstractContextManager[Any]:
+    """The terminal's keys for --teleop (ConfigError when there is no terminal), or none."""
+    if not teleop:
+        return nullcontext(None)
+    from harness.live.teleop import KeyReader
+
+    return KeyReader()
 
 
 class _Panel:
@@ -199,6 +217,11 @@ def _summary(console: Console, session: LiveSession, result: RunResult | None) -
         f"{session.scenario.name}: {stats.sim_s:.1f} s simulated in {stats.wall_s:.1f} s "
         f"({stats.real_time_factor:.2f}x real time, asked {session.settings.rate:g}x), "
         f"{stats.scans} scans, {stats.commands} /cmd_vel commands; ended by {stats.stopped_by}",
+        highlight=False,
+    )
+    pose = session.state.pose
+    console.print(
+        f"the robot ended at x {pose.x:.2f} m, y {pose.y:.2f} m, yaw {pose.yaw:.2f} rad",
         highlight=False,
     )
     for note in session.notes:

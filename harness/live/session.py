@@ -101,7 +101,8 @@ class LiveSession:
         on_update: Hook | None = None,
         on_ready: Callable[[int], None] | None = None,
         view: Any = None,
-        keyboard: Any = None,
+        keys: Any = None,
+        show: Callable[[str], None] = print,
     ) -> None:
         if not settings.rate > 0 or not math.isfinite(settings.rate):
             raise ConfigError(f"--rate must be a positive number, got {settings.rate}")
@@ -115,7 +116,8 @@ class LiveSession:
         self.on_update = on_update
         self.on_ready = on_ready  # told the ROS domain once the world runs (and the node is up)
         self.view = view  # publish_pose / publish_scan / publish_answer, or None
-        self.keyboard = keyboard  # poll(now) -> (linear, angular) | None, or None
+        self.keys = keys  # a teleop.KeyReader to drive with, or None
+        self.show = show  # where the keyboard's help and speed lines go
         self.state = LiveState()
         self.stats = LiveStats()
         self.notes: list[str] = []
@@ -208,6 +210,7 @@ class LiveSession:
         if bridge.tf_missing:
             self.notes.append(bridge.tf_missing)
         watchdog = CommandWatchdog()
+        keyboard = self._keyboard(world)
         spec, rate, duration = world.spec, self.settings.rate, self.settings.duration
         # Scans fall on the physics step nearest their time (within 1/480 s).
         tick, scan_step = 0, 0
@@ -227,7 +230,7 @@ class LiveSession:
                 _check_node(link, self.stats)
                 if self.on_update is not None:
                     self.on_update(self.state)
-                self._follow_commands(world, bridge, watchdog)
+                self._follow_commands(world, bridge, watchdog, keyboard)
                 world.advance(_slice_steps(world.steps, scan_step))
                 self._moved(world, bridge)
         except KeyboardInterrupt:
@@ -245,11 +248,29 @@ class LiveSession:
         if not self.result.records and link is None:
             self.result = None  # nobody answered: nothing was judged
 
-    def _follow_commands(self, world: LiveWorld, bridge: Any, watchdog: CommandWatchdog) -> None:
-        """Drive with the newest command (the keyboard's too, which comes over /cmd_vel)."""
+    def _keyboard(self, world: LiveWorld) -> Any:
+        """The keyboard's teleop, within the robot's limits; None without --teleop."""
+        if self.keys is None:
+            return None
+        from harness.live.teleop import KeyboardTeleop, TeleopState
+
+        limits = world.limits
+        teleop = KeyboardTeleop(
+            self.keys, TeleopState(limits.top_speed, limits.top_turn), show=self.show
+        )
+        teleop.start()
+        return teleop
+
+    def _follow_commands(
+        self, world: LiveWorld, bridge: Any, watchdog: CommandWatchdog, keyboard: Any
+    ) -> None:
+        """Drive with the newest /cmd_vel; the keyboard's go out on /cmd_vel too, as
+        teleop_twist_keyboard's do, and come back like anyone else's."""
         now = time.perf_counter()
-        if self.keyboard is not None:
-            self.keyboard.poll(now)
+        if keyboard is not None:
+            typed = keyboard.poll(now)
+            if typed is not None:
+                bridge.publish_command(*typed)
         for command in bridge.commands():
             watchdog.heard(command.linear, command.angular, now)
             self.stats.commands += 1

@@ -184,3 +184,51 @@ def test_bad_input_is_one_line_and_exit_2(args: list[str], message: str) -> None
     assert done.returncode == 2, done.stdout + done.stderr
     lines = done.stderr.strip().splitlines()
     assert len(lines) == 1 and message in lines[0], done.stderr
+
+
+def test_teleop_drives_from_the_terminal_with_the_labs_keys() -> None:
+    """`--teleop` on a real pty: `i` drives forward (over /cmd_vel), to the wall."""
+    import os
+    import pty
+    import select
+
+    from harness.ros.domain import reserve_domain
+
+    master, slave = pty.openpty()
+    with reserve_domain() as domain:
+        sim = subprocess.Popen(
+            [*COMMAND, "sim", "single_wall", "--teleop", "--duration", "4"]
+            + ["--foxglove-port", "off", "--domain-id", str(domain.domain_id)],
+            stdin=slave,
+            stdout=slave,
+            stderr=slave,
+            start_new_session=True,
+        )
+        os.close(slave)
+        out, typed = b"", False
+        deadline = time.monotonic() + 60
+        try:
+            while time.monotonic() < deadline:
+                readable, _, _ = select.select([master], [], [], 0.1)
+                chunk = b""
+                if readable:
+                    try:
+                        chunk = os.read(master, 65536)
+                    except OSError:  # the other side closed: the command has ended
+                        break
+                    out += chunk
+                if not typed and b"is live" in out:
+                    os.write(master, b"i")
+                    typed = True
+                if not chunk and sim.poll() is not None:
+                    break
+            assert sim.wait(timeout=20) == 0, out.decode(errors="replace")
+        finally:
+            if sim.poll() is None:
+                sim.kill()
+            os.close(master)
+    text = out.decode(errors="replace")
+    assert typed, text
+    assert "speed" in text  # the keyboard's help and speed line
+    ended = text[text.index("the robot ended at x") :].split()
+    assert float(ended[5]) > 1.0, text[-500:]  # driven towards the wall at x = 2
