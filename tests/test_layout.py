@@ -13,10 +13,9 @@ import subprocess
 import sys
 from pathlib import Path
 
-import harness
-
-HARNESS = Path(harness.__file__).parent
-DOCS = HARNESS.parent / "docs" / "architecture.md"
+ROOT = Path(__file__).resolve().parents[1]  # the source tree, also where CI installs a copy
+HARNESS = ROOT / "harness"
+DOCS = ROOT / "docs" / "architecture.md"
 
 # Folders of data or of the bundled nodes, not packages of the harness's code.
 NOT_CODE = {"reference", "board_driver", "robot_models", "scenarios"}
