@@ -56,6 +56,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="write a report folder: plots, summary.json, junit.xml, index.html "
         "(see docs/reports.md)",
     )
+    parser.add_argument(
+        "--animate",
+        action="store_true",
+        help="with --out: also an animated top-down view of each scenario, "
+        "scenarios/<name>.gif (a few seconds per scenario)",
+    )
     add_node_options(parser)
     add_device_options(parser)
 
@@ -80,20 +86,39 @@ def settings_from(args: argparse.Namespace) -> RunSettings:
     )
 
 
-def open_report(out: str | None) -> ReportFolder | None:
+def open_report(out: str | None, *, animate: bool = False) -> ReportFolder | None:
     """The `--out` folder, created now so a bad path fails before anything runs."""
     if out is None:
         return None
-    from harness.report.outputs import ReportFolder
+    from harness.report.outputs import ReportFolder, artifact_writers
 
     try:
-        return ReportFolder(out)
+        return ReportFolder(out, artifact_writers(animate=animate))
     except ConfigError as err:
         raise ConfigError(f"--out {err}") from None
 
 
+def check_animate(args: argparse.Namespace) -> None:
+    """`--animate` writes into the report folder, so it needs one."""
+    if args.animate and args.out is None:
+        raise ConfigError("--animate needs --out DIR (the animations go into the report folder)")
+
+
+def scenario_of(scenarios: Sequence[Scenario]) -> Callable[[RunResult], Scenario | None]:
+    """The scenario each result ran: results come in the order of `scenarios`, one each."""
+    pending = iter(scenarios)
+
+    def lookup(result: RunResult) -> Scenario | None:
+        scenario = next(pending, None)
+        return scenario if scenario is not None and scenario.name == result.scenario else None
+
+    return lookup
+
+
 def run(args: argparse.Namespace, console: Console) -> int:
     from harness.nodes.forkserver import scope
+
+    check_animate(args)  # before a node or a fork server starts
 
     with scope():  # whatever prepare() starts stops with the command
         return _run(args, console)
@@ -117,14 +142,16 @@ def _run(args: argparse.Namespace, console: Console) -> int:
     from harness.runner.suite import run_suite
 
     check_settings(scenarios, settings_from(args))
-    report = open_report(args.out)
+    report = open_report(args.out, animate=args.animate)
+    ran = scenario_of(scenarios)
 
     with RunProgress(console, [s.name for s in scenarios]) as progress:
 
         def finished(result: RunResult) -> None:
             progress.on_result(result)
+            scenario = ran(result)
             if report is not None:
-                _write(f"--out {args.out}", report.add, result)
+                _write(f"--out {args.out}", report.add, result, scenario)
 
         interrupted: Interrupted | None = None
         try:

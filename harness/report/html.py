@@ -1,5 +1,7 @@
 """index.html: the run on one page, readable offline and from a CI artifact.
 
+Each scenario's section shows its plot and, with `--animate`, its animation.
+
 Built from summary.json's data (so the page and the file cannot disagree),
 plain HTML with inline CSS, no scripts. All text is escaped, with every
 non-printable character shown as its escape (harness.safe_text): scenario
@@ -78,14 +80,20 @@ def _section(i: int, e: Mapping[str, Any], diagnostics: str) -> list[str]:
         lines = visible(clip(diagnostics, DIAGNOSTICS_LIMIT)).rstrip().split("\n")
         tail = "\n".join(lines[-DIAGNOSTIC_LINES:])
         out.append(f"<pre>{_text(tail, DIAGNOSTICS_LIMIT)}</pre>")
-    plot = e["files"].get("plot")
-    if plot:
+    files = e["files"]
+    if files.get("plot"):
         alt = f"plot of {e['scenario']}: ranges, the node's answers and failed ticks over time"
-        out.append(
-            f'<p><a href="{_href(plot)}"><img src="{_href(plot)}" alt="{_text(alt)}" '
-            'loading="lazy"></a></p>'
-        )
+        out.append(_image(files["plot"], alt))
+    if files.get("animation"):
+        alt = f"animation of {e['scenario']}: the robot from above, its scan and the node's answers"
+        out.append(_image(files["animation"], alt))
     return out
+
+
+def _image(path: str, alt: str) -> str:
+    """An image that links to itself (loaded when scrolled to: a run may have many)."""
+    href = _href(path)
+    return f'<p><a href="{href}"><img src="{href}" alt="{_text(alt)}" loading="lazy"></a></p>'
 
 
 def index_html(summary: Mapping[str, Any], *, diagnostics: Sequence[str] = ()) -> bytes:

@@ -3,15 +3,18 @@
 Layout (docs/reports.md)::
 
     DIR/summary.json  junit.xml  index.html
-    DIR/scenarios/<name>.png  <name>.mcap  <name>.json
+    DIR/scenarios/<name>.png  <name>.mcap  <name>.json  (<name>.gif with --animate)
 
 Per-scenario artifacts come from a short list of writers, each
 ``(name, suffix, write(path, result) -> Path)``: adding a kind of file is
-one entry in ``artifact_writers``. Every file lands atomically: a writer
-writes a hidden temporary file beside the final name, which is renamed
-over it only once the writer returned, so an interrupted run never leaves
-half a file under its final name. Paths inside a report file are relative
-to the folder of that file, so the folder can be moved or archived whole.
+one entry in ``artifact_writers``. A file drawn from the scenario's world
+too (the animation) is a ``WorldArtifactWriter``, whose `write` also takes
+the Scenario; it is written when ``add`` is given one. Every file lands
+atomically: a writer writes a hidden temporary file beside the final name,
+which is renamed over it only once the writer returned, so an interrupted
+run never leaves half a file under its final name. Paths inside a report
+file are relative to the folder of that file, so the folder can be moved or
+archived whole.
 """
 
 from __future__ import annotations
@@ -21,6 +24,7 @@ import re
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from harness.atomic_write import fill_atomically, relative_path, write_atomically
 from harness.errors import ConfigError
@@ -29,10 +33,14 @@ from harness.report.folder_lock import lock_folder
 from harness.report.summary import json_bytes, run_summary, scenario_details, scenario_entry
 from harness.safe_text import DIAGNOSTICS_LIMIT, for_storage
 
+if TYPE_CHECKING:  # pydantic only when a scenario is at hand
+    from harness.scenario.schema import Scenario
+
 __all__ = [
     "ArtifactWriter",
     "ReportFolder",
     "ScenarioFiles",
+    "WorldArtifactWriter",
     "artifact_writers",
     "prepare_folder",
     "write_report",
@@ -52,18 +60,41 @@ class ArtifactWriter:
     write: Callable[[Path, RunResult], Path]
 
 
+@dataclass(frozen=True)
+class WorldArtifactWriter:
+    """A per-scenario file drawn from the run and its scenario (the world it ran in):
+    `write(path, result, scenario)`; not written for a result added without its scenario."""
+
+    name: str
+    suffix: str
+    write: Callable[[Path, RunResult, Scenario], Path]
+
+
+Writer = ArtifactWriter | WorldArtifactWriter
+
+
 def _write_plot(path: Path, result: RunResult) -> Path:
     from harness.report.plot import write_plot  # numpy now, matplotlib only when drawing
 
     return write_plot(path, result)
 
 
-def artifact_writers() -> list[ArtifactWriter]:
-    """The per-scenario artifacts, in the order they are written."""
-    return [
+def artifact_writers(*, animate: bool = False) -> list[Writer]:
+    """The per-scenario artifacts, in the order they are written; `animate` adds the
+    animated top-down view (`--animate`: seconds per scenario, so last and optional)."""
+    writers: list[Writer] = [
         ArtifactWriter("plot", ".png", _write_plot),
         ArtifactWriter("recording", ".mcap", _write_recording),
     ]
+    if animate:
+        writers.append(WorldArtifactWriter("animation", ".gif", _write_animation))
+    return writers
+
+
+def _write_animation(path: Path, result: RunResult, scenario: Scenario) -> Path:
+    from harness.report.animation import write_animation  # matplotlib only when drawing
+
+    return write_animation(result, scenario, path)
 
 
 def _write_recording(path: Path, result: RunResult) -> Path:
@@ -99,13 +130,24 @@ def _safe_stem(name: str) -> str:
     return stem[:100] or "scenario"
 
 
-def _write_via_temporary(writer: ArtifactWriter, final: Path, result: RunResult) -> Path:
+def _write_via_temporary(
+    writer: Writer, final: Path, result: RunResult, scenario: Scenario | None
+) -> Path | None:
     """Run `writer` on a hidden temporary file, then rename it to `final` (atomic).
 
     A writer that returns another path chose its own; it answers for it.
+    None: a world writer without the scenario, so nothing written.
     """
+    if isinstance(writer, ArtifactWriter):
+        write = writer.write
+        return fill_atomically(
+            final, lambda temporary: write(temporary, result), suffix=writer.suffix
+        )
+    if scenario is None:
+        return None
+    draw = writer.write
     return fill_atomically(
-        final, lambda temporary: writer.write(temporary, result), suffix=writer.suffix
+        final, lambda temporary: draw(temporary, result, scenario), suffix=writer.suffix
     )
 
 
@@ -141,7 +183,7 @@ class ReportFolder:
     second run on it is refused with a ConfigError naming this one.
     """
 
-    def __init__(self, root: str | Path, writers: Sequence[ArtifactWriter] | None = None) -> None:
+    def __init__(self, root: str | Path, writers: Sequence[Writer] | None = None) -> None:
         self.root = prepare_folder(root)
         self._lock = lock_folder(self.root, root)
         self.writers = list(writers) if writers is not None else artifact_writers()
@@ -158,8 +200,11 @@ class ReportFolder:
         self._stems.add(stem.lower())
         return stem
 
-    def add(self, result: RunResult) -> ScenarioFiles:
-        """Write this scenario's artifacts (none for a scenario with no ticks) and its JSON."""
+    def add(self, result: RunResult, scenario: Scenario | None = None) -> ScenarioFiles:
+        """Write this scenario's artifacts (none for a scenario with no ticks) and its JSON.
+
+        `scenario`, the one `result` ran, for the writers that draw its world.
+        """
         folder = self.root / SCENARIO_FOLDER
         result = stored(result)
         stem = self._stem(result.scenario)
@@ -167,7 +212,9 @@ class ReportFolder:
         if result.records:
             for writer in self.writers:
                 final = folder / f"{stem}{writer.suffix}"
-                files.paths[writer.name] = _write_via_temporary(writer, final, result)
+                written = _write_via_temporary(writer, final, result, scenario)
+                if written is not None:
+                    files.paths[writer.name] = written
         details = folder / f"{stem}.json"
         files.paths[DETAILS] = details
         names = self._names(files, relative_to=folder)
@@ -212,11 +259,15 @@ class ReportFolder:
 
 
 def write_report(
-    root: str | Path, results: Sequence[RunResult], writers: Sequence[ArtifactWriter] | None = None
+    root: str | Path,
+    results: Sequence[RunResult],
+    writers: Sequence[Writer] | None = None,
+    scenarios: Sequence[Scenario | None] = (),
 ) -> ReportFolder:
-    """The whole folder for results already at hand (the CLI adds them one by one)."""
+    """The whole folder for results already at hand (the CLI adds them one by one);
+    `scenarios[i]`, when given, is the one `results[i]` ran."""
     with ReportFolder(root, writers) as report:
-        for result in results:
-            report.add(result)
+        for i, result in enumerate(results):
+            report.add(result, scenarios[i] if i < len(scenarios) else None)
         report.finish()
     return report

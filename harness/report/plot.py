@@ -12,6 +12,7 @@ import io
 import math
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -20,10 +21,20 @@ from harness.judge.records import RunResult
 from harness.report.summary import verdict_of
 from harness.safe_text import visible
 
-__all__ = ["PlotSeries", "plot_series", "render_plot", "write_plot"]
+__all__ = ["AS_WRITTEN", "PlotSeries", "draw_text", "plot_series", "render_plot", "write_plot"]
 
 WIDTH_IN, HEIGHT_IN, DPI = 8.0, 5.0, 90  # about 720 x 450 px: a few tens of kB
 FAILED_COLOUR = "#f2b8b8"
+# matplotlib text properties for text from outside (a scenario name, a node's status):
+# mathtext off, so a "$" in it is a dollar sign, never a formula matplotlib fails to parse.
+AS_WRITTEN: dict[str, Any] = {"parse_math": False}
+
+
+def draw_text(where: Any, x: float, y: float, text: str, **style: Any) -> Any:
+    """Draw text from outside on a Figure or Axes as written: non-printable characters
+    as their escapes (`visible`), mathtext off (`AS_WRITTEN`). Returns the Text, whose
+    later `set_text` calls keep mathtext off (their text must be made `visible` too)."""
+    return where.text(x, y, visible(text), **AS_WRITTEN, **style)
 
 
 @dataclass(frozen=True)
@@ -107,7 +118,7 @@ def render_plot(series: PlotSeries) -> bytes:
     top, bottom = fig.subplots(
         2, 1, sharex=True, gridspec_kw={"height_ratios": [3, 1]}, squeeze=True
     )
-    fig.suptitle(series.title, fontsize=10, parse_math=False)  # a name may hold "$"
+    fig.suptitle(series.title, fontsize=10, **AS_WRITTEN)  # a name may hold "$"
     t = series.t
     failed_spans = _spans(t, series.failed)
     band_spans = _spans(t, np.isnan(series.warning_expected))
