@@ -24,6 +24,7 @@ from harness.errors import ConfigError
 if TYPE_CHECKING:
     from harness.judge.records import RunResult
     from harness.live.session import LiveSession, LiveState
+    from harness.scenario.schema import Scenario
 
 NAME = "sim"
 HELP = "run a world live: drive the robot over /cmd_vel or the keyboard, watch it, judge a node"
@@ -143,7 +144,13 @@ def run(args: argparse.Namespace, console: Console) -> int:
         )
 
     shown = _Panel(console, judging=node)
-    with _keys(args.teleop) as keys, shown:
+    with _view(scenario, args.foxglove_port) as view, _keys(args.teleop) as keys, shown:
+        if view is not None:
+            console.print(
+                f"Foxglove: open {view.url} in the Foxglove app (Open connection)", highlight=False
+            )
+            for note in view.notes:
+                console.print(f"note: {note}", highlight=False)
         session = LiveSession(
             scenario,
             options,
@@ -151,6 +158,7 @@ def run(args: argparse.Namespace, console: Console) -> int:
             on_ready=ready,
             on_update=shown.update,
             keys=keys,
+            view=view,
             show=lambda line: console.print(line, highlight=False, markup=False),
         )
         result = session.run()
@@ -161,6 +169,15 @@ def run(args: argparse.Namespace, console: Console) -> int:
         write_recording(args.record, result)
         console.print(f"recording: {args.record}", highlight=False)
     return 0 if result is None or result.ok else 1
+
+
+def _view(scenario: Scenario, port: int | None) -> AbstractContextManager[Any]:
+    """The Foxglove live view on `port`, or none (--foxglove-port off)."""
+    if port is None:
+        return nullcontext(None)
+    from harness.live.foxglove_view import FoxgloveView
+
+    return FoxgloveView(scenario, port=port)
 
 
 def _keys(teleop: bool) -> AbstractContextManager[Any]:

@@ -19,7 +19,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from harness.errors import ConfigError, LinkError
+from harness.errors import ConfigError, Interrupted, LinkError
 from harness.judge.oracle import Oracle
 from harness.judge.records import RunResult, TickRecord
 from harness.lidar.scan import Scan
@@ -41,6 +41,7 @@ SCAN_FRAME = Scan.frame_id  # the frame every emitted scan carries
 SLICE_STEPS = 4  # physics steps between two looks at the commands (1/60 s)
 SLICE_S = SLICE_STEPS * TIME_STEP
 FINAL_GRACE_S = 0.2  # wall seconds for the last scan's answers after the session ends
+WARM_UP_S = 2.0  # wall seconds a node may take to answer its first scan before it is judged
 
 
 @dataclass(frozen=True)
@@ -123,6 +124,7 @@ class LiveSession:
         self.notes: list[str] = []
         self.result: RunResult | None = None
         self._external = False  # a node not started by us answers: judge it
+        self._loop_started = 0.0
 
     def run(self) -> RunResult | None:
         """Run until the duration is reached, Ctrl-C, or the node stops; always clean up."""
@@ -144,6 +146,8 @@ class LiveSession:
                 if self.on_ready is not None:
                     self.on_ready(link.domain.domain_id if link is not None else domain.domain_id)
                 self._loop(world, observer, self._judge(seed), rng, link)
+        except KeyboardInterrupt as err:  # Ctrl-C or SIGTERM while starting: a normal end too
+            self.stats.stopped_by = f"{Interrupted.of(err).name} before the world ran"
         finally:
             self.stats.wall_s = time.perf_counter() - started
             if link is not None:
@@ -188,6 +192,8 @@ class LiveSession:
         return LiveJudge(oracle, self.result, on_tick=self._judged)
 
     def _judged(self, record: TickRecord) -> None:
+        if self.view is not None:
+            self.view.publish_answer(record.t, None, None, verdict=record.verdict)
         state = self.state
         state.judged += 1
         if not record.verdict.ok:
@@ -214,7 +220,7 @@ class LiveSession:
         spec, rate, duration = world.spec, self.settings.rate, self.settings.duration
         # Scans fall on the physics step nearest their time (within 1/480 s).
         tick, scan_step = 0, 0
-        started = time.perf_counter()
+        started = self._loop_started = time.perf_counter()
         self._moved(world, bridge)
         try:
             while duration is None or world.t < duration - 1e-9:
@@ -233,8 +239,8 @@ class LiveSession:
                 self._follow_commands(world, bridge, watchdog, keyboard)
                 world.advance(_slice_steps(world.steps, scan_step))
                 self._moved(world, bridge)
-        except KeyboardInterrupt:
-            self.stats.stopped_by = "Ctrl-C"
+        except KeyboardInterrupt as err:  # Ctrl-C or SIGTERM: the normal way to end
+            self.stats.stopped_by = Interrupted.of(err).name
         except LinkError as err:  # the node died: the session ends, its verdicts stand
             self.stats.stopped_by = "the node's exit"
             if self.result is not None:
@@ -305,7 +311,12 @@ class LiveSession:
     def _judging(self, observer: Observer, link: Any) -> bool:
         """Judge this scan? With a node of ours, always; else once something publishes
         the status topic (a node started by hand, `ros2 launch`), from then on."""
-        if link is not None or self._external:
+        if link is not None:
+            # As `run` warms up: from the node's first answer (a first scan can take a
+            # Python node a while), or after WARM_UP_S whether it answered or not.
+            answered = observer.heard["status"] > 0
+            return answered or time.perf_counter() - self._loop_started > WARM_UP_S
+        if self._external:
             return True
         self._external = observer.status_sub.get_publisher_count() > 0
         if self._external:
@@ -348,7 +359,9 @@ class LiveSession:
             if judge is not None and heard.kind in ("status", "warning"):
                 judge.heard(heard.kind, heard.value, heard.source_ns)  # type: ignore[arg-type]
             if self.view is not None:
-                self.view.publish_answer(self.state.t, self.state.status, self.state.warning)
+                status = str(heard.value) if heard.kind == "status" else None
+                warning = bool(heard.value) if heard.kind == "warning" else None
+                self.view.publish_answer(self.state.t, status, warning)
 
 
 def _lidar_offset(world: LiveWorld) -> Pose:

@@ -139,7 +139,7 @@ def test_cmd_vel_drives_the_robot_and_the_wall_stops_it(driver) -> None:
     sim.send_signal(signal.SIGINT)  # Ctrl-C is the normal end
     out, _ = sim.communicate(timeout=20)
     assert sim.returncode == 0, out
-    assert "ended by Ctrl-C" in out and "/cmd_vel commands" in out
+    assert "ended by SIGINT" in out and "/cmd_vel commands" in out
 
 
 @pytest.mark.parametrize(
@@ -232,3 +232,49 @@ def test_teleop_drives_from_the_terminal_with_the_labs_keys() -> None:
     assert "speed" in text  # the keyboard's help and speed line
     ended = text[text.index("the robot ended at x") :].split()
     assert float(ended[5]) > 1.0, text[-500:]  # driven towards the wall at x = 2
+
+
+def test_sim_serves_the_foxglove_view() -> None:
+    """`sim` advertises its world, scan and answers to a real Foxglove client."""
+    import asyncio
+    import json
+    import socket
+
+    import websockets
+
+    with socket.socket() as probe:  # a free port (released just before sim takes it)
+        probe.bind(("127.0.0.1", 0))
+        port = probe.getsockname()[1]
+    sim = subprocess.Popen(
+        [*COMMAND, "sim", "single_wall", "--duration", "30", "--foxglove-port", str(port)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        text=True,
+    )
+
+    async def advertised() -> set[str]:
+        deadline = time.monotonic() + 30
+        while True:  # the simulator takes a moment to come up
+            try:
+                ws = await websockets.connect(
+                    f"ws://127.0.0.1:{port}", subprotocols=["foxglove.sdk.v1"]
+                )
+                break
+            except OSError:
+                assert time.monotonic() < deadline and sim.poll() is None, "no view"
+                await asyncio.sleep(0.2)
+        topics: set[str] = set()
+        async with ws:
+            while "/world" not in topics or "/scan" not in topics:
+                message = await asyncio.wait_for(ws.recv(), 10)
+                if isinstance(message, str) and json.loads(message).get("op") == "advertise":
+                    topics |= {c["topic"] for c in json.loads(message)["channels"]}
+        return topics
+
+    try:
+        topics = asyncio.run(advertised())
+    finally:
+        sim.send_signal(signal.SIGINT)
+        out, _ = sim.communicate(timeout=20)
+    assert {"/scan", "/world", "/tf", "/lidar_status", "/obstacle_warning"} <= topics
+    assert f"ws://127.0.0.1:{port}" in out and sim.returncode == 0, out
