@@ -17,6 +17,7 @@ import sys
 import time
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import pytest
 from command_line import COMMAND, fossbot_hil
@@ -151,22 +152,18 @@ def test_cmd_vel_drives_the_robot_and_the_wall_stops_it(driver) -> None:
     ids=["reference", "degrees"],
 )
 def test_the_live_judge_passes_a_right_node_and_explains_a_wrong_one(
-    node: str, code: int, says: str
+    node: str, code: int, says: str, tmp_path: Path
 ) -> None:
+    evidence = ["--record", str(tmp_path / "s.mcap"), "--animate", str(tmp_path / "s.gif")]
     done = fossbot_hil(
-        "sim",
-        "obstacle_at_side",
-        "--duration",
-        "2",
-        "--foxglove-port",
-        "off",
-        "--node",
-        node,
-        timeout=90,
-    )
+        "sim", "obstacle_at_side", "--duration", "2", "--foxglove-port", "off", "--node", node,
+        *evidence, timeout=120,
+    )  # fmt: skip
     assert done.returncode == code, done.stdout + done.stderr
     assert says in done.stdout
     assert "live" in done.stdout  # the table's link column
+    assert (tmp_path / "s.mcap").stat().st_size > 0
+    assert (tmp_path / "s.gif").read_bytes().startswith(b"GIF8")
 
 
 @pytest.mark.parametrize(
