@@ -137,8 +137,9 @@ def add_scenario_overrides(parser: argparse.ArgumentParser) -> None:
     )
 
 
-def add_judging_options(parser: argparse.ArgumentParser) -> None:
-    """How answers are judged and waited for: threshold, status regex, timeout."""
+def add_judging_options(parser: argparse.ArgumentParser, *, deadline: bool = True) -> None:
+    """How answers are judged and waited for: threshold, status regex, and (lockstep
+    commands, `deadline`) the per-scan timeout."""
     parser.add_argument(
         "--threshold",
         type=positive("threshold"),
@@ -150,6 +151,8 @@ def add_judging_options(parser: argparse.ArgumentParser) -> None:
         metavar="REGEX",
         help="parse the status with this regex (named groups distance, angle)",
     )
+    if not deadline:
+        return
     parser.add_argument(
         "--timeout",
         type=duration("timeout"),
@@ -275,7 +278,7 @@ def link_options(args: argparse.Namespace) -> LinkOptions:
 def unchecked_link_options(args: argparse.Namespace) -> LinkOptions:
     """Link settings from the command line as given (`link_options` checks them)."""
     return LinkOptions(
-        scan_timeout=args.timeout,
+        scan_timeout=getattr(args, "timeout", LinkOptions.scan_timeout),
         ready_timeout=args.ready_timeout,
         processor=getattr(args, "processor", None),
         node=args.node,

@@ -11,6 +11,7 @@ from typing import TYPE_CHECKING, Any
 from rich.console import Console
 
 from harness.commands.arguments import (
+    add_judging_options,
     add_node_options,
     check_output_file,
     domain_id,
@@ -99,17 +100,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         metavar="NAME[,NAME]",
         help="sensor fault profiles or inline faults (docs/faults.md); link faults are for `run`",
     )
-    parser.add_argument(
-        "--threshold",
-        type=positive("threshold"),
-        metavar="M",
-        help="the warning threshold in metres, for the node and the judge (default: the world's)",
-    )
-    parser.add_argument(
-        "--status-regex",
-        metavar="REGEX",
-        help="parse the status with this regex (named groups distance, angle)",
-    )
+    add_judging_options(parser, deadline=False)  # live, nothing waits for the node
     add_node_options(
         parser, "node under test (default: none; a node started elsewhere is judged too)"
     )
@@ -123,7 +114,6 @@ def run(args: argparse.Namespace, console: Console) -> int:
 
     if args.realtime:
         raise ConfigError("--realtime: a live session always runs in real time (see --rate)")
-    args.timeout = 1.0  # read by the shared option checks; a live session has no deadline
     check_status_regex(args)
     check_output_file("--record", args.record)
     check_output_file("--animate", args.animate)
