@@ -31,14 +31,10 @@ from harness.errors import ConfigError
 from harness.judge.oracle import Expectation, Verdict
 from harness.judge.status import StatusClaim
 from harness.lidar.scan import Scan
-from harness.live import foxglove_view
-from harness.live.foxglove_view import (
-    INSTALL_HINT,
-    FoxgloveView,
-    Placement,
-    lidar_placement,
-    verdict_message,
-)
+from harness.live import foxglove_messages
+from harness.live.foxglove_messages import INSTALL_HINT, verdict_message
+from harness.live.foxglove_view import FoxgloveView
+from harness.live.robot_mount import Placement, lidar_placement
 from harness.safe_text import TEXT_LIMIT
 from harness.scenario.schema import Scenario
 
@@ -400,13 +396,13 @@ def test_close_is_idempotent_and_frees_the_port() -> None:
 
 def test_without_foxglove_sdk_the_view_names_the_extra(monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setitem(sys.modules, "foxglove", None)  # import foxglove raises ImportError
-    foxglove_view._sdk.cache_clear()
+    foxglove_messages.foxglove_sdk.cache_clear()
     try:
         with pytest.raises(ConfigError) as caught:
             FoxgloveView(scenario(), port=0)
     finally:
         monkeypatch.undo()
-        foxglove_view._sdk.cache_clear()
+        foxglove_messages.foxglove_sdk.cache_clear()
     assert str(caught.value) == INSTALL_HINT
 
 
