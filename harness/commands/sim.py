@@ -21,6 +21,7 @@ from harness.commands.arguments import (
     seed,
 )
 from harness.errors import ConfigError
+from harness.safe_text import shown
 
 if TYPE_CHECKING:
     from harness.judge.records import RunResult
@@ -83,8 +84,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--record",
         type=given("--record"),
-        metavar="FILE",
-        help="write the judged session as an MCAP recording (needs a node that answers)",
+        metavar="PATH",
+        help="write the judged session as an MCAP recording: PATH.mcap, or WORLD.mcap in the "
+        "folder PATH (needs a node that answers)",
     )
     parser.add_argument(
         "--animate",
@@ -115,6 +117,7 @@ def run(args: argparse.Namespace, console: Console) -> int:
     if args.realtime:
         raise ConfigError("--realtime: a live session always runs in real time (see --rate)")
     check_status_regex(args)
+    args.record = _recording_path(args.record, scenario_name=args.world)
     check_output_file("--record", args.record)
     check_output_file("--animate", args.animate)
     options = replace(link_options(args), domain_id=_domain(args.domain_id))
@@ -206,6 +209,20 @@ class _Panel:
     def __exit__(self, *exc: object) -> None:
         if self._live is not None:
             self._live.stop()
+
+
+def _recording_path(path: str | None, *, scenario_name: str) -> str | None:
+    """--record PATH: a .mcap file as given, else WORLD.mcap inside the folder PATH (made
+    if need be, as --out makes its folder)."""
+    if path is None or path.endswith(".mcap"):
+        return path
+    try:
+        os.makedirs(path, exist_ok=True)
+    except (OSError, ValueError) as err:
+        reason = getattr(err, "strerror", None) or err
+        raise ConfigError(f"--record {shown(path)}: cannot make this folder: {reason}") from None
+    name = os.path.basename(scenario_name).removesuffix(".yaml").removesuffix(".yml")
+    return os.path.join(path, f"{name or 'sim'}.mcap")
 
 
 def _evidence(

@@ -131,7 +131,8 @@ class LiveSession:
         run = self.settings.run
         seed = run.seed if run.seed is not None else self.scenario.seed
         rng = np.random.default_rng(seed)
-        link = create_link("ros2", self.options) if self.settings.node else None
+        # The ros2 link starts the node, waits for it and explains what goes wrong.
+        link: Any = create_link("ros2", self.options) if self.settings.node else None
         domain = None
         observer: Observer | None = None
         started = time.perf_counter()
@@ -139,12 +140,12 @@ class LiveSession:
             with LiveWorld(self.scenario) as world:
                 if link is not None:
                     link.open()  # the node is up and reads /scan (bounded, explained)
-                    observer = link.observer  # type: ignore[attr-defined]
+                    observer, domain_id = link.observer, link.domain.domain_id
                 else:
                     domain = reserve_domain(self.options.domain_id)
-                    observer = self._observer(domain.domain_id)
+                    observer, domain_id = self._observer(domain.domain_id), domain.domain_id
                 if self.on_ready is not None:
-                    self.on_ready(link.domain.domain_id if link is not None else domain.domain_id)
+                    self.on_ready(domain_id)
                 self._loop(world, observer, self._judge(seed), rng, link)
         except KeyboardInterrupt as err:  # Ctrl-C or SIGTERM while starting: a normal end too
             self.stats.stopped_by = f"{Interrupted.of(err).name} before the world ran"
@@ -251,6 +252,7 @@ class LiveSession:
             self.stats.scans = tick
         self._wait_until(time.perf_counter() + FINAL_GRACE_S, observer, judge)
         judge.settle(time.time_ns(), final=True)
+        assert self.result is not None  # made with the judge
         if not self.result.records and link is None:
             self.result = None  # nobody answered: nothing was judged
 

@@ -9,6 +9,7 @@ its angle in degrees.
 
 from __future__ import annotations
 
+import contextlib
 import math
 import os
 import signal
@@ -34,6 +35,16 @@ class Seen:
 
     odom: list[tuple[float, float, float]] = field(default_factory=list)  # (when, x, speed)
     nearest: list[float] = field(default_factory=list)  # each scan's nearest finite return
+
+
+@contextlib.contextmanager
+def own_domain() -> Iterator[list[str]]:
+    """A ROS domain of the test's own, as the sim's options: sims never meet (a sim's
+    default is the shell's domain, 0, which parallel tests would share)."""
+    from harness.ros.domain import reserve_domain
+
+    with reserve_domain() as domain:
+        yield ["--domain-id", str(domain.domain_id)]
 
 
 def _nearest(ranges: list[float]) -> float:
@@ -154,15 +165,16 @@ def test_cmd_vel_drives_the_robot_and_the_wall_stops_it(driver) -> None:
 def test_the_live_judge_passes_a_right_node_and_explains_a_wrong_one(
     node: str, code: int, says: str, tmp_path: Path
 ) -> None:
-    evidence = ["--record", str(tmp_path / "s.mcap"), "--animate", str(tmp_path / "s.gif")]
-    done = fossbot_hil(
-        "sim", "obstacle_at_side", "--duration", "2", "--foxglove-port", "off", "--node", node,
-        *evidence, timeout=120,
-    )  # fmt: skip
+    evidence = ["--record", str(tmp_path / "records"), "--animate", str(tmp_path / "s.gif")]
+    with own_domain() as domain:
+        done = fossbot_hil(
+            "sim", "obstacle_at_side", "--duration", "2", "--foxglove-port", "off", "--node", node,
+            *evidence, *domain, timeout=120,
+        )  # fmt: skip
     assert done.returncode == code, done.stdout + done.stderr
     assert says in done.stdout
     assert "live" in done.stdout  # the table's link column
-    assert (tmp_path / "s.mcap").stat().st_size > 0
+    assert (tmp_path / "records" / "obstacle_at_side.mcap").stat().st_size > 0
     assert (tmp_path / "s.gif").read_bytes().startswith(b"GIF8")
 
 
@@ -173,11 +185,15 @@ def test_the_live_judge_passes_a_right_node_and_explains_a_wrong_one(
         (["--foxglove-port", "70000"], "1-65535"),
         (["no_such_world"], "unknown world 'no_such_world'"),
         (["--realtime"], "--realtime"),
+        (["--record", "/proc/version/x"], "--record /proc/version/x: cannot make this folder"),
         (["--faults", "drop(rate=0.1)"], "link faults apply to `run`"),
     ],
 )
 def test_bad_input_is_one_line_and_exit_2(args: list[str], message: str) -> None:
-    done = fossbot_hil("sim", "--duration", "1", "--foxglove-port", "off", *args, timeout=60)
+    with own_domain() as domain:
+        done = fossbot_hil(
+            "sim", "--duration", "1", "--foxglove-port", "off", *domain, *args, timeout=60
+        )
     assert done.returncode == 2, done.stdout + done.stderr
     lines = done.stderr.strip().splitlines()
     assert len(lines) == 1 and message in lines[0], done.stderr
@@ -242,14 +258,8 @@ def test_sim_serves_the_foxglove_view() -> None:
     with socket.socket() as probe:  # a free port (released just before sim takes it)
         probe.bind(("127.0.0.1", 0))
         port = probe.getsockname()[1]
-    sim = subprocess.Popen(
-        [*COMMAND, "sim", "single_wall", "--duration", "30", "--foxglove-port", str(port)],
-        stdout=subprocess.PIPE,
-        stderr=subprocess.STDOUT,
-        text=True,
-    )
 
-    async def advertised() -> set[str]:
+    async def advertised(sim: subprocess.Popen[str]) -> set[str]:
         deadline = time.monotonic() + 30
         while True:  # the simulator takes a moment to come up
             try:
@@ -268,10 +278,18 @@ def test_sim_serves_the_foxglove_view() -> None:
                     topics |= {c["topic"] for c in json.loads(message)["channels"]}
         return topics
 
-    try:
-        topics = asyncio.run(advertised())
-    finally:
-        sim.send_signal(signal.SIGINT)
-        out, _ = sim.communicate(timeout=20)
+    with own_domain() as domain:
+        sim = subprocess.Popen(
+            [*COMMAND, "sim", "single_wall", "--duration", "30", "--foxglove-port", str(port)]
+            + domain,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.STDOUT,
+            text=True,
+        )
+        try:
+            topics = asyncio.run(advertised(sim))
+        finally:
+            sim.send_signal(signal.SIGINT)
+            out, _ = sim.communicate(timeout=20)
     assert {"/scan", "/world", "/tf", "/lidar_status", "/obstacle_warning"} <= topics
     assert f"ws://127.0.0.1:{port}" in out and sim.returncode == 0, out
