@@ -25,13 +25,13 @@ GROUND = {"__init__", "errors", "safe_text", "holder_lock", "atomic_write"}
 
 # Bottom to top; a package imports only from layers below its own.
 LAYERS: list[set[str]] = [
-    {"lidar", "nodes", "serial_line"},
+    {"lidar", "nodes", "serial_line", "cluster"},
     {"faults", "devices", "ros"},
     {"scenario", "judge"},
     {"sim", "record"},
     {"links", "report"},
     {"runner"},
-    {"bench", "grading", "live"},
+    {"bench", "grading", "live", "campaign"},
     {"commands"},
     {"pytest_plugin", "cli"},
 ]

@@ -18,6 +18,7 @@ COMMAND_MODULES = (
     "emulate",
     "replay",
     "grade",
+    "sweep",
     "bench",
 )
 

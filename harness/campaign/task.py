@@ -1,0 +1,52 @@
+"""One campaign run, as a Dask task: it runs on a worker and returns its row.
+
+Everything it needs travels with it (the run's levels and the node
+options), so any worker on any machine can take it; the link starts the
+node in its own process group and ROS domain there, and the run is bounded
+by the scenario's own deadlines, so a hanging node ends the run, not the
+campaign.
+"""
+
+from __future__ import annotations
+
+import os
+import socket
+import time
+from dataclasses import replace
+from typing import Any
+
+from harness.campaign.plan import SCENARIO_FAULTS, RunSpec
+from harness.links.base import LinkOptions
+from harness.safe_text import clip, for_csv
+
+FAILURE_CHARS = 500  # of the first failure kept in the table
+
+
+def run_one(spec: RunSpec, link_name: str, options: LinkOptions) -> dict[str, Any]:
+    """Run `spec` through a fresh link and return its results row."""
+    from harness.faults.sensor import split_fault_text
+    from harness.runner.scenario_run import run
+    from harness.runner.settings import RunSettings
+    from harness.scenario.files import resolve_scenario
+
+    started = time.perf_counter()
+    try:
+        scenario = resolve_scenario(spec.scenario)
+        faults = None if spec.faults == SCENARIO_FAULTS else split_fault_text(spec.faults)
+        settings = RunSettings(seed=spec.seed, threshold=spec.threshold, faults=faults)
+        result = run(scenario, link_name, replace(options), settings)
+    except Exception as err:  # a run that could not be made is a result, not a lost task
+        verdict, ticks, failed, failure = "ERROR", 0, 0, f"{type(err).__name__}: {err}"
+    else:
+        verdict = "PASS" if result.ok else ("ERROR" if result.error else "FAIL")
+        ticks, failed = len(result.records), len(result.failed_ticks)
+        failure = result.first_failure or result.error or ""
+    return {
+        **spec.as_row(),
+        "verdict": verdict,
+        "ticks": ticks,
+        "failed_ticks": failed,
+        "first_failure": for_csv(clip(failure, FAILURE_CHARS)).replace("\n", "\\n"),
+        "wall_s": round(time.perf_counter() - started, 3),
+        "worker": f"{socket.gethostname()}:{os.getpid()}",
+    }

@@ -1,0 +1,52 @@
+"""Opening and closing the Dask cluster a command runs its tasks on."""
+
+from __future__ import annotations
+
+import contextlib
+import os
+from collections.abc import Iterator
+from typing import Any
+
+from harness.errors import ConfigError
+
+CONNECT_TIMEOUT_S = 10  # for an external scheduler to answer
+
+
+def default_workers() -> int:
+    """One worker per core: each run keeps a core busy (simulation) beside its node."""
+    return max(1, len(os.sched_getaffinity(0)))
+
+
+@contextlib.contextmanager
+def open_client(scheduler: str | None = None, workers: int | None = None) -> Iterator[Any]:
+    """A Client on `scheduler`, or on a LocalCluster of `workers` processes that ends with it."""
+    from distributed import Client, LocalCluster
+
+    if scheduler is not None:
+        if workers is not None:
+            raise ConfigError("--workers sizes the embedded cluster; not with --scheduler")
+        try:
+            client = Client(scheduler, timeout=CONNECT_TIMEOUT_S)
+        except (OSError, TimeoutError, ValueError) as err:
+            raise ConfigError(f"--scheduler {scheduler}: cannot connect: {err}") from None
+        with client:
+            yield client
+        return
+    count = workers if workers is not None else default_workers()
+    cluster = LocalCluster(
+        n_workers=count,
+        threads_per_worker=1,
+        processes=True,
+        dashboard_address=":0",  # any free port: two commands may run at once
+        silence_logs=40,  # errors only: the command reports progress itself
+    )
+    with cluster, Client(cluster) as client:
+        yield client
+
+
+def dashboard(client: Any) -> str | None:
+    """The dashboard's address, when the cluster serves one."""
+    with contextlib.suppress(Exception):
+        link = client.dashboard_link
+        return str(link) if link else None
+    return None

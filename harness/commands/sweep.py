@@ -1,0 +1,203 @@
+"""`fossbot-hil sweep`: one node through scenarios x faults x seeds x thresholds, on Dask."""
+
+from __future__ import annotations
+
+import argparse
+import math
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from rich.console import Console
+
+from harness.commands.arguments import (
+    add_link_option,
+    add_node_options,
+    check_link_options,
+    given,
+)
+from harness.errors import ConfigError
+
+if TYPE_CHECKING:
+    from harness.campaign.plan import RunSpec
+    from harness.campaign.results import ResultsTable
+    from harness.links.base import LinkOptions
+
+NAME = "sweep"
+HELP = "run one node through every combination of scenarios, faults, seeds and thresholds"
+MAX_RUNS = 100_000
+
+
+def _count(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        value = 0
+    if not 1 <= value <= 10_000:
+        raise argparse.ArgumentTypeError(f"a whole number 1..10000, got {text[:20]!r}")
+    return value
+
+
+def _names(text: str) -> list[str]:
+    names = [n.strip() for n in text.split(",") if n.strip()]
+    if not names:
+        raise argparse.ArgumentTypeError("give at least one name")
+    return names
+
+
+def _thresholds(text: str) -> list[float]:
+    values = []
+    for item in _names(text):
+        try:
+            value = float(item)
+        except ValueError:
+            value = math.nan
+        if not (math.isfinite(value) and value > 0):
+            raise argparse.ArgumentTypeError(f"a threshold is metres > 0, got {item[:20]!r}")
+        values.append(value)
+    return values
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "--scenario",
+        type=_names,
+        metavar="NAME[,NAME]",
+        help="scenarios (names or files; default: every shipped one)",
+    )
+    parser.add_argument(
+        "--faults",
+        metavar="A,B",
+        help="fault levels, one profile or inline fault each (default: each scenario's own)",
+    )
+    parser.add_argument(
+        "--seeds", type=_count, default=1, metavar="N", help="seeds 0..N-1 (default 1)"
+    )
+    parser.add_argument(
+        "--thresholds",
+        type=_thresholds,
+        metavar="M[,M]",
+        help="warning thresholds in metres (default: each scenario's own)",
+    )
+    add_link_option(parser)
+    parser.add_argument(
+        "--out",
+        type=given("--out"),
+        default="sweep",
+        metavar="DIR",
+        help="where results.csv and summary.txt go (default ./sweep)",
+    )
+    parser.add_argument(
+        "--resume", action="store_true", help="run only what DIR/results.csv does not hold yet"
+    )
+    cluster = parser.add_argument_group("where the runs run (Dask)")
+    cluster.add_argument(
+        "--scheduler",
+        type=given("--scheduler"),
+        metavar="ADDRESS",
+        help="an existing Dask scheduler, e.g. tcp://host:8786 (default: an embedded cluster)",
+    )
+    cluster.add_argument(
+        "--workers",
+        type=_count,
+        metavar="N",
+        help="worker processes of the embedded cluster (default: one per core)",
+    )
+    add_node_options(parser)
+
+
+def run(args: argparse.Namespace, console: Console) -> int:
+    from harness.campaign.factors import explain
+    from harness.campaign.plan import plan
+    from harness.campaign.results import ResultsTable
+
+    if args.scheduler is not None and args.workers is not None:
+        raise ConfigError("--workers sizes the embedded cluster; not with --scheduler")
+    if args.domain_id is not None:
+        raise ConfigError("--domain-id: every run of a sweep reserves a domain of its own")
+    options = check_link_options(args)
+    specs = plan(*_levels(args))
+    if len(specs) > MAX_RUNS:
+        raise ConfigError(f"{len(specs)} runs; at most {MAX_RUNS} in one sweep")
+    out = Path(args.out)
+    table = ResultsTable(out / "results.csv", resume=args.resume)
+    todo = [spec for spec in specs if spec.key not in table.done]
+    console.print(
+        f"sweep: {len(specs)} runs ({len(specs) - len(todo)} done already), "
+        f"results in {out / 'results.csv'}",
+        highlight=False,
+    )
+    if todo:
+        _run_all(console, todo, args, options, table)
+    wanted = {spec.key for spec in specs}
+    rows = [row for row in table.rows if row["key"] in wanted]
+    lines = explain(rows)
+    (out / "summary.txt").write_text("\n".join(lines) + "\n", encoding="utf-8")
+    for line in lines:
+        console.print(line, highlight=False, markup=False)
+    failed = sum(row["verdict"] != "PASS" for row in rows)
+    return 0 if not failed else 1
+
+
+def _levels(args: argparse.Namespace) -> tuple[list[str], list[str], list[int], list[Any]]:
+    """Each factor's levels, checked now, so a mistake exits 2 before any cluster starts."""
+    from harness.campaign.plan import SCENARIO_FAULTS
+    from harness.faults.sensor import split_fault_text
+    from harness.runner.settings import RunSettings, check_settings
+    from harness.scenario.files import resolve_scenario, shipped_scenarios
+
+    if args.scenario:
+        scenarios = [resolve_scenario(name) for name in args.scenario]
+    else:
+        scenarios = shipped_scenarios()
+    faults = split_fault_text(args.faults) if args.faults else [SCENARIO_FAULTS]
+    thresholds: list[Any] = args.thresholds or [None]
+    for level in faults:
+        items = None if level == SCENARIO_FAULTS else [level]
+        for threshold in thresholds:
+            check_settings(scenarios, RunSettings(threshold=threshold, faults=items))
+    names = list(args.scenario) if args.scenario else [s.name for s in scenarios]
+    return names, faults, list(range(args.seeds)), thresholds
+
+
+def _run_all(
+    console: Console,
+    todo: list[RunSpec],
+    args: argparse.Namespace,
+    options: LinkOptions,
+    table: ResultsTable,
+) -> None:
+    """Submit every run, write each row as it finishes, show progress."""
+    from distributed import as_completed
+    from rich.progress import (
+        BarColumn,
+        MofNCompleteColumn,
+        Progress,
+        TextColumn,
+        TimeElapsedColumn,
+        TimeRemainingColumn,
+    )
+
+    from harness.campaign.task import run_one
+    from harness.cluster.client import dashboard, open_client
+
+    with open_client(args.scheduler, args.workers) as client:
+        link = dashboard(client)
+        if link:
+            console.print(f"Dask dashboard: {link}", highlight=False)
+        futures = client.map(run_one, todo, link_name=args.link, options=options, pure=False)
+        failed = 0
+        columns = (
+            TextColumn("{task.description}"),
+            BarColumn(),
+            MofNCompleteColumn(),
+            TextColumn("{task.fields[failed]} failed"),
+            TimeElapsedColumn(),
+            TimeRemainingColumn(),
+        )
+        with Progress(*columns, console=console, transient=False) as progress:
+            task = progress.add_task("runs", total=len(todo), failed=0)
+            for future in as_completed(futures):
+                row = future.result()
+                table.add(row)
+                failed += row["verdict"] != "PASS"
+                progress.update(task, advance=1, failed=failed)

@@ -1,0 +1,140 @@
+"""`fossbot-hil sweep` on real Dask clusters: an embedded one, and one started with Dask's
+own `dask scheduler` / `dask worker` commands, one worker killed (-9) mid-sweep.
+
+Every run must be in the results exactly once, with the verdicts a one-machine
+sweep of the same seeds gives.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import csv
+import os
+import signal
+import socket
+import subprocess
+import sys
+import time
+from collections.abc import Iterator
+from pathlib import Path
+
+import pytest
+from command_line import COMMAND, fossbot_hil
+
+pytestmark = [pytest.mark.ros, pytest.mark.slow, pytest.mark.timeout(300)]
+
+DASK = [sys.executable, "-m", "distributed.cli.dask_scheduler"]
+WORKER = [sys.executable, "-m", "distributed.cli.dask_worker"]
+SWEEP = [
+    "sweep",
+    "--scenario",
+    "approach_wall,obstacle_at_side",
+    "--faults",
+    "clean,noisy",
+    "--seeds",
+    "2",
+]
+
+
+def _rows(folder: Path) -> list[dict[str, str]]:
+    with open(folder / "results.csv", encoding="utf-8", newline="") as handle:
+        return list(csv.DictReader(handle))
+
+
+def _verdicts(rows: list[dict[str, str]]) -> dict[str, tuple[str, str, str]]:
+    return {r["key"]: (r["verdict"], r["ticks"], r["failed_ticks"]) for r in rows}
+
+
+def _free_port() -> int:
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        return int(probe.getsockname()[1])
+
+
+@contextlib.contextmanager
+def _cluster(workers: int) -> Iterator[tuple[str, list[subprocess.Popen[bytes]]]]:
+    """A scheduler and `workers` single-threaded workers, without nannies (a killed
+    worker stays dead), all stopped afterwards."""
+    port = _free_port()
+    address = f"tcp://127.0.0.1:{port}"
+    quiet = {"stdout": subprocess.DEVNULL, "stderr": subprocess.DEVNULL}
+    scheduler = subprocess.Popen(
+        [*DASK, "--host", "127.0.0.1", "--port", str(port), "--dashboard-address", ":0"], **quiet
+    )
+    started = [
+        subprocess.Popen([*WORKER, address, "--nthreads", "1", "--no-nanny"], **quiet)
+        for _ in range(workers)
+    ]
+    try:
+        yield address, started
+    finally:
+        for process in [*started, scheduler]:
+            if process.poll() is None:
+                process.send_signal(signal.SIGTERM)
+        for process in [*started, scheduler]:
+            try:
+                process.wait(timeout=20)
+            except subprocess.TimeoutExpired:
+                process.kill()
+                process.wait(timeout=10)
+
+
+def test_an_external_cluster_loses_nothing_when_a_worker_is_killed(tmp_path: Path) -> None:
+    one_machine = tmp_path / "one"
+    done = fossbot_hil(*SWEEP, "--workers", "1", "--out", str(one_machine), timeout=240)
+    assert done.returncode in (0, 1), done.stdout + done.stderr
+    expected = _verdicts(_rows(one_machine))
+    assert len(expected) == 8
+
+    out = tmp_path / "cluster"
+    with _cluster(workers=2) as (address, workers):
+        sweep = subprocess.Popen(
+            [*COMMAND, *SWEEP, "--scheduler", address, "--out", str(out)],
+            stdout=subprocess.PIPE,
+            stderr=subprocess.STDOUT,
+            text=True,
+        )
+        deadline = time.monotonic() + 120
+        while time.monotonic() < deadline and sweep.poll() is None:
+            if (out / "results.csv").exists() and len(_rows(out)) >= 1:
+                os.kill(workers[0].pid, signal.SIGKILL)  # mid-sweep: the others are running
+                break
+            time.sleep(0.05)
+        output, _ = sweep.communicate(timeout=240)
+    assert sweep.returncode in (0, 1), output
+    rows = _rows(out)
+    keys = [r["key"] for r in rows]
+    assert len(keys) == len(set(keys)) == 8, output  # every run, exactly once
+    assert _verdicts(rows) == expected
+    assert (out / "summary.txt").read_text().strip()
+
+
+def test_the_embedded_cluster_resumes_what_is_missing(tmp_path: Path) -> None:
+    out = tmp_path / "sweep"
+    first = fossbot_hil(*SWEEP, "--workers", "2", "--out", str(out), timeout=240)
+    assert first.returncode in (0, 1), first.stdout + first.stderr
+    rows = _rows(out)
+    assert len(rows) == 8
+    kept = (out / "results.csv").read_text().splitlines()[:4]  # header and three rows
+    (out / "results.csv").write_text("\n".join(kept) + "\n")
+    again = fossbot_hil(*SWEEP, "--workers", "2", "--out", str(out), "--resume", timeout=240)
+    assert "(3 done already)" in again.stdout, again.stdout + again.stderr
+    assert _verdicts(_rows(out)) == _verdicts(rows)
+
+
+@pytest.mark.parametrize(
+    "args, message",
+    [
+        (["--seeds", "0"], "--seeds"),
+        (["--thresholds", "0.3,-1"], "threshold"),
+        (["--scenario", "no_such_scenario"], "unknown scenario"),
+        (["--faults", "no_such_profile"], "no_such_profile"),
+        (["--domain-id", "5"], "--domain-id"),
+        (["--workers", "2", "--scheduler", "tcp://127.0.0.1:1"], "--workers"),
+    ],
+)
+def test_bad_input_is_one_line_and_exit_2(args: list[str], message: str, tmp_path: Path) -> None:
+    done = fossbot_hil("sweep", "--out", str(tmp_path / "s"), *args, timeout=60)
+    assert done.returncode == 2, done.stdout + done.stderr
+    lines = done.stderr.strip().splitlines()
+    assert len(lines) == 1 and message in lines[0], done.stderr
