@@ -273,6 +273,12 @@ def _summary(console: Console, session: LiveSession, result: RunResult | None) -
         f"the robot ended at x {pose.x:.2f} m, y {pose.y:.2f} m, yaw {pose.yaw:.2f} rad",
         highlight=False,
     )
+    if stats.late_slices:
+        console.print(
+            f"note: {stats.late_slices} slices of 1/60 s ran late: this machine could not keep "
+            f"{session.settings.rate:g}x real time all along (try a lower --rate)",
+            highlight=False,
+        )
     for note in session.notes:
         console.print(f"note: {note}", highlight=False)
     if result is None:
