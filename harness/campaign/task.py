@@ -12,7 +12,6 @@ from __future__ import annotations
 import os
 import socket
 import time
-from dataclasses import replace
 from typing import Any
 
 from harness.campaign.plan import SCENARIO_FAULTS, RunSpec
@@ -34,7 +33,7 @@ def run_one(spec: RunSpec, link_name: str, options: LinkOptions) -> dict[str, An
         scenario = resolve_scenario(spec.scenario)
         faults = None if spec.faults == SCENARIO_FAULTS else split_fault_text(spec.faults)
         settings = RunSettings(seed=spec.seed, threshold=spec.threshold, faults=faults)
-        result = run(scenario, link_name, replace(options), settings)
+        result = run(scenario, link_name, options, settings)
     except Exception as err:  # a run that could not be made is a result, not a lost task
         verdict, ticks, failed, failure = "ERROR", 0, 0, f"{type(err).__name__}: {err}"
     else:

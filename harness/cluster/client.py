@@ -17,14 +17,19 @@ def default_workers() -> int:
     return max(1, len(os.sched_getaffinity(0)))
 
 
+def check_cluster_options(scheduler: str | None, workers: int | None) -> None:
+    """--scheduler and --workers: one cluster or the other (checked before a command starts)."""
+    if scheduler is not None and workers is not None:
+        raise ConfigError("--workers sizes the embedded cluster; not with --scheduler")
+
+
 @contextlib.contextmanager
 def open_client(scheduler: str | None = None, workers: int | None = None) -> Iterator[Any]:
     """A Client on `scheduler`, or on a LocalCluster of `workers` processes that ends with it."""
     from distributed import Client, LocalCluster
 
+    check_cluster_options(scheduler, workers)
     if scheduler is not None:
-        if workers is not None:
-            raise ConfigError("--workers sizes the embedded cluster; not with --scheduler")
         try:
             client = Client(scheduler, timeout=CONNECT_TIMEOUT_S)
         except (OSError, TimeoutError, ValueError) as err:

@@ -109,9 +109,9 @@ def run(args: argparse.Namespace, console: Console) -> int:
     from harness.campaign.factors import explain
     from harness.campaign.plan import plan
     from harness.campaign.results import ResultsTable
+    from harness.cluster.client import check_cluster_options
 
-    if args.scheduler is not None and args.workers is not None:
-        raise ConfigError("--workers sizes the embedded cluster; not with --scheduler")
+    check_cluster_options(args.scheduler, args.workers)
     if args.domain_id is not None:
         raise ConfigError("--domain-id: every run of a sweep reserves a domain of its own")
     options = check_link_options(args)

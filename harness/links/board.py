@@ -132,12 +132,12 @@ class BoardLink(Ros2Link):
             return False  # the driver has not asked for a scan yet
         return self.observer.ready()
 
-    def _node_gone(self, when: str = "") -> str | None:
+    def node_gone(self, when: str = "") -> str | None:
         if self.server is not None and self.server.error is not None:
             return f"{self.profile.name} line: {self.server.error}"
         if self.driver is not None and self.driver.returncode() is not None:
             return f"the board's LIDAR driver {self.driver.exit_summary(when)}"
-        return None if self.physical else super()._node_gone(when)
+        return None if self.physical else super().node_gone(when)
 
     def damage_line(self, damage: LineDamage) -> None:
         """Line faults: the device's revolutions reach the driver damaged from now on.
@@ -172,7 +172,7 @@ class BoardLink(Ros2Link):
 
         deadline = time.perf_counter() + max(self.options.scan_timeout, 1.0 / rate)
         while (heard := driver_scan()) is None:
-            gone = self._node_gone()
+            gone = self.node_gone()
             if gone or time.perf_counter() >= deadline:
                 missing = (
                     f"the board's driver published no {self.options.scan_topic} for this "

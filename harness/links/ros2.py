@@ -80,6 +80,20 @@ def node_parameters(options: LinkOptions) -> tuple[str, ...]:
     return params
 
 
+def harness_observer(options: LinkOptions, domain_id: int, *, publish_scans: bool) -> Observer:
+    """The harness's own ROS node in `domain_id`, on the topics and graph the options name."""
+    from harness.ros.observer import Observer  # imports rclpy
+
+    return Observer(
+        domain_id,
+        scan_topic=options.scan_topic,
+        status_topic=options.status_topic,
+        warning_topic=options.warning_topic,
+        network=options.ros_network,
+        publish_scans=publish_scans,
+    )
+
+
 @register("ros2")
 class Ros2Link(Link):
     """Drive a ROS 2 node process through its scan topic; watch status and warning."""
@@ -151,7 +165,7 @@ class Ros2Link(Link):
         deadline = time.monotonic() + opts.ready_timeout
         clock_due = 0.0  # monotonic time of the next /clock while waiting
         while not self._ready():
-            gone = self._node_gone("before it was ready")
+            gone = self.node_gone("before it was ready")
             if gone:
                 raise LinkError(gone)
             expired = time.monotonic() >= deadline
@@ -240,17 +254,7 @@ class Ros2Link(Link):
         self.process.start()
 
     def _make_observer(self, domain_id: int) -> Observer:
-        from harness.ros.observer import Observer
-
-        opts = self.options
-        return Observer(
-            domain_id,
-            scan_topic=opts.scan_topic,
-            status_topic=opts.status_topic,
-            warning_topic=opts.warning_topic,
-            network=opts.ros_network,
-            publish_scans=self.publishes_scans,
-        )
+        return harness_observer(self.options, domain_id, publish_scans=self.publishes_scans)
 
     def _ready(self) -> bool:
         assert self.observer is not None
@@ -281,7 +285,7 @@ class Ros2Link(Link):
             if outcome is None:
                 break
             if outcome != "timeout":  # it names the node (or the driver, or the line) already
-                raise LinkError(self._node_gone("while warming up") or outcome)
+                raise LinkError(self.node_gone("while warming up") or outcome)
             if time.perf_counter() >= deadline:
                 raise LinkError(
                     f"node {self.command.description} never answered a scan within "
@@ -397,8 +401,9 @@ class Ros2Link(Link):
             return 0.0
         return min(max(MIN_GRACE_S, 4 * self._bool_after_gap), self.options.scan_timeout)
 
-    def _node_gone(self, when: str = "") -> str | None:
-        """Why a process this link started is no longer running, or None if all run."""
+    def node_gone(self, when: str = "") -> str | None:
+        """Why a process this link started is no longer running, or None if all run
+        (`when` says at what point, e.g. "during the session")."""
         assert self.process is not None
         if self.process.returncode() is not None:
             return f"node {self.command.description} {self.process.exit_summary(when)}"
@@ -418,7 +423,7 @@ class Ros2Link(Link):
             now = time.perf_counter()
             timed_out = now >= end
             if timed_out or now >= self._alive_until:
-                gone = self._node_gone()
+                gone = self.node_gone()
                 if gone:
                     self.observer.drain()
                     return None if done() else gone

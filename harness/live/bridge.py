@@ -44,7 +44,7 @@ class LiveBridge:
     """/cmd_vel in; /odom, /tf and /tf_static out, on the observer's node."""
 
     def __init__(self, observer: Observer, lidar_frame: str, lidar_offset: Pose) -> None:
-        node = self._sub_node = observer.node
+        node = self._node = observer.node
         self._sub = node.create_subscription(Twist, CMD_VEL, lambda msg: None, CMD_QOS)
         self._cmd: Any = None  # a publisher of our own, for the keyboard
         self._odom = node.create_publisher(Odometry, ODOM, QOS)
@@ -76,7 +76,7 @@ class LiveBridge:
     def publish_command(self, linear: float, angular: float) -> None:
         """Publish a /cmd_vel (the keyboard's): every /cmd_vel subscriber hears it, this one too."""
         if self._cmd is None:
-            self._cmd = self._sub_node.create_publisher(Twist, CMD_VEL, CMD_QOS)
+            self._cmd = self._node.create_publisher(Twist, CMD_VEL, CMD_QOS)
         twist = Twist()
         twist.linear.x, twist.angular.z = linear, angular
         self._cmd.publish(twist)

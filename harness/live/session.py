@@ -24,6 +24,7 @@ from harness.judge.oracle import Oracle
 from harness.judge.records import RunResult, TickRecord
 from harness.lidar.scan import Scan
 from harness.links.base import LinkOptions, create_link
+from harness.links.ros2 import harness_observer
 from harness.live.drive import CommandWatchdog
 from harness.live.judge import LiveJudge
 from harness.live.world import LiveWorld
@@ -143,7 +144,8 @@ class LiveSession:
                     observer, domain_id = link.observer, link.domain.domain_id
                 else:
                     domain = reserve_domain(self.options.domain_id)
-                    observer, domain_id = self._observer(domain.domain_id), domain.domain_id
+                    domain_id = domain.domain_id
+                    observer = harness_observer(self.options, domain_id, publish_scans=True)
                 if self.on_ready is not None:
                     self.on_ready(domain_id)
                 self._loop(world, observer, self._judge(seed), rng, link)
@@ -161,18 +163,6 @@ class LiveSession:
         if self.result is not None:
             self.result.wall_s = self.stats.wall_s
         return self.result
-
-    def _observer(self, domain_id: int) -> Observer:
-        from harness.ros.observer import Observer
-
-        opts = self.options
-        return Observer(
-            domain_id,
-            scan_topic=opts.scan_topic,
-            status_topic=opts.status_topic,
-            warning_topic=opts.warning_topic,
-            network=opts.ros_network,
-        )
 
     def _judge(self, seed: int) -> LiveJudge:
         """The judge, and the result it fills (dropped at the end if nothing answered)."""
@@ -326,10 +316,11 @@ class LiveSession:
         return self._external
 
     def _scanned(self, scan: Scan, t: float) -> None:
+        """The panel's nearest valid return (REP-117, as the oracle reads it); the view's scan."""
         ranges = np.asarray(scan.ranges, dtype=np.float64)
-        finite = np.isfinite(ranges) & (ranges >= scan.range_min) & (ranges <= scan.range_max)
-        if finite.any():
-            index = int(np.argmin(np.where(finite, ranges, np.inf)))
+        valid = scan.valid_mask()
+        if valid.any():
+            index = int(np.argmin(np.where(valid, ranges, np.inf)))
             angle = scan.angle_min + index * scan.angle_increment
             self.state.nearest = (float(ranges[index]), math.remainder(angle, 2.0 * math.pi))
         else:
@@ -384,8 +375,7 @@ def _slice_steps(steps: int, scan_step: int) -> int:
 
 def _check_node(link: Any, stats: LiveStats) -> None:
     """End the session, saying how, when the node under test has exited."""
-    process = getattr(link, "process", None)
-    if process is not None and process.returncode() is not None:
+    gone = link.node_gone("during the session") if link is not None else None
+    if gone is not None:
         stats.stopped_by = "the node's exit"
-        summary = process.exit_summary("during the session")
-        raise LinkError(f"node {link.command.description} {summary}")
+        raise LinkError(gone)
