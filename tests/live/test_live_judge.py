@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from harness.faults.sensor import build_profile
 from harness.judge.oracle import Oracle
 from harness.judge.records import RunResult
 from harness.lidar.scan import Scan
@@ -17,20 +18,11 @@ AHEAD = 180  # the beam at 0 rad (angle_min is -pi)
 
 
 def _scan(nearest: float, beam: int = AHEAD) -> Scan:
+    """The scan a clean driver publishes with one return, `nearest` m away on `beam`."""
     spec = preset("gazebo")
-    ranges = np.full(spec.samples, np.inf, dtype=np.float32)
-    ranges[beam] = nearest
-    return Scan(
-        angle_min=spec.angle_min,
-        angle_max=spec.angle_max,
-        angle_increment=spec.angle_increment,
-        time_increment=spec.time_increment,
-        scan_time=spec.scan_time,
-        range_min=spec.range_min,
-        range_max=spec.range_max,
-        ranges=ranges,
-        intensities=np.zeros(spec.samples, dtype=np.float32),
-    )
+    truth = np.full(spec.samples, np.inf)
+    truth[beam] = nearest
+    return build_profile([]).emit(truth, spec, np.random.default_rng(0), stamp=0.0)
 
 
 def _judge() -> tuple[LiveJudge, RunResult]:
