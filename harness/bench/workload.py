@@ -21,7 +21,7 @@ from harness.errors import ConfigError
 from harness.faults.sensor import FaultProfile
 from harness.judge.oracle import Oracle
 from harness.runner.frames import Frame
-from harness.runner.settings import RunSettings, effective_threshold, fault_profile
+from harness.runner.settings import RunSettings, effective_seed, effective_threshold, fault_profile
 from harness.scenario.files import resolve_scenario
 from harness.scenario.schema import Scenario
 
@@ -120,7 +120,7 @@ class FrameStream:
         workload = self.workload
         tick0, t0 = 0, 0.0
         for scenario, profile in zip(workload.runs(), workload.profiles(), strict=True):
-            seed = workload.settings.seed if workload.settings.seed is not None else scenario.seed
+            seed = effective_seed(scenario, workload.settings)
             rng = np.random.default_rng(seed)
             sim: Simulation = self._timed(Simulation, scenario)
             try:

@@ -20,7 +20,6 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from harness.errors import ConfigError, Interrupted, LinkError
-from harness.judge.oracle import Oracle
 from harness.judge.records import RunResult, TickRecord
 from harness.lidar.scan import Scan
 from harness.links.base import LinkOptions, create_link
@@ -30,7 +29,7 @@ from harness.live.judge import LiveJudge
 from harness.live.world import LiveWorld
 from harness.ros.domain import reserve_domain
 from harness.runner.scenario_run import scenario_options
-from harness.runner.settings import RunSettings, effective_threshold, fault_profile
+from harness.runner.settings import RunSettings, effective_seed, fault_profile, judging
 from harness.scenario.schema import Scenario
 from harness.sim.motion import Pose
 from harness.sim.world import TIME_STEP
@@ -129,9 +128,7 @@ class LiveSession:
 
     def run(self) -> RunResult | None:
         """Run until the duration is reached, Ctrl-C, or the node stops; always clean up."""
-        run = self.settings.run
-        seed = run.seed if run.seed is not None else self.scenario.seed
-        rng = np.random.default_rng(seed)
+        rng = np.random.default_rng(effective_seed(self.scenario, self.settings.run))
         # The ros2 link starts the node, waits for it and explains what goes wrong.
         link: Any = create_link("ros2", self.options) if self.settings.node else None
         domain = None
@@ -148,7 +145,7 @@ class LiveSession:
                     observer = harness_observer(self.options, domain_id, publish_scans=True)
                 if self.on_ready is not None:
                     self.on_ready(domain_id)
-                self._loop(world, observer, self._judge(seed), rng, link)
+                self._loop(world, observer, self._judge(), rng, link)
         except KeyboardInterrupt as err:  # Ctrl-C or SIGTERM while starting: a normal end too
             self.stats.stopped_by = f"{Interrupted.of(err).name} before the world ran"
         finally:
@@ -164,22 +161,9 @@ class LiveSession:
             self.result.wall_s = self.stats.wall_s
         return self.result
 
-    def _judge(self, seed: int) -> LiveJudge:
+    def _judge(self) -> LiveJudge:
         """The judge, and the result it fills (dropped at the end if nothing answered)."""
-        threshold = effective_threshold(self.scenario, self.settings.run)
-        oracle = Oracle(
-            threshold,
-            noise_sigma=self.profile.noise_sigma,
-            status_pattern=self.settings.run.status_pattern,
-        )
-        self.result = RunResult(
-            scenario=self.scenario.name,
-            link="live",
-            seed=seed,
-            threshold=threshold,
-            faults=self.profile.name,
-            noise_sigma=self.profile.noise_sigma,
-        )
+        oracle, self.result = judging(self.scenario, "live", self.settings.run, self.profile)
         return LiveJudge(oracle, self.result, on_tick=self._judged)
 
     def _judged(self, record: TickRecord) -> None:

@@ -18,7 +18,7 @@ from harness.devices.profiles import DeviceProfile
 from harness.devices.revolution import samples_from_scan
 from harness.errors import ConfigError
 from harness.faults.link import LINE_KINDS, LineDamage, LinkFaults, scan_periods
-from harness.runner.settings import RunSettings, fault_profile
+from harness.runner.settings import RunSettings, effective_seed, fault_profile
 from harness.scenario.schema import Scenario
 
 IDLE_WAIT_S = 5.0  # after the last revolution: let the line drain
@@ -63,7 +63,7 @@ def emulate(
 
     spec = scenario.lidar_spec
     faults = fault_profile(scenario, settings)  # a mistake here opens nothing
-    seed = settings.seed if settings.seed is not None else scenario.seed
+    seed = effective_seed(scenario, settings)
     check_device_faults(faults.link)
     drift = faults.link.get("rate_drift")
     device = profile.make_device(spec.rate_hz)

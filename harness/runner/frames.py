@@ -9,7 +9,6 @@ from __future__ import annotations
 
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, replace
-from typing import TYPE_CHECKING
 
 from harness.errors import ConfigError, Interrupted, LinkError
 from harness.faults.link import (
@@ -24,9 +23,6 @@ from harness.judge.oracle import Oracle
 from harness.judge.records import RunResult, TickRecord
 from harness.lidar.scan import Scan
 from harness.links.base import Link
-
-if TYPE_CHECKING:
-    pass
 
 
 @dataclass(frozen=True)

@@ -18,12 +18,18 @@ from harness.faults.link import (
     scan_periods,
 )
 from harness.faults.sensor import FaultProfile
-from harness.judge.oracle import Oracle
 from harness.judge.records import RunResult, TickRecord
 from harness.lidar.scan import Scan
 from harness.links.base import Link, LinkOptions, create_link
 from harness.runner.frames import Frame, check_link_faults, judge_frames
-from harness.runner.settings import RunSettings, effective_threshold, fault_profile, faults_origin
+from harness.runner.settings import (
+    RunSettings,
+    effective_seed,
+    effective_threshold,
+    fault_profile,
+    faults_origin,
+    judging,
+)
 from harness.scenario.schema import Scenario
 
 if TYPE_CHECKING:
@@ -42,21 +48,10 @@ def run_scenario(
     from harness.sim.simulation import Simulation  # imports pybullet
 
     started = time.perf_counter()
-    seed = settings.seed if settings.seed is not None else scenario.seed
-    threshold = effective_threshold(scenario, settings)
     profile = fault_profile(scenario, settings)
-    oracle = Oracle(
-        threshold, noise_sigma=profile.noise_sigma, status_pattern=settings.status_pattern
-    )
+    oracle, result = judging(scenario, link.name, settings, profile)
+    seed = result.seed
     rng = np.random.default_rng(seed)
-    result = RunResult(
-        scenario=scenario.name,
-        link=link.name,
-        seed=seed,
-        threshold=threshold,
-        faults=profile.name,
-        noise_sigma=profile.noise_sigma,
-    )
     try:
         check_link_faults(profile.link, link)
     except ConfigError as err:
@@ -153,7 +148,7 @@ def not_started_as(
 ) -> Callable[[str, str], RunResult]:
     """How a scenario whose link never came up is recorded."""
     threshold = effective_threshold(scenario, settings)
-    seed = settings.seed if settings.seed is not None else scenario.seed
+    seed = effective_seed(scenario, settings)
     faults = fault_profile(scenario, settings).name
 
     def failed(reason: str, diagnostics: str) -> RunResult:

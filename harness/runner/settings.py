@@ -4,15 +4,14 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from harness.errors import ConfigError
 from harness.faults.sensor import FaultProfile, build_profile
+from harness.judge.oracle import Oracle
+from harness.judge.records import RunResult
 from harness.scenario.checks import check_run_length, threshold_problem
 from harness.scenario.schema import Scenario
-
-if TYPE_CHECKING:
-    pass
 
 
 @dataclass(frozen=True)
@@ -24,6 +23,30 @@ class RunSettings:
     faults: Sequence[str | dict[str, Any]] | None = None
     status_pattern: str | None = None
     gui: bool = False
+
+
+def effective_seed(scenario: Scenario, settings: RunSettings) -> int:
+    """The run's seed: the override, else the scenario's."""
+    return settings.seed if settings.seed is not None else scenario.seed
+
+
+def judging(
+    scenario: Scenario, link_name: str, settings: RunSettings, profile: FaultProfile
+) -> tuple[Oracle, RunResult]:
+    """The oracle for one run of `scenario`, and the empty result its verdicts go into."""
+    threshold = effective_threshold(scenario, settings)
+    oracle = Oracle(
+        threshold, noise_sigma=profile.noise_sigma, status_pattern=settings.status_pattern
+    )
+    result = RunResult(
+        scenario=scenario.name,
+        link=link_name,
+        seed=effective_seed(scenario, settings),
+        threshold=threshold,
+        faults=profile.name,
+        noise_sigma=profile.noise_sigma,
+    )
+    return oracle, result
 
 
 def effective_threshold(scenario: Scenario, settings: RunSettings) -> float:

@@ -5,7 +5,6 @@ from __future__ import annotations
 import time
 from collections.abc import Callable, Sequence
 from contextlib import AbstractContextManager, nullcontext
-from typing import TYPE_CHECKING
 
 from harness.errors import Interrupted
 from harness.judge.records import RunResult, TickRecord
@@ -21,9 +20,6 @@ from harness.runner.scenario_run import (
 )
 from harness.runner.settings import RunSettings
 from harness.scenario.schema import Scenario
-
-if TYPE_CHECKING:
-    pass
 
 
 def run_suite(
