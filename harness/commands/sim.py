@@ -117,11 +117,11 @@ def run(args: argparse.Namespace, console: Console) -> int:
     if args.realtime:
         raise ConfigError("--realtime: a live session always runs in real time (see --rate)")
     check_status_regex(args)
-    args.record = _recording_path(args.record, scenario_name=args.world)
-    check_output_file("--record", args.record)
-    check_output_file("--animate", args.animate)
     options = replace(link_options(args), domain_id=_domain(args.domain_id))
     scenario = resolve_world(args.world)
+    args.record = _recording_path(args.record, scenario.name)
+    check_output_file("--record", args.record)
+    check_output_file("--animate", args.animate)
     node = bool(args.node or args.package or args.executable)
     settings = LiveSettings(
         rate=args.rate,
@@ -211,9 +211,9 @@ class _Panel:
             self._live.stop()
 
 
-def _recording_path(path: str | None, *, scenario_name: str) -> str | None:
+def _recording_path(path: str | None, world: str) -> str | None:
     """--record PATH: a .mcap file as given, else WORLD.mcap inside the folder PATH (made
-    if need be, as --out makes its folder)."""
+    if need be, as --out makes its folder; the world's name made a safe file name)."""
     if path is None or path.endswith(".mcap"):
         return path
     try:
@@ -221,8 +221,9 @@ def _recording_path(path: str | None, *, scenario_name: str) -> str | None:
     except (OSError, ValueError) as err:
         reason = getattr(err, "strerror", None) or err
         raise ConfigError(f"--record {shown(path)}: cannot make this folder: {reason}") from None
-    name = os.path.basename(scenario_name).removesuffix(".yaml").removesuffix(".yml")
-    return os.path.join(path, f"{name or 'sim'}.mcap")
+    from harness.report.outputs import safe_stem
+
+    return os.path.join(path, f"{safe_stem(world)}.mcap")
 
 
 def _evidence(

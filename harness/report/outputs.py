@@ -124,7 +124,7 @@ def prepare_folder(path: str | Path) -> Path:
     return folder
 
 
-def _safe_stem(name: str) -> str:
+def safe_stem(name: str) -> str:
     """A scenario name as a portable file name (letters, digits, . _ -)."""
     stem = re.sub(r"[^A-Za-z0-9._-]+", "_", name).strip("._")
     return stem[:100] or "scenario"
@@ -192,7 +192,7 @@ class ReportFolder:
 
     def _stem(self, scenario: str) -> str:
         """A file stem no earlier scenario of this run took (names may repeat)."""
-        base = _safe_stem(scenario)
+        base = safe_stem(scenario)
         stem, n = base, 1
         while stem.lower() in self._stems:
             n += 1
