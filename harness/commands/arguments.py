@@ -51,6 +51,24 @@ def positive(kind: str, maximum: float = math.inf) -> Callable[[str], float]:
     return parse
 
 
+def whole_number(kind: str, low: int, high: int | None = None) -> Callable[[str], int]:
+    """A whole number from `low` (to `high`), named `kind` in the error."""
+    bounds = f">= {low}" if high is None else f"{low}..{high}"
+
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            value = low - 1
+        if value < low or (high is not None and value > high):
+            raise argparse.ArgumentTypeError(
+                f"{kind} must be a whole number {bounds}, got {text[:40]!r}"
+            )
+        return value
+
+    return parse
+
+
 def duration(kind: str) -> Callable[[str], float]:
     """Seconds to wait for something: positive, at most a day (the OS's timed waits
     overflow somewhere past 24 days; no wait of the harness needs more than a day)."""
@@ -67,14 +85,7 @@ def seed(text: str) -> int:
     return value
 
 
-def domain_id(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        value = -1
-    if not 0 <= value <= 232:
-        raise argparse.ArgumentTypeError(f"domain id must be a whole number 0..232, got {text!r}")
-    return value
+domain_id = whole_number("domain id", 0, 232)
 
 
 def param(text: str) -> str:

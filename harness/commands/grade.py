@@ -26,6 +26,7 @@ from harness.commands.arguments import (
     fault_list,
     given,
     link_options,
+    whole_number,
 )
 from harness.errors import ConfigError
 from harness.grading import LAB_EXECUTABLE, LAB_PACKAGE
@@ -48,15 +49,7 @@ NOT_FOR_GRADING = {
 }
 
 
-def jobs(text: str) -> int:
-    """--jobs: a whole number of students graded at once."""
-    try:
-        value = int(text)
-    except ValueError:
-        value = 0
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"jobs must be a whole number >= 1, got {text!r}")
-    return value
+jobs = whole_number("jobs", 1)  # --jobs: students graded at once
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

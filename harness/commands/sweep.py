@@ -14,6 +14,7 @@ from harness.commands.arguments import (
     add_node_options,
     check_link_options,
     given,
+    whole_number,
 )
 from harness.errors import ConfigError
 
@@ -25,16 +26,6 @@ if TYPE_CHECKING:
 NAME = "sweep"
 HELP = "run one node through every combination of scenarios, faults, seeds and thresholds"
 MAX_RUNS = 100_000
-
-
-def _count(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        value = 0
-    if not 1 <= value <= 10_000:
-        raise argparse.ArgumentTypeError(f"a whole number 1..10000, got {text[:20]!r}")
-    return value
 
 
 def _names(text: str) -> list[str]:
@@ -70,7 +61,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="fault levels, one profile or inline fault each (default: each scenario's own)",
     )
     parser.add_argument(
-        "--seeds", type=_count, default=1, metavar="N", help="seeds 0..N-1 (default 1)"
+        "--seeds",
+        type=whole_number("seeds", 1, 10_000),
+        default=1,
+        metavar="N",
+        help="seeds 0..N-1 (default 1)",
     )
     parser.add_argument(
         "--thresholds",
@@ -98,7 +93,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     cluster.add_argument(
         "--workers",
-        type=_count,
+        type=whole_number("workers", 1, 1_000),
         metavar="N",
         help="worker processes of the embedded cluster (default: one per core)",
     )
