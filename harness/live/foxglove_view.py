@@ -52,6 +52,7 @@ from harness.live.foxglove_messages import (
     yaw_quaternion,
 )
 from harness.live.robot_mount import robot_shape
+from harness.record.writer import RecordTopics
 from harness.safe_text import for_storage, shown
 from harness.scenario.schema import Scenario
 
@@ -64,16 +65,20 @@ WORLD_EVERY_S = 1.0  # wall-clock seconds between two sends of the world to watc
 PORT_RELEASE_S = 2.0  # how long close() waits for the port to be free again
 
 
+_RECORDED = RecordTopics()
+
+
 @dataclass(frozen=True)
 class ViewTopics:
-    """Where each stream goes; the answer topics are the lab's, as in the recordings."""
+    """Where each stream goes: the recordings' topics (a layout made for one works live),
+    and the view's own frames, log and world."""
 
-    scan: str = "/scan"
+    scan: str = _RECORDED.scan
     tf: str = "/tf"
-    pose: str = "/fossbot_hil/pose"
-    status: str = "/lidar_status"
-    warning: str = "/obstacle_warning"
-    verdict: str = "/fossbot_hil/verdict"
+    pose: str = _RECORDED.pose
+    status: str = _RECORDED.status
+    warning: str = _RECORDED.warning
+    verdict: str = _RECORDED.verdict
     log: str = "/fossbot_hil/log"  # the judge's failures, for the Log panel
     world: str = "/world"
 
