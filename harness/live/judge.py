@@ -47,7 +47,7 @@ class LiveJudge:
         self.result = result
         self.on_tick = on_tick
         self._open: list[_Sent] = []  # published, not yet judged, oldest first
-        self.unmatched = 0  # answers published before the first scan
+        self.unmatched = 0  # answers to no open scan: before the first, or to one already judged
 
     def sent(
         self, tick: int, t: float, pose: tuple[float, float, float], scan: Scan, sent_ns: int

@@ -226,6 +226,11 @@ class LiveSession:
             self.stats.scans = tick
         self._wait_until(time.perf_counter() + FINAL_GRACE_S, observer, judge)
         judge.settle(time.time_ns(), final=True)
+        if judge.unmatched:
+            self.notes.append(
+                f"{judge.unmatched} answers came for no scan still being judged (before the "
+                "first, or after their scan was judged) and were not counted"
+            )
         assert self.result is not None  # made with the judge
         if not self.result.records and link is None:
             self.result = None  # nobody answered: nothing was judged

@@ -112,6 +112,9 @@ def driver() -> Iterator[tuple[subprocess.Popen[str], Callable[..., None], Seen]
                 executor.spin_once(timeout_sec=0.01)
 
         try:
+            # Up, and hearing us: commands sent before discovery matched would be lost.
+            drive(None, 20.0, until=lambda: len(seen.odom) > 5 and cmd.get_subscription_count() > 0)
+            assert seen.odom and cmd.get_subscription_count() > 0, "the simulator never came up"
             yield sim, drive, seen
         finally:
             if sim.poll() is None:
@@ -128,8 +131,6 @@ def driver() -> Iterator[tuple[subprocess.Popen[str], Callable[..., None], Seen]
 
 def test_cmd_vel_drives_the_robot_and_the_wall_stops_it(driver) -> None:
     sim, drive, seen = driver
-    drive(None, 20.0, until=lambda: len(seen.odom) > 5)  # the simulator is up
-    assert seen.odom, "no /odom within 20 s"
     x0, near0 = seen.odom[-1][1], seen.nearest[-1]
 
     drive(0.3, 2.0)
