@@ -21,6 +21,7 @@ from harness.commands.arguments import (
     seed,
 )
 from harness.errors import ConfigError
+from harness.report.terminal import print_safe as say
 from harness.safe_text import shown
 
 if TYPE_CHECKING:
@@ -137,20 +138,18 @@ def run(args: argparse.Namespace, console: Console) -> int:
 
     def ready(domain: int) -> None:
         reach = "this machine" if not options.ros_network else "the network"
-        console.print(
+        say(
+            console,
             f"{scenario.name} is live on ROS_DOMAIN_ID={domain} ({reach}): /cmd_vel in; "
             "/scan, /odom, /clock out. Ctrl-C ends it.",
-            highlight=False,
         )
 
     shown = _Panel(console, judging=node)
     with _view(scenario, args.foxglove_port) as view, _keys(args.teleop) as keys, shown:
         if view is not None:
-            console.print(
-                f"Foxglove: open {view.url} in the Foxglove app (Open connection)", highlight=False
-            )
+            say(console, f"Foxglove: open {view.url} in the Foxglove app (Open connection)")
             for note in view.notes:
-                console.print(f"note: {note}", highlight=False)
+                say(console, f"note: {note}")
         session = LiveSession(
             scenario,
             options,
@@ -159,7 +158,7 @@ def run(args: argparse.Namespace, console: Console) -> int:
             on_update=shown.update,
             keys=keys,
             view=view,
-            show=lambda line: console.print(line, highlight=False, markup=False),
+            show=lambda line: say(console, line),
         )
         result = session.run()
     _summary(console, session, result)
@@ -234,18 +233,18 @@ def _evidence(
     if not wanted:
         return
     if result is None:
-        console.print(f"{' and '.join(wanted)}: nothing was judged, so nothing was written")
+        say(console, f"{' and '.join(wanted)}: nothing was judged, so nothing was written")
         return
     if args.record:
         from harness.record.writer import write_recording
 
         write_recording(args.record, result)
-        console.print(f"recording: {args.record}", highlight=False)
+        say(console, f"recording: {args.record}")
     if args.animate:
         from harness.report.animation import write_animation
 
         write_animation(result, scenario, args.animate)
-        console.print(f"animation: {args.animate}", highlight=False)
+        say(console, f"animation: {args.animate}")
 
 
 def _domain(given_id: int | None) -> int:
@@ -263,27 +262,24 @@ def _domain(given_id: int | None) -> int:
 def _summary(console: Console, session: LiveSession, result: RunResult | None) -> None:
     """How the session went: its speed, what it heard, and the judge's verdict."""
     stats = session.stats
-    console.print(
+    say(
+        console,
         f"{session.scenario.name}: {stats.sim_s:.1f} s simulated in {stats.wall_s:.1f} s "
         f"({stats.real_time_factor:.2f}x real time, asked {session.settings.rate:g}x), "
         f"{stats.scans} scans, {stats.commands} /cmd_vel commands; ended by {stats.stopped_by}",
-        highlight=False,
     )
     pose = session.state.pose
-    console.print(
-        f"the robot ended at x {pose.x:.2f} m, y {pose.y:.2f} m, yaw {pose.yaw:.2f} rad",
-        highlight=False,
-    )
+    say(console, f"the robot ended at x {pose.x:.2f} m, y {pose.y:.2f} m, yaw {pose.yaw:.2f} rad")
     if stats.late_slices:
-        console.print(
+        say(
+            console,
             f"note: {stats.late_slices} slices of 1/60 s ran late: this machine could not keep "
             f"{session.settings.rate:g}x real time all along (try a lower --rate)",
-            highlight=False,
         )
     for note in session.notes:
-        console.print(f"note: {note}", highlight=False)
+        say(console, f"note: {note}")
     if result is None:
-        console.print("no node answered: nothing was judged", highlight=False)
+        say(console, "no node answered: nothing was judged")
         return
     from harness.report.terminal import print_results
 

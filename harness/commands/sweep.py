@@ -17,6 +17,7 @@ from harness.commands.arguments import (
     whole_number,
 )
 from harness.errors import ConfigError
+from harness.report.terminal import print_safe as say
 
 if TYPE_CHECKING:
     from harness.campaign.plan import RunSpec
@@ -116,10 +117,10 @@ def run(args: argparse.Namespace, console: Console) -> int:
     out = Path(args.out)
     table = ResultsTable(out / "results.csv", resume=args.resume)
     todo = [spec for spec in specs if spec.key not in table.done]
-    console.print(
+    say(
+        console,
         f"sweep: {len(specs)} runs ({len(specs) - len(todo)} done already), "
         f"results in {out / 'results.csv'}",
-        highlight=False,
     )
     if todo:
         _run_all(console, todo, args, options, table)
@@ -128,7 +129,7 @@ def run(args: argparse.Namespace, console: Console) -> int:
     lines = explain(rows)
     (out / "summary.txt").write_text("\n".join(lines) + "\n", encoding="utf-8")
     for line in lines:
-        console.print(line, highlight=False, markup=False)
+        say(console, line)
     failed = sum(row["verdict"] != "PASS" for row in rows)
     return 0 if not failed else 1
 
@@ -178,7 +179,7 @@ def _run_all(
     with open_client(args.scheduler, args.workers) as client:
         link = dashboard(client)
         if link:
-            console.print(f"Dask dashboard: {link}", highlight=False)
+            say(console, f"Dask dashboard: {link}")
         futures = client.map(run_one, todo, link_name=args.link, options=options, pure=False)
         failed = 0
         columns = (

@@ -27,7 +27,9 @@ def _plain(text: object, style: str = "") -> Text:
     return Text(for_terminal(clip(str(text))), style=style)
 
 
-def _print(console: Console, text: str, *, style: str = "", limit: int | None = TEXT_LIMIT) -> None:
+def print_safe(
+    console: Console, text: str, *, style: str = "", limit: int | None = TEXT_LIMIT
+) -> None:
     """External text on the terminal: escaped, bounded (unless `limit` is None), no markup."""
     shown = for_terminal(text if limit is None else clip(text, limit))
     console.print(shown, style=style, markup=False, highlight=False, soft_wrap=True)
@@ -96,23 +98,23 @@ def print_results(
         if r.not_run:
             continue
         console.print()
-        _print(console, r.first_failure or "", style="bold red")
+        print_safe(console, r.first_failure or "", style="bold red")
         more = len(r.failed_ticks) - 1
         if more > 0:
             console.print(f"  ({more} more failed tick{'s' if more > 1 else ''})", highlight=False)
         if r.error and r.failed_ticks and r.error not in (r.first_failure or ""):
-            _print(console, f"  run ended: {r.error}")
+            print_safe(console, f"  run ended: {r.error}")
         if r.diagnostics in shown:
             console.print("  (node output as above)", highlight=False)
         elif r.diagnostics:
             shown.add(r.diagnostics)
             lines = for_terminal(clip(r.diagnostics, DIAGNOSTICS_LIMIT)).rstrip().split("\n")
-            _print(console, "  " + "\n  ".join(lines[-DIAGNOSTIC_LINES:]), limit=None)
+            print_safe(console, "  " + "\n  ".join(lines[-DIAGNOSTIC_LINES:]), limit=None)
     not_run = [r for r in failed if r.not_run]
     if not_run:
         console.print()
         reason = (not_run[0].error or "").removeprefix("not run: ")
-        _print(console, f"{len(not_run)} not run: {reason}")
+        print_safe(console, f"{len(not_run)} not run: {reason}")
     total = len(results)
     passed = total - len(failed)
     console.print()
