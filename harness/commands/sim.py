@@ -20,7 +20,7 @@ from harness.commands.arguments import (
     positive,
     seed,
 )
-from harness.errors import ConfigError
+from harness.errors import ConfigError, Interrupted
 from harness.report.terminal import print_safe as say
 from harness.safe_text import shown
 
@@ -145,22 +145,26 @@ def run(args: argparse.Namespace, console: Console) -> int:
         )
 
     shown = _Panel(console, judging=node)
-    with _view(scenario, args.foxglove_port) as view, _keys(args.teleop) as keys, shown:
-        if view is not None:
-            say(console, f"Foxglove: open {view.url} in the Foxglove app (Open connection)")
-            for note in view.notes:
-                say(console, f"note: {note}")
-        session = LiveSession(
-            scenario,
-            options,
-            settings,
-            on_ready=ready,
-            on_update=shown.update,
-            keys=keys,
-            view=view,
-            show=lambda line: say(console, line),
-        )
-        result = session.run()
+    try:
+        with _view(scenario, args.foxglove_port) as view, _keys(args.teleop) as keys, shown:
+            if view is not None:
+                say(console, f"Foxglove: open {view.url} in the Foxglove app (Open connection)")
+                for note in view.notes:
+                    say(console, f"note: {note}")
+            session = LiveSession(
+                scenario,
+                options,
+                settings,
+                on_ready=ready,
+                on_update=shown.update,
+                keys=keys,
+                view=view,
+                show=lambda line: say(console, line),
+            )
+            result = session.run()
+    except KeyboardInterrupt as err:  # while starting, before the session can end itself
+        say(console, f"stopped by {Interrupted.of(err).name} before the world ran")
+        return 0
     _summary(console, session, result)
     _evidence(console, args, scenario, result)
     return 0 if result is None or result.ok else 1

@@ -129,12 +129,13 @@ class LiveSession:
     def run(self) -> RunResult | None:
         """Run until the duration is reached, Ctrl-C, or the node stops; always clean up."""
         rng = np.random.default_rng(effective_seed(self.scenario, self.settings.run))
-        # The ros2 link starts the node, waits for it and explains what goes wrong.
-        link: Any = create_link("ros2", self.options) if self.settings.node else None
+        link: Any = None
         domain = None
         observer: Observer | None = None
         started = time.perf_counter()
         try:
+            # The ros2 link starts the node, waits for it and explains what goes wrong.
+            link = create_link("ros2", self.options) if self.settings.node else None
             with LiveWorld(self.scenario) as world:
                 if link is not None:
                     link.open()  # the node is up and reads /scan (bounded, explained)
