@@ -10,6 +10,11 @@ from typing import Any
 from harness.errors import ConfigError
 
 CONNECT_TIMEOUT_S = 10  # for an external scheduler to answer
+# Our tasks are long (a run, a student): a worker holds only the one it runs, so
+# the next goes to whichever worker frees first, and a worker that dies takes no
+# queued task down with it (Dask counts those as suspects, and gives up on a
+# task suspected `allowed-failures` + 1 times).
+ONE_TASK_PER_THREAD = 1.0
 
 
 def default_workers() -> int:
@@ -24,8 +29,16 @@ def check_cluster_options(scheduler: str | None, workers: int | None) -> None:
 
 
 @contextlib.contextmanager
-def open_client(scheduler: str | None = None, workers: int | None = None) -> Iterator[Any]:
-    """A Client on `scheduler`, or on a LocalCluster of `workers` processes that ends with it."""
+def open_client(
+    scheduler: str | None = None, workers: int | None = None, *, retries: int | None = None
+) -> Iterator[Any]:
+    """A Client on `scheduler`, or on a LocalCluster of `workers` processes that ends with it.
+
+    `retries`: how often the embedded cluster runs a task again after its
+    worker died under it (Dask's ``allowed-failures``, 3 by default); an
+    external scheduler keeps its own setting.
+    """
+    import dask
     from distributed import Client, LocalCluster
 
     check_cluster_options(scheduler, workers)
@@ -38,13 +51,17 @@ def open_client(scheduler: str | None = None, workers: int | None = None) -> Ite
             yield client
         return
     count = workers if workers is not None else default_workers()
-    cluster = LocalCluster(
-        n_workers=count,
-        threads_per_worker=1,
-        processes=True,
-        dashboard_address=":0",  # any free port: two commands may run at once
-        silence_logs=40,  # errors only: the command reports progress itself
-    )
+    limits: dict[str, float] = {"distributed.scheduler.worker-saturation": ONE_TASK_PER_THREAD}
+    if retries is not None:
+        limits["distributed.scheduler.allowed-failures"] = retries
+    with dask.config.set(limits):  # read by the scheduler, which starts here
+        cluster = LocalCluster(
+            n_workers=count,
+            threads_per_worker=1,
+            processes=True,
+            dashboard_address=":0",  # any free port: two commands may run at once
+            silence_logs=40,  # errors only: the command reports progress itself
+        )
     with cluster, Client(cluster) as client:
         yield client
 

@@ -26,8 +26,8 @@ from harness.commands.arguments import (
     fault_list,
     given,
     link_options,
-    whole_number,
 )
+from harness.commands.cluster_options import add_cluster_options, describe_cluster, workers
 from harness.errors import ConfigError
 from harness.grading import LAB_EXECUTABLE, LAB_PACKAGE
 from harness.grading.discover import GRADES_MARKER, Student
@@ -49,9 +49,6 @@ NOT_FOR_GRADING = {
 }
 
 
-jobs = whole_number("jobs", 1)  # --jobs: students graded at once
-
-
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "dirs",
@@ -66,12 +63,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         metavar="DIR",
         help="where the class table and each student's logs go (default: grades)",
     )
-    parser.add_argument(
-        "--jobs",
-        type=jobs,
-        default=1,
-        metavar="N",
-        help="students graded at once (default 1)",
+    parser.add_argument(  # the name before grading ran on Dask; kept so scripts still work
+        "--jobs", dest="workers", type=workers, help=argparse.SUPPRESS
     )
     parser.add_argument(
         "--scenario",
@@ -97,6 +90,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         metavar="S",
         help="longest one student's scenario suite may take (default 900)",
     )
+    add_cluster_options(parser, unit="students")
     add_node_options(parser)
     _adapt_node_options(parser)
 
@@ -192,15 +186,22 @@ def _progress(console: Console, student: Student, grade: object) -> None:
     console.print(f"  {name}: {', '.join(parts)}", markup=False, highlight=False)
 
 
+def _show_dashboard(console: Console, link: str | None) -> None:
+    if link:
+        console.print(f"Dask dashboard: {link}", markup=False, highlight=False)
+
+
 def run(args: argparse.Namespace, console: Console) -> int:
     from harness.atomic_write import write_atomically
+    from harness.cluster.client import check_cluster_options, dashboard, open_client
     from harness.grading.build import colcon_executable
     from harness.grading.class_table import class_csv, class_html, class_rich_table
     from harness.grading.discover import discover
-    from harness.grading.grade import GradeConfig, grade_class
+    from harness.grading.grade import WORKER_RETRIES, GradeConfig, grade_class
     from harness.runner.settings import RunSettings, check_settings
 
     check_grading_options(args)
+    check_cluster_options(args.scheduler, args.workers)
     options = link_options(args)  # topics and parameters: refused now, before any folder
     scenarios = selected_scenarios(args.scenario)
     settings = RunSettings(
@@ -220,7 +221,10 @@ def run(args: argparse.Namespace, console: Console) -> int:
         raise ConfigError(
             "grading needs rclpy: pip install 'fossbot-hil[ros]' (or source ROS 2 Jazzy)"
         )
-    with prepare_out(out):  # the folder is this grade's until it is done
+    with (
+        open_client(args.scheduler, args.workers, retries=WORKER_RETRIES) as client,
+        prepare_out(out),  # the folder is this grade's until it is done
+    ):
         names = tuple(s.name for s in scenarios)
         config = GradeConfig(
             scenarios=names,
@@ -237,15 +241,17 @@ def run(args: argparse.Namespace, console: Console) -> int:
         count = len(found.students)
         console.print(
             f"grading {count} student{'s' if count != 1 else ''} on {len(names)} scenario"
-            f"{'s' if len(names) != 1 else ''} over {args.link}, {args.jobs} at a time, into {out}",
+            f"{'s' if len(names) != 1 else ''} over {args.link} "
+            f"{describe_cluster(args.scheduler, args.workers)}, into {out}",
             markup=False,
             highlight=False,
         )
+        _show_dashboard(console, dashboard(client))
         started = time.monotonic()
         grades = grade_class(
             found.students,
             config,
-            jobs=args.jobs,
+            client,
             on_graded=lambda student, grade: _progress(console, student, grade),
         )
         wall_s = time.monotonic() - started

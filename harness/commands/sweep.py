@@ -16,6 +16,7 @@ from harness.commands.arguments import (
     given,
     whole_number,
 )
+from harness.commands.cluster_options import add_cluster_options
 from harness.errors import ConfigError
 from harness.report.terminal import print_safe as say
 
@@ -85,19 +86,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--resume", action="store_true", help="run only what DIR/results.csv does not hold yet"
     )
-    cluster = parser.add_argument_group("where the runs run (Dask)")
-    cluster.add_argument(
-        "--scheduler",
-        type=given("--scheduler"),
-        metavar="ADDRESS",
-        help="an existing Dask scheduler, e.g. tcp://host:8786 (default: an embedded cluster)",
-    )
-    cluster.add_argument(
-        "--workers",
-        type=whole_number("workers", 1, 1_000),
-        metavar="N",
-        help="worker processes of the embedded cluster (default: one per core)",
-    )
+    add_cluster_options(parser)
     add_node_options(parser)
 
 

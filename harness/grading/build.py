@@ -10,13 +10,12 @@ from __future__ import annotations
 import re
 import shutil
 import sys
-import threading
 from dataclasses import dataclass
 from pathlib import Path
 
 from harness.errors import ConfigError
 from harness.grading.discover import Student
-from harness.grading.process import Finished, run_bounded
+from harness.grading.process import Finished, StopFlag, run_bounded
 
 __all__ = ["BuildResult", "build_student", "build_error", "colcon_command"]
 
@@ -175,7 +174,7 @@ def build_student(
     executable: str,
     log: Path,
     timeout: float,
-    cancel: threading.Event | None = None,
+    cancel: StopFlag | None = None,
 ) -> BuildResult:
     """Build `student` into `workspace` (wiped first), logging colcon's output to `log`."""
     shutil.rmtree(workspace, ignore_errors=True)

@@ -3,20 +3,23 @@
 Every step of a student is bounded (build and suite time limits, log size
 limits) and runs in a child process, and any failure of one student,
 including a bug of ours while grading them, becomes that student's row:
-it never stops the others. Students are graded ``jobs`` at a time; each
-suite reserves its own ROS domain, so parallel runs never hear each other.
+it never stops the others. Each student is one task on a Dask cluster
+(harness.cluster: embedded, or the user's), one student per worker at a
+time; each suite reserves its own ROS domain on its host, so parallel runs
+never hear each other.
 """
 
 from __future__ import annotations
 
+import contextlib
 import json
 import shlex
 import shutil
 import sys
 import threading
 import traceback
+import uuid
 from collections.abc import Callable, Sequence
-from concurrent.futures import FIRST_COMPLETED, Future, ThreadPoolExecutor, wait
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
@@ -25,7 +28,7 @@ from harness.atomic_write import write_atomically
 from harness.grading.build import build_student
 from harness.grading.class_table import ERROR, NOT_RUN, PASS, StudentGrade
 from harness.grading.discover import Student
-from harness.grading.process import Finished, run_bounded
+from harness.grading.process import TERM_GRACE_S, Finished, StopFlag, run_bounded
 from harness.grading.worker import write_job
 from harness.judge.records import RunResult
 from harness.links.base import LinkOptions
@@ -34,6 +37,8 @@ from harness.runner.settings import RunSettings
 __all__ = ["GradeConfig", "grade_class", "grade_student"]
 
 MAX_RUN_LOG_BYTES = 20 * 1024 * 1024
+WORKER_RETRIES = 1  # a student is graded again once if their worker died under them
+STOP_WAIT_S = TERM_GRACE_S + 15.0  # on Ctrl-C: for running students to stop their children
 ARTIFACTS = (("build log", "build.log"), ("run log", "run.log"), ("JUnit", "junit.xml"))
 
 
@@ -142,7 +147,7 @@ def _run_options(student: Student, config: GradeConfig, folder: Path) -> LinkOpt
     return replace(config.options, node=None, workspace=str(folder / "colcon"))
 
 
-def _grade(student: Student, config: GradeConfig, cancel: threading.Event) -> StudentGrade:
+def _grade(student: Student, config: GradeConfig, cancel: StopFlag) -> StudentGrade:
     folder = config.students_dir / student.slug
     shutil.rmtree(folder, ignore_errors=True)
     folder.mkdir(parents=True)
@@ -203,7 +208,7 @@ def _grade(student: Student, config: GradeConfig, cancel: threading.Event) -> St
 
 
 def grade_student(
-    student: Student, config: GradeConfig, cancel: threading.Event | None = None
+    student: Student, config: GradeConfig, cancel: StopFlag | None = None
 ) -> StudentGrade:
     """One student's row; a bug of ours while grading them is their row too, not a crash."""
     cancel = cancel or threading.Event()
@@ -222,32 +227,71 @@ def grade_student(
 def grade_class(
     students: Sequence[Student],
     config: GradeConfig,
+    client: Any,
     *,
-    jobs: int = 1,
     on_graded: Callable[[Student, StudentGrade], None] | None = None,
 ) -> list[StudentGrade]:
-    """Every student's row, in the order given; `jobs` students at a time.
+    """Every student's row, in the order given, each graded as a task on `client`'s cluster.
 
-    On Ctrl-C (or SIGTERM) the running builds and suites are stopped, each
-    within its bounded grace, before KeyboardInterrupt goes on up.
+    Open the client with ``retries=WORKER_RETRIES``: a student whose grading
+    kills its worker is then run once more elsewhere (a worker can die for
+    reasons of its own) before their row says so. On Ctrl-C (or SIGTERM)
+    the running builds and suites are stopped, each within its bounded
+    grace, before KeyboardInterrupt goes on up.
     """
-    cancel = threading.Event()
+    from distributed import as_completed
+
+    from harness.cluster.flag import ClusterFlag
+
     grades: dict[int, StudentGrade] = {}
-    with ThreadPoolExecutor(max_workers=jobs, thread_name_prefix="grade") as pool:
-        pending: dict[Future[StudentGrade], int] = {
-            pool.submit(grade_student, s, config, cancel): i for i, s in enumerate(students)
-        }
-        try:
-            while pending:
-                done, _ = wait(pending, timeout=1.0, return_when=FIRST_COMPLETED)
-                for future in done:
-                    index = pending.pop(future)
-                    grades[index] = future.result()
-                    if on_graded is not None:
-                        on_graded(students[index], grades[index])
-        except BaseException:
-            cancel.set()
-            for future in pending:
-                future.cancel()
-            raise
+    stop = ClusterFlag()
+    futures = {
+        client.submit(grade_student, s, config, stop, key=_task_key(s), pure=False): i
+        for i, s in enumerate(students)
+    }
+    try:
+        for future in as_completed(futures):
+            index = futures[future]
+            grades[index] = _outcome(future, students[index], config)
+            if on_graded is not None:
+                on_graded(students[index], grades[index])
+    except BaseException:
+        stop.set()
+        _wait_for_running(futures, client)
+        raise
     return [grades[i] for i in range(len(students))]
+
+
+def _task_key(student: Student) -> str:
+    """Names the student on the dashboard; unique, so a re-graded class is not a cache hit."""
+    return f"grade-{student.slug}-{uuid.uuid4().hex[:8]}"
+
+
+def _outcome(future: Any, student: Student, config: GradeConfig) -> StudentGrade:
+    """The task's row; a task Dask gave up on (its worker died every time) is a row too."""
+    from distributed import KilledWorker
+
+    try:
+        grade = future.result()
+    except KilledWorker:
+        reason = (
+            f"could not grade: the worker grading this student died {WORKER_RETRIES + 1} times "
+            "(does the node kill processes other than its own?)"
+        )
+    except Exception as err:  # lost to the cluster, not to the student's code
+        reason = f"could not grade: {type(err).__name__}: {err}"
+    else:
+        assert isinstance(grade, StudentGrade)
+        return grade
+    not_run = dict.fromkeys(config.scenarios, NOT_RUN)
+    return StudentGrade(student.name, student.kind, not_run, reason)
+
+
+def _wait_for_running(futures: dict[Any, int], client: Any) -> None:
+    """Let running tasks stop their children (bounded), drop the ones not started."""
+    from distributed import wait as wait_for
+
+    pending = [f for f in futures if not f.done()]
+    client.cancel([f for f in pending if f.status == "pending"], reason="interrupted")
+    with contextlib.suppress(Exception):
+        wait_for(pending, timeout=STOP_WAIT_S)

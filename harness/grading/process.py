@@ -19,15 +19,15 @@ import os
 import signal
 import subprocess
 import sys
-import threading
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Protocol
 
 from harness.nodes.process_group import signal_group, wait_group_gone
 
-__all__ = ["Finished", "run_bounded"]
+__all__ = ["StopFlag", "Finished", "run_bounded"]
 
 MAX_FILE_BYTES = 128 * 1024 * 1024  # any one file a student's build or node writes
 # How often a running child's log size and the cancel flag are looked at: a child
@@ -37,6 +37,12 @@ POLL_S = 0.02
 TERM_GRACE_S = 15.0  # after SIGTERM: a worker stops its node (up to 9 s) and writes results
 KILL_WAIT_S = 5.0
 PR_SET_PDEATHSIG = 1
+
+
+class StopFlag(Protocol):
+    """What asks a child to stop: a threading.Event, or a flag set across a cluster."""
+
+    def is_set(self) -> bool: ...
 
 
 @dataclass(frozen=True)
@@ -81,7 +87,7 @@ def run_bounded(
     max_log_bytes: int,
     cwd: Path | None = None,
     env: dict[str, str] | None = None,
-    cancel: threading.Event | None = None,
+    cancel: StopFlag | None = None,
     max_file_bytes: int = MAX_FILE_BYTES,
 ) -> Finished:
     """Run `argv` with stdout and stderr in `log`; stop it on timeout, flood or cancel."""

@@ -22,7 +22,13 @@ def classroom(tmp_path: Path) -> Path:
     [
         (["{missing}"], "no such folder"),
         (["{empty}"], "no students found in"),
-        (["{class}", "--jobs", "0"], "jobs must be a whole number >= 1"),
+        (["{class}", "--workers", "0"], "workers must be a whole number 1..1000"),
+        (["{class}", "--jobs", "0"], "argument --jobs: workers must be a whole number 1..1000"),
+        (["{class}", "--workers", "2", "--scheduler", "tcp://h:1"], "--workers sizes the embedded"),
+        (
+            ["{class}", "--scheduler", "tcp://127.0.0.1:9"],
+            "--scheduler tcp://127.0.0.1:9: cannot connect",
+        ),
         (["{class}", "--scenario", "nope"], "unknown scenario 'nope'"),
         (["{class}", "--scenario", "approach_wall,approach_wall"], "given twice"),
         (["{class}", "--threshold", "-1"], "threshold must be a positive number"),

@@ -1,0 +1,36 @@
+"""`--scheduler` and `--workers`: where a command's many runs run (a Dask cluster)."""
+
+from __future__ import annotations
+
+import argparse
+
+from harness.commands.arguments import given, whole_number
+
+workers = whole_number("workers", 1, 1_000)
+
+
+def add_cluster_options(parser: argparse.ArgumentParser, *, unit: str = "runs") -> None:
+    """The embedded cluster's size, or an existing cluster's address (not both)."""
+    group = parser.add_argument_group(f"where the {unit} run (Dask)")
+    group.add_argument(
+        "--scheduler",
+        type=given("--scheduler"),
+        metavar="ADDRESS",
+        help="an existing Dask scheduler, e.g. tcp://host:8786 (default: an embedded cluster)",
+    )
+    group.add_argument(
+        "--workers",
+        type=workers,
+        metavar="N",
+        help=f"worker processes of the embedded cluster, {unit} at once (default: one per core)",
+    )
+
+
+def describe_cluster(scheduler: str | None, workers: int | None) -> str:
+    """Where the runs go, in words, for the command's opening line."""
+    from harness.cluster.client import default_workers
+
+    if scheduler is not None:
+        return f"on the Dask cluster at {scheduler}"
+    count = workers if workers is not None else default_workers()
+    return f"on an embedded Dask cluster of {count} worker{'s' if count != 1 else ''}"

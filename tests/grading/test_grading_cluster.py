@@ -1,0 +1,229 @@
+"""`fossbot-hil grade` on real Dask clusters: the embedded default, and one started with
+Dask's own `dask scheduler` / `dask worker` commands with a worker killed (-9) mid-class.
+
+The class: correct students, one reporting the angle in degrees, one whose node
+hangs (never comes up, ignores SIGTERM) and one whose node kills the Dask
+worker grading it. Every student must get exactly one row, the same through
+either cluster.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import csv
+import os
+import signal
+import socket
+import subprocess
+import sys
+import time
+from collections.abc import Iterator
+from pathlib import Path
+
+import pytest
+from command_line import COMMAND
+from grading_class import STUDENT_NODE
+
+pytestmark = [pytest.mark.ros, pytest.mark.slow, pytest.mark.timeout(300)]
+
+SCHEDULER = [sys.executable, "-m", "distributed.cli.dask_scheduler"]
+WORKER = [sys.executable, "-m", "distributed.cli.dask_worker"]
+GRADE = ["grade", "--scenario", "approach_wall", "--ready-timeout", "4"]
+VARIANT = (
+    "import runpy\nimport sys\n\n"
+    'sys.argv[1:1] = ["{variant}"]\n'
+    f'runpy.run_path({str(STUDENT_NODE)!r}, run_name="__main__")\n'
+)
+HANGS = (
+    "import signal\nimport time\n\n"
+    "signal.signal(signal.SIGTERM, signal.SIG_IGN)  # and never comes up\n"
+    "while True:\n    time.sleep(1)\n"
+)
+# Walks up its ancestors to the Dask worker process (a nanny's spawned child, or a
+# `dask worker --no-nanny`) and kills it, as a node gone badly wrong might.
+KILLS_ITS_WORKER = """\
+import os
+import signal
+
+pid = os.getppid()
+while pid > 1:
+    with open(f"/proc/{pid}/cmdline", "rb") as handle:
+        command = handle.read().replace(b"\\0", b" ")
+    if b"spawn_main" in command or b"dask_worker" in command:
+        os.kill(pid, signal.SIGKILL)
+        break
+    with open(f"/proc/{pid}/stat", "rb") as handle:
+        pid = int(handle.read().rsplit(b")", 1)[1].split()[1])
+"""
+STUDENTS = {
+    "ana": VARIANT.format(variant="correct"),
+    "ben": VARIANT.format(variant="angle_in_degrees"),
+    "cai": VARIANT.format(variant="correct"),
+    "dan": HANGS,
+    "eve": KILLS_ITS_WORKER,
+    "fay": VARIANT.format(variant="correct"),
+}
+
+
+@pytest.fixture(scope="module")
+def classroom(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    folder = tmp_path_factory.mktemp("class")
+    for name, source in STUDENTS.items():
+        (folder / name).mkdir()
+        (folder / name / "lidar_node.py").write_text(source)
+    return folder
+
+
+def _rows(out: Path) -> dict[str, dict[str, str]]:
+    with open(out / "grades.csv", encoding="utf-8", newline="") as handle:
+        return {row["student"]: row for row in csv.DictReader(handle)}
+
+
+def _check_class(rows: dict[str, dict[str, str]], output: str) -> None:
+    assert sorted(rows) == sorted(STUDENTS), output
+    verdicts = {name: row["approach_wall"] for name, row in rows.items()}
+    assert verdicts == {
+        "ana": "PASS",
+        "ben": "FAIL",
+        "cai": "PASS",
+        "dan": "ERROR",
+        "eve": "NOT RUN",
+        "fay": "PASS",
+    }, output
+    assert "degrees" in rows["ben"]["first_failure"], rows["ben"]
+    assert rows["dan"]["first_failure"].startswith("node did not start"), rows["dan"]
+    assert "the worker grading this student died 2 times" in rows["eve"]["first_failure"]
+
+
+@pytest.fixture(scope="module")
+def embedded(classroom: Path, tmp_path_factory: pytest.TempPathFactory) -> dict[str, dict]:
+    """The class graded by the default: an embedded cluster, one worker per core."""
+    out = tmp_path_factory.mktemp("embedded") / "grades"
+    done = subprocess.run(
+        [*COMMAND, *GRADE, str(classroom), "--out", str(out)],
+        capture_output=True,
+        text=True,
+        timeout=240,
+    )
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert "on an embedded Dask cluster of" in done.stdout
+    assert "Dask dashboard: http" in done.stdout
+    rows = _rows(out)
+    _check_class(rows, done.stdout + done.stderr)
+    return rows
+
+
+def test_the_embedded_cluster_grades_every_kind_of_student(embedded: dict[str, dict]) -> None:
+    assert embedded["ana"]["passed"] == "1/1"
+
+
+def _free_port() -> int:
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        return int(probe.getsockname()[1])
+
+
+def _children(pid: int) -> list[int]:
+    found = []
+    for task in Path(f"/proc/{pid}/task").iterdir():
+        with contextlib.suppress(OSError):
+            found += [int(p) for p in (task / "children").read_text().split()]
+    return found
+
+
+@contextlib.contextmanager
+def _cluster(workers: int) -> Iterator[tuple[str, list[subprocess.Popen[bytes]]]]:
+    """A scheduler and `workers` single-threaded workers with nannies (a killed worker
+    comes back), configured as the docs advise for grading, all stopped afterwards."""
+    port = _free_port()
+    address = f"tcp://127.0.0.1:{port}"
+    env = {
+        **os.environ,
+        "DASK_DISTRIBUTED__SCHEDULER__ALLOWED_FAILURES": "1",
+        "DASK_DISTRIBUTED__SCHEDULER__WORKER_SATURATION": "1.0",
+    }
+    quiet = {"stdout": subprocess.DEVNULL, "stderr": subprocess.DEVNULL, "env": env}
+    scheduler = subprocess.Popen(
+        [*SCHEDULER, "--host", "127.0.0.1", "--port", str(port), "--dashboard-address", ":0"],
+        **quiet,
+    )
+    nannies = [
+        subprocess.Popen([*WORKER, address, "--nthreads", "1"], **quiet) for _ in range(workers)
+    ]
+    try:
+        yield address, nannies
+    finally:
+        for process in [*nannies, scheduler]:
+            if process.poll() is None:
+                process.send_signal(signal.SIGTERM)
+        for process in [*nannies, scheduler]:
+            try:
+                process.wait(timeout=30)
+            except subprocess.TimeoutExpired:
+                process.kill()
+                process.wait(timeout=10)
+
+
+def test_an_external_cluster_gives_the_same_rows_with_a_worker_killed(
+    classroom: Path, embedded: dict[str, dict], tmp_path: Path
+) -> None:
+    out = tmp_path / "grades"
+    with _cluster(workers=2) as (address, nannies):
+        grade = subprocess.Popen(
+            [*COMMAND, *GRADE, str(classroom), "--scheduler", address, "--out", str(out)],
+            stdout=subprocess.PIPE,
+            stderr=subprocess.STDOUT,
+            text=True,
+        )
+        assert grade.stdout is not None
+        killed = None
+        for line in grade.stdout:  # ends when the command does
+            if killed is None and ": script, " in line:  # a first student is done
+                workers = _children(nannies[0].pid)
+                if workers:
+                    killed = workers[0]
+                    os.kill(killed, signal.SIGKILL)
+        grade.wait(timeout=60)
+    assert killed is not None, "no worker was killed"
+    assert grade.returncode == 0
+    rows = _rows(out)
+    _check_class(rows, str(rows))
+    assert rows == embedded
+
+
+def test_ctrl_c_stops_the_students_running_on_an_external_cluster(tmp_path: Path) -> None:
+    """Dask cannot interrupt a running task: the grader's stop flag must reach the worker,
+    which stops the student's suite and node, while the cluster itself lives on."""
+    pid_file = tmp_path / "node.pid"
+    (tmp_path / "class" / "gus").mkdir(parents=True)
+    (tmp_path / "class" / "gus" / "lidar_node.py").write_text(
+        f"import os\nopen({str(pid_file)!r}, 'w').write(str(os.getpid()))\n{HANGS}"
+    )
+    with _cluster(workers=1) as (address, nannies):
+        grade = subprocess.Popen(
+            [*COMMAND, "grade", str(tmp_path / "class"), "--scheduler", address]
+            + ["--scenario", "approach_wall", "--ready-timeout", "120"]
+            + ["--out", str(tmp_path / "grades")],
+            stdout=subprocess.PIPE,
+            stderr=subprocess.STDOUT,
+            text=True,
+        )
+        deadline = time.monotonic() + 60
+        while not pid_file.exists() or not pid_file.read_text():
+            assert time.monotonic() < deadline and grade.poll() is None, "the node never started"
+            time.sleep(0.05)
+        node = int(pid_file.read_text())
+        grade.send_signal(signal.SIGINT)
+        output, _ = grade.communicate(timeout=60)
+        assert grade.returncode == 130, output
+        deadline = time.monotonic() + 30
+        while Path(f"/proc/{node}").exists() and _state(node) != "Z":
+            assert time.monotonic() < deadline, f"the student's node {node} is still running"
+            time.sleep(0.05)
+        assert all(n.poll() is None for n in nannies), "the cluster must live on"
+
+
+def _state(pid: int) -> str:
+    with contextlib.suppress(OSError):
+        return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+    return "gone"
