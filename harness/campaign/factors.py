@@ -7,7 +7,8 @@ string) and returns a few lines, most telling first:
 
 * failures confined to some levels of one factor ("fails only with faults
   drifting_rate: 12 of 20 runs there failed, 0 of 60 elsewhere"), for the
-  threshold as an ordered range ("fails only when threshold <= 0.2");
+  threshold and generated variations (``varied``: wall_distance, speed, ...)
+  as an ordered range ("fails only when threshold <= 0.2");
 * failures confined to a combination of two factors when that says more
   than any single factor does;
 * "fails at every level of every factor" when nothing narrows them down;
@@ -22,11 +23,13 @@ is taken as an ERROR (a run that does not say it passed did not pass).
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable, Mapping
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from itertools import combinations
 
 FACTORS = ("scenario", "faults", "threshold", "seed")
+UNORDERED = ("scenario", "faults", "seed")  # the others are quantities: "threshold <= 0.2"
+Factors = tuple[str, ...]
 
 Level = str | int | float | None
 Row = Mapping[str, str | int | float | None]
@@ -109,14 +112,14 @@ def _level(factor: str, value: object) -> Level:
         return None
     if factor == "faults":  # "a, b" and "a,b" are the same profile list
         return ",".join(part.strip() for part in text.split(",") if part.strip()) or None
-    if factor in ("threshold", "seed"):
-        number = _number(text)
-        if number is None:
-            return text
-        if factor == "seed" and number.is_integer():
-            return int(number)
-        return number
-    return text
+    if factor == "scenario":
+        return text
+    number = _number(text)  # a threshold, a seed, a varied quantity
+    if number is None:
+        return text
+    if factor == "seed" and number.is_integer():
+        return int(number)
+    return number
 
 
 def _verdict(value: object) -> str:
@@ -129,10 +132,10 @@ def _verdict(value: object) -> str:
     return "ERROR"
 
 
-def _runs(rows: Iterable[Row]) -> list[_Run]:
-    """The rows as runs; keys other than FACTORS and verdict are ignored."""
+def _runs(rows: Iterable[Row], factors: Factors) -> list[_Run]:
+    """The rows as runs; keys other than the factors and verdict are ignored."""
     return [
-        _Run(tuple(_level(f, row.get(f)) for f in FACTORS), _verdict(row.get("verdict")))
+        _Run(tuple(_level(f, row.get(f)) for f in factors), _verdict(row.get("verdict")))
         for row in rows
     ]
 
@@ -200,9 +203,11 @@ def _failing(tallies: Mapping[Level, _Tally]) -> list[Level]:
 # --- describing a set of levels -----------------------------------------------------------------
 
 
-def _threshold_range(tallies: Mapping[Level, _Tally], chosen: list[Level]) -> str | None:
-    """'threshold <= 0.2 (...)' when the failing thresholds all lie below (or above) every
-    passing one; None when they do not, or a failing level is not a number."""
+def _range(factor: str, tallies: Mapping[Level, _Tally], chosen: list[Level]) -> str | None:
+    """'threshold <= 0.2 (...)' when the failing levels of a quantity all lie below (or
+    above) every passing one; None when they do not, or a failing level is not a number."""
+    if factor in UNORDERED:
+        return None
     numbers = [lv for lv in tallies if isinstance(lv, float)]
     if len(chosen) == len(tallies) or any(not isinstance(lv, float) for lv in chosen):
         return None
@@ -210,58 +215,60 @@ def _threshold_range(tallies: Mapping[Level, _Tally], chosen: list[Level]) -> st
     if k >= len(numbers):
         return None
     if numbers[:k] == chosen:
-        return f"threshold <= {chosen[-1]:g} (every run from {numbers[k]:g} up passed)"
+        return f"{factor} <= {chosen[-1]:g} (every run from {numbers[k]:g} up passed)"
     if numbers[-k:] == chosen:
-        return f"threshold >= {chosen[0]:g} (every run up to {numbers[-k - 1]:g} passed)"
+        return f"{factor} >= {chosen[0]:g} (every run up to {numbers[-k - 1]:g} passed)"
     return None
 
 
 def _describe(factor: str, tallies: Mapping[Level, _Tally], chosen: list[Level]) -> str:
     """Some levels of a factor in words: 'faults drifting_rate', 'threshold <= 0.2 (...)',
     'some seeds (2 of 5: 1 or 4)'."""
-    if factor == "threshold":
-        ranged = _threshold_range(tallies, chosen)
-        if ranged:
-            return ranged
+    ranged = _range(factor, tallies, chosen)
+    if ranged:
+        return ranged
     names = _join([_label(factor, lv) for lv in chosen])
     if factor == "seed":
         return f"some seeds ({len(chosen)} of {len(tallies)}: {names})"
-    noun = factor if len(chosen) == 1 or factor == "faults" else _NOUNS[factor]
+    noun = factor if len(chosen) == 1 or factor == "faults" else _NOUNS.get(factor, factor)
     return f"{noun} {names}"
 
 
 def _short(description: str) -> str:
     """A description without its parenthesis, for use inside a longer phrase."""
-    return description.split(" (", 1)[0] if description.startswith("threshold") else description
+    ranged = " <= " in description or " >= " in description
+    return description.split(" (", 1)[0] if ranged else description
 
 
 # --- findings -----------------------------------------------------------------------------------
 
 
-def _single_findings(runs: list[_Run], varying: list[int]) -> list[_Finding]:
+def _single_findings(runs: list[_Run], varying: list[int], factors: Factors) -> list[_Finding]:
     """Each factor whose failures sit in a strict subset of its levels."""
     found = []
     for index in varying:
-        factor = FACTORS[index]
+        factor = factors[index]
         tallies = _by_level(runs, index)
         chosen = _failing(tallies)
         if len(chosen) == len(tallies):
             continue
         description = _describe(factor, tallies, chosen)
-        word = "when" if _threshold_range(tallies, chosen) else "with"
+        word = "when" if _range(factor, tallies, chosen) else "with"
         there = _tally(r for r in runs if r.levels[index] in chosen)
         found.append(_Finding(f"{word} {description}", there, (0, index)))
     return found
 
 
-def _cells_phrase(pair: tuple[int, int], cells: list[tuple[Level, Level]], observed: int) -> str:
+def _cells_phrase(
+    pair: tuple[int, int], cells: list[tuple[Level, Level]], observed: int, factors: Factors
+) -> str:
     """'in 2 of 9 combinations of faults and threshold (faults a with threshold 0.1; ...)'."""
-    f1, f2 = FACTORS[pair[0]], FACTORS[pair[1]]
+    f1, f2 = factors[pair[0]], factors[pair[1]]
     named = [f"{f1} {_label(f1, a)} with {f2} {_label(f2, b)}" for a, b in cells]
     return f"in {len(cells)} of {observed} combinations of {f1} and {f2} ({'; '.join(named)})"
 
 
-def _pair_finding(runs: list[_Run], pair: tuple[int, int]) -> _Finding | None:
+def _pair_finding(runs: list[_Run], pair: tuple[int, int], factors: Factors) -> _Finding | None:
     """Failures confined within two factors: to a block of levels of each
     ('with faults a and threshold <= 0.2'), or to a few named combinations."""
     i, j = pair
@@ -276,13 +283,13 @@ def _pair_finding(runs: list[_Run], pair: tuple[int, int]) -> _Finding | None:
     chosen_i, chosen_j = _failing(by_i), _failing(by_j)
     block = [c for c in cells if c[0] in chosen_i and c[1] in chosen_j]
     strict = len(chosen_i) < len(by_i) and len(chosen_j) < len(by_j)
-    seeded = FACTORS[j] == "seed"  # seeds are never named one by one
+    seeded = factors[j] == "seed"  # seeds are never named one by one
     if len(failing) < len(block) and len(failing) <= _MAX_CELLS and not seeded:
-        head = _cells_phrase(pair, failing, len(cells))
+        head = _cells_phrase(pair, failing, len(cells), factors)
         there = _tally(r for r in runs if key(r) in set(failing))
     elif strict:
-        first = _short(_describe(FACTORS[i], by_i, chosen_i))
-        second = _short(_describe(FACTORS[j], by_j, chosen_j))
+        first = _short(_describe(factors[i], by_i, chosen_i))
+        second = _short(_describe(factors[j], by_j, chosen_j))
         head = f"with {first} and {second}"
         there = _tally(r for r in runs if key(r) in set(block))
     else:
@@ -290,15 +297,15 @@ def _pair_finding(runs: list[_Run], pair: tuple[int, int]) -> _Finding | None:
     return _Finding(head, there, (1, i, j))
 
 
-def _findings(runs: list[_Run], varying: list[int]) -> list[_Finding]:
+def _findings(runs: list[_Run], varying: list[int], factors: Factors) -> list[_Finding]:
     """The 'fails only ...' statements worth saying, most telling first: a pair is
     said only when it narrows the failures down further than every single factor."""
-    singles = _single_findings(runs, varying)
+    singles = _single_findings(runs, varying, factors)
     best_single = max((f.there.rate for f in singles), default=0.0)
     pairs = [
         found
         for pair in combinations(varying, 2)
-        if (found := _pair_finding(runs, pair)) and found.there.rate > best_single + 1e-12
+        if (found := _pair_finding(runs, pair, factors)) and found.there.rate > best_single + 1e-12
     ]
     pairs = sorted(pairs, key=_telling)[:_MAX_PAIRS]
     return sorted(singles + pairs, key=_telling)[:_MAX_FINDINGS]
@@ -325,9 +332,9 @@ def _rate(tally: _Tally) -> str:
     return f"{tally.failed}/{tally.runs}{errors}"
 
 
-def _factor_line(runs: list[_Run], index: int) -> str:
+def _factor_line(runs: list[_Run], index: int, factors: Factors) -> str:
     """One factor's failure rate per level; seeds only 'some' or 'every'."""
-    factor = FACTORS[index]
+    factor = factors[index]
     tallies = _by_level(runs, index)
     if factor == "seed":
         chosen = _failing(tallies)
@@ -357,20 +364,27 @@ def _tally_sum(tallies: Iterable[_Tally]) -> _Tally:
 # --- the summary --------------------------------------------------------------------------------
 
 
-def explain(rows: Iterable[Mapping[str, str | int | float | None]]) -> list[str]:
-    """The summary lines of a campaign, most telling first, each one line with counts."""
-    runs = _runs(rows)
+def explain(
+    rows: Iterable[Mapping[str, str | int | float | None]], varied: Sequence[str] = ()
+) -> list[str]:
+    """The summary lines of a campaign, most telling first, each one line with counts.
+
+    `varied`: the columns of generated scenario variations (wall_distance,
+    speed, ...), factors like the others and ordered like the threshold.
+    """
+    factors: Factors = (*FACTORS, *varied)
+    runs = _runs(rows, factors)
     total = _tally(runs)
     if not runs:
         return ["no runs: nothing to explain"]
     if not total.failed:
         return ["the 1 run passed" if total.runs == 1 else f"all {total.runs} runs passed"]
-    varying = [i for i in range(len(FACTORS)) if len({r.levels[i] for r in runs}) > 1]
+    varying = [i for i in range(len(factors)) if len({r.levels[i] for r in runs}) > 1]
     totals = _failed_phrase(total)
     if not varying:
         why = "only 1 run" if total.runs == 1 else f"no factor varies across the {total.runs} runs"
         return [f"{totals}; {why}: the failures cannot be tied to a factor"]
-    findings = _findings(runs, varying)
+    findings = _findings(runs, varying, factors)
     lines = [_finding_line(f, total) for f in findings]
     if not any(f.rank[0] == 0 for f in findings):
         lines.append(
@@ -378,12 +392,12 @@ def explain(rows: Iterable[Mapping[str, str | int | float | None]]) -> list[str]
             "not tied to one factor"
         )
     lines.append(totals)
-    lines.extend(_factor_line(runs, i) for i in varying if _useful(runs, i))
+    lines.extend(_factor_line(runs, i, factors) for i in varying if _useful(runs, i, factors))
     return lines
 
 
-def _useful(runs: list[_Run], index: int) -> bool:
+def _useful(runs: list[_Run], index: int, factors: Factors) -> bool:
     """A rate line says something when the rates differ (seeds: always, for flakiness)."""
-    if FACTORS[index] == "seed":
+    if factors[index] == "seed":
         return True
     return len({(t.failed, t.runs) for t in _by_level(runs, index).values()}) > 1

@@ -11,8 +11,10 @@ from __future__ import annotations
 import csv
 import io
 import os
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from pathlib import Path
+
+from harness.errors import ConfigError
 
 COLUMNS = (
     "key",
@@ -29,6 +31,17 @@ COLUMNS = (
 )
 
 
+def columns_for(varied: Sequence[str] = ()) -> tuple[str, ...]:
+    """The table's columns: each generated variation's level after the threshold."""
+    at = COLUMNS.index("threshold") + 1
+    return (*COLUMNS[:at], *varied, *COLUMNS[at:])
+
+
+def read_header(path: Path) -> tuple[str, ...]:
+    with open(path, encoding="utf-8", errors="replace", newline="") as handle:
+        return tuple(next(csv.reader(handle), []))
+
+
 def read_rows(path: Path) -> list[dict[str, str]]:
     """The complete rows of a results file (a partly written last line is left out)."""
     if not path.exists():
@@ -41,16 +54,27 @@ def read_rows(path: Path) -> list[dict[str, str]]:
 
 
 class ResultsTable:
-    """Appends rows to ``path``; `done` holds the keys of every run already there."""
+    """Appends rows to ``path``; `done` holds the keys of every run already there.
 
-    def __init__(self, path: Path, *, resume: bool) -> None:
+    Resuming needs the same columns (the same generated variations): a table
+    of another campaign is refused rather than mixed with this one.
+    """
+
+    def __init__(self, path: Path, *, resume: bool, columns: Sequence[str] = COLUMNS) -> None:
         self.path = path
-        rows = read_rows(path) if resume else []
+        self.columns = tuple(columns)
+        resuming = resume and path.exists()
+        if resuming and read_header(path) != self.columns:
+            raise ConfigError(
+                f"--resume: {path} has the columns {', '.join(read_header(path))[:300]}; "
+                f"this sweep writes {', '.join(self.columns)} (another --vary? use another --out)"
+            )
+        rows = read_rows(path) if resuming else []
         self.done = {row["key"] for row in rows}
         self.rows = rows
         path.parent.mkdir(parents=True, exist_ok=True)
-        if not resume or not path.exists():
-            self._write(_line(dict(zip(COLUMNS, COLUMNS, strict=True))), mode="w")
+        if not resuming:
+            self._write(self._line(dict(zip(self.columns, self.columns, strict=True))), mode="w")
         else:
             self._trim()
 
@@ -60,8 +84,8 @@ class ResultsTable:
         if key in self.done:
             return  # a retried task that had finished after all: one row per run
         self.done.add(key)
-        self.rows.append({c: str(row.get(c, "")) for c in COLUMNS})
-        self._write(_line(row), mode="a")
+        self.rows.append({c: str(row.get(c, "")) for c in self.columns})
+        self._write(self._line(row), mode="a")
 
     def _trim(self) -> None:
         """Drop a last line a kill cut short, so appended rows start on a line of their own."""
@@ -76,8 +100,7 @@ class ResultsTable:
             handle.flush()
             os.fsync(handle.fileno())
 
-
-def _line(row: Mapping[str, object]) -> str:
-    out = io.StringIO()
-    csv.writer(out, lineterminator="\n").writerow([row.get(c, "") for c in COLUMNS])
-    return out.getvalue()
+    def _line(self, row: Mapping[str, object]) -> str:
+        out = io.StringIO()
+        csv.writer(out, lineterminator="\n").writerow([row.get(c, "") for c in self.columns])
+        return out.getvalue()

@@ -27,10 +27,11 @@ def run_one(spec: RunSpec, link_name: str, options: LinkOptions) -> dict[str, An
     from harness.runner.scenario_run import run
     from harness.runner.settings import RunSettings
     from harness.scenario.files import resolve_scenario
+    from harness.scenario.variations import varied
 
     started = time.perf_counter()
     try:
-        scenario = resolve_scenario(spec.scenario)
+        scenario = varied(resolve_scenario(spec.scenario), dict(spec.variation))
         faults = None if spec.faults == SCENARIO_FAULTS else split_fault_text(spec.faults)
         settings = RunSettings(seed=spec.seed, threshold=spec.threshold, faults=faults)
         result = run(scenario, link_name, options, settings)

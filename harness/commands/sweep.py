@@ -9,6 +9,7 @@ from typing import TYPE_CHECKING, Any
 
 from rich.console import Console
 
+from harness.atomic_write import write_atomically
 from harness.commands.arguments import (
     add_link_option,
     add_node_options,
@@ -21,7 +22,7 @@ from harness.errors import ConfigError
 from harness.report.terminal import print_safe as say
 
 if TYPE_CHECKING:
-    from harness.campaign.plan import RunSpec
+    from harness.campaign.plan import RunSpec, Variation
     from harness.campaign.results import ResultsTable
     from harness.links.base import LinkOptions
 
@@ -50,6 +51,28 @@ def _thresholds(text: str) -> list[float]:
     return values
 
 
+def _variation(text: str) -> tuple[str, list[float]]:
+    """NAME=LEVEL[,LEVEL]: a generated variation and its levels."""
+    from harness.scenario.variations import VARIATIONS
+
+    name, sep, levels = text.partition("=")
+    name = name.strip()
+    if not sep or name not in VARIATIONS:
+        known = ", ".join(VARIATIONS)
+        raise argparse.ArgumentTypeError(f"give NAME=LEVEL[,LEVEL] with NAME one of {known}")
+    values = []
+    for item in _names(levels):
+        try:
+            value = float(item)
+        except ValueError:
+            value = math.nan
+        if not math.isfinite(value) or (name in ("speed", "wall_distance") and value <= 0):
+            kind = "a number > 0" if name in ("speed", "wall_distance") else "a number"
+            raise argparse.ArgumentTypeError(f"{name}: a level is {kind}, got {item[:20]!r}")
+        values.append(value)
+    return name, values
+
+
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--scenario",
@@ -75,6 +98,15 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         metavar="M[,M]",
         help="warning thresholds in metres (default: each scenario's own)",
     )
+    parser.add_argument(
+        "--vary",
+        type=_variation,
+        action="append",
+        default=[],
+        metavar="NAME=L[,L]",
+        help="generated scenario variations, each a factor (repeatable): wall_distance (m), "
+        "start_dx, start_dy (m), start_dyaw (rad), speed (x); docs/campaigns.md",
+    )
     add_link_option(parser)
     parser.add_argument(
         "--out",
@@ -86,62 +118,92 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--resume", action="store_true", help="run only what DIR/results.csv does not hold yet"
     )
+    parser.add_argument(
+        "--parquet",
+        action="store_true",
+        help="also write DIR/results.parquet at the end (needs fossbot-hil[parquet])",
+    )
     add_cluster_options(parser)
     add_node_options(parser)
 
 
 def run(args: argparse.Namespace, console: Console) -> int:
     from harness.campaign.factors import explain
+    from harness.campaign.parquet import check_parquet_available, write_parquet
     from harness.campaign.plan import plan
-    from harness.campaign.results import ResultsTable
+    from harness.campaign.results import ResultsTable, columns_for
     from harness.cluster.client import check_cluster_options
 
     check_cluster_options(args.scheduler, args.workers)
     if args.domain_id is not None:
         raise ConfigError("--domain-id: every run of a sweep reserves a domain of its own")
+    if args.parquet:
+        check_parquet_available()
     options = check_link_options(args)
-    specs = plan(*_levels(args))
+    varied = _varied(args.vary)
+    specs = plan(*_levels(args, varied))
     if len(specs) > MAX_RUNS:
         raise ConfigError(f"{len(specs)} runs; at most {MAX_RUNS} in one sweep")
     out = Path(args.out)
-    table = ResultsTable(out / "results.csv", resume=args.resume)
+    table = ResultsTable(out / "results.csv", resume=args.resume, columns=columns_for(list(varied)))
     todo = [spec for spec in specs if spec.key not in table.done]
     say(
         console,
-        f"sweep: {len(specs)} runs ({len(specs) - len(todo)} done already), "
+        f"sweep: {len(specs)} run{'s' if len(specs) != 1 else ''} "
+        f"({len(specs) - len(todo)} done already), "
         f"results in {out / 'results.csv'}",
     )
     if todo:
         _run_all(console, todo, args, options, table)
     wanted = {spec.key for spec in specs}
     rows = [row for row in table.rows if row["key"] in wanted]
-    lines = explain(rows)
-    (out / "summary.txt").write_text("\n".join(lines) + "\n", encoding="utf-8")
+    lines = explain(rows, varied=list(varied))
+    write_atomically(out / "summary.txt", ("\n".join(lines) + "\n").encode())
+    if args.parquet:
+        say(console, f"wrote {write_parquet(out / 'results.parquet', rows, table.columns)}")
     for line in lines:
         say(console, line)
     failed = sum(row["verdict"] != "PASS" for row in rows)
     return 0 if not failed else 1
 
 
-def _levels(args: argparse.Namespace) -> tuple[list[str], list[str], list[int], list[Any]]:
+def _varied(items: list[tuple[str, list[float]]]) -> dict[str, list[float]]:
+    """--vary items by name, in the one order runs are keyed by; a name given twice is a
+    mistake."""
+    from harness.scenario.variations import ORDER
+
+    levels: dict[str, list[float]] = {}
+    for name, values in items:
+        if name in levels:
+            raise ConfigError(f"--vary {name}: given twice (list its levels in one --vary)")
+        levels[name] = values
+    return {name: levels[name] for name in ORDER if name in levels}
+
+
+def _levels(
+    args: argparse.Namespace, varied_levels: dict[str, list[float]]
+) -> tuple[list[str], list[str], list[int], list[Any], list[Variation]]:
     """Each factor's levels, checked now, so a mistake exits 2 before any cluster starts."""
-    from harness.campaign.plan import SCENARIO_FAULTS
+    from harness.campaign.plan import SCENARIO_FAULTS, variation_levels
     from harness.faults.sensor import split_fault_text
     from harness.runner.settings import RunSettings, check_settings
     from harness.scenario.files import resolve_scenario, shipped_scenarios
+    from harness.scenario.variations import varied
 
     if args.scenario:
         scenarios = [resolve_scenario(name) for name in args.scenario]
     else:
         scenarios = shipped_scenarios()
+    variations = variation_levels(varied_levels)
+    scenarios = [varied(s, dict(v)) for s in scenarios for v in variations]  # each one checked
     faults = split_fault_text(args.faults) if args.faults else [SCENARIO_FAULTS]
     thresholds: list[Any] = args.thresholds or [None]
     for level in faults:
         items = None if level == SCENARIO_FAULTS else [level]
         for threshold in thresholds:
             check_settings(scenarios, RunSettings(threshold=threshold, faults=items))
-    names = list(args.scenario) if args.scenario else [s.name for s in scenarios]
-    return names, faults, list(range(args.seeds)), thresholds
+    names = list(args.scenario) if args.scenario else [s.name for s in shipped_scenarios()]
+    return names, faults, list(range(args.seeds)), thresholds, variations
 
 
 def _run_all(

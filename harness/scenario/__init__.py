@@ -9,7 +9,9 @@ in a file becomes one ``ConfigError`` line naming the file and the field.
 - ``checks``: rules across fields and files (run length, reachable
   conditions, model files, a start clear of obstacles), with ``ahead``,
   ``footprint``, ``geometry`` and ``model_files`` as their pure helpers;
-- ``yaml_loader``: YAML 1.2 core only, bounded.
+- ``yaml_loader``: YAML 1.2 core only, bounded;
+- ``variations``: a scenario with its wall moved, its start moved or its
+  speed scaled, checked as a file is (a campaign's generated factors).
 
 Pure: pydantic and numpy, no pybullet. Add a check in ``checks``, a field
 in ``schema`` (and docs/scenarios.md).

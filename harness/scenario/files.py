@@ -113,7 +113,12 @@ def load_scenario_file(path: str | Path) -> Scenario:
         raise ConfigError(f"{name}: YAML error: nested too deeply") from None
     except ValueError as err:  # e.g. an integer with more digits than Python converts
         raise ConfigError(f"{name}: YAML error: {' '.join(str(err).split())[:200]}") from None
-    scenario = parse_scenario(data, source=str(path))
+    return checked_scenario(data, source=str(path))
+
+
+def checked_scenario(data: Any, *, source: str) -> Scenario:
+    """`parse_scenario`, then the checks that read model files or span fields."""
+    scenario = parse_scenario(data, source=source)
     check_reachable(scenario)
     check_start_clear(scenario, check_model_files(scenario))
     return scenario

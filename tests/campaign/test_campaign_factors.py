@@ -233,3 +233,15 @@ def test_order_of_rows_does_not_matter() -> None:
     shuffled = rows[:]
     random.Random(1).shuffle(shuffled)
     assert explain(shuffled) == explain(rows)
+
+
+def test_a_generated_variation_is_a_factor_ordered_like_the_threshold() -> None:
+    """`--vary wall_distance=...`: 'fails only when wall_distance <= 0.3', named as such."""
+    rows = []
+    for distance, row in product(("0.2", "0.3", "1", "2"), table(lambda s, f, t, d: False)):
+        failed = float(distance) <= 0.3 and row["faults"] == "drifting_rate"
+        rows.append({**row, "wall_distance": distance, "verdict": "FAIL" if failed else "PASS"})
+    lines = explain(rows, varied=["wall_distance"])
+    assert any("when wall_distance <= 0.3" in line for line in lines), lines
+    assert any(line.startswith("wall_distance, runs failed per level: 0.2 ") for line in lines)
+    assert explain(rows) == explain([{**r, "wall_distance": "x"} for r in rows])  # not asked

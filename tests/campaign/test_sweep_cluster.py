@@ -131,6 +131,11 @@ def test_the_embedded_cluster_resumes_what_is_missing(tmp_path: Path) -> None:
         (["--faults", "no_such_profile"], "no_such_profile"),
         (["--domain-id", "5"], "--domain-id"),
         (["--workers", "2", "--scheduler", "tcp://127.0.0.1:1"], "--workers"),
+        (["--vary", "spd=1"], "NAME one of start_dx, start_dy"),
+        (["--vary", "speed=0"], "speed: a level is a number > 0"),
+        (["--vary", "speed=1", "--vary", "speed=2"], "--vary speed: given twice"),
+        (["--scenario", "reverse_to_wall", "--vary", "wall_distance=1"], "straight ahead"),
+        (["--scenario", "approach_wall", "--vary", "speed=50"], "--vary speed=50: "),
     ],
 )
 def test_bad_input_is_one_line_and_exit_2(args: list[str], message: str, tmp_path: Path) -> None:
@@ -138,3 +143,29 @@ def test_bad_input_is_one_line_and_exit_2(args: list[str], message: str, tmp_pat
     assert done.returncode == 2, done.stdout + done.stderr
     lines = done.stderr.strip().splitlines()
     assert len(lines) == 1 and message in lines[0], done.stderr
+
+
+def test_generated_variations_are_factors_with_a_column_each(tmp_path: Path) -> None:
+    """Two wall distances of approach_wall: one row each, the level in its own column,
+    and the same rows in results.parquet with typed columns."""
+    out = tmp_path / "sweep"
+    done = fossbot_hil(
+        "sweep",
+        "--scenario",
+        "approach_wall",
+        "--vary",
+        "wall_distance=0.4,1.5",
+        "--workers",
+        "1",
+        "--parquet",
+        "--out",
+        str(out),
+        timeout=240,
+    )
+    assert done.returncode == 0, done.stdout + done.stderr
+    rows = _rows(out)
+    assert [(r["wall_distance"], r["verdict"]) for r in rows] == [("0.4", "PASS"), ("1.5", "PASS")]
+    assert int(rows[0]["ticks"]) < int(rows[1]["ticks"])  # the nearer wall is reached sooner
+    parquet = pytest.importorskip("pyarrow.parquet")
+    table = parquet.read_table(out / "results.parquet").to_pylist()
+    assert [r["wall_distance"] for r in table] == [0.4, 1.5]
