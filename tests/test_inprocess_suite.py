@@ -93,3 +93,20 @@ def test_processor_crash_is_a_verdict() -> None:
     """An exception in the processing function ends the run with its message, not a traceback."""
     result = run("drive_past_10m", f"{STUDENTS}:crash_when_nothing_in_range")
     assert result.error is not None and "ValueError" in result.error
+
+
+def test_a_hard_coded_threshold_is_named_with_the_threshold_it_behaves_as() -> None:
+    """The harness passes 0.3 m; the function warns below 0.5 m: the whole run says so."""
+    result = run("obstacle_at_side", f"{STUDENTS}:threshold_hard_coded", threshold=0.3)
+    first = result.first_failure or ""
+    assert "expected warning False (or none); got True" in first
+    assert "the node warns as if its threshold were between 0.4" in first
+    assert "not the 0.3 m the harness passed" in first
+
+
+@pytest.mark.parametrize("fn", ["inverted_bool", "no_bool", "angle_in_degrees"])
+def test_other_bugs_get_no_threshold_hint(fn: str) -> None:
+    """An inverted Bool fits no threshold; missing Bools and wrong angles are not about it."""
+    results = [run(name, f"{STUDENTS}:{fn}") for name in ("approach_wall", "rotate_beside_wall")]
+    assert not all(r.ok for r in results)
+    assert all("as if its threshold" not in (r.first_failure or "") for r in results)

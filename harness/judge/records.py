@@ -7,6 +7,7 @@ from dataclasses import dataclass, field
 from harness.faults.link import ON_TIME, Delivery
 from harness.judge.answers import Answers
 from harness.judge.oracle import Verdict
+from harness.judge.run_hints import threshold_hint
 from harness.lidar.scan import Scan
 
 
@@ -71,10 +72,13 @@ class RunResult:
 
     @property
     def first_failure(self) -> str | None:
-        """The explanation a user reads first: the run error or the first failed tick."""
+        """The explanation a user reads first: the run error or the first failed tick,
+        with what the whole run suggests about its cause."""
         failed = self.failed_ticks
         if failed:
-            return f"{self.scenario}: {failed[0].verdict.explanation}"
+            hint = threshold_hint(self.records, self.threshold)
+            more = f" ({hint})" if hint else ""
+            return f"{self.scenario}: {failed[0].verdict.explanation}{more}"
         if self.error is not None:
             return f"{self.scenario}: {self.error}"
         return None

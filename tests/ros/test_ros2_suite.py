@@ -45,7 +45,7 @@ BUGS = {
     "angle_in_degrees": "looks like degrees",
     "no_bool": "got no Bool",
     "inverted_bool": "expected warning",
-    "threshold_hard_coded": "expected warning False",
+    "threshold_hard_coded": "the node warns as if its threshold were between 0.4",
     "answers_twice": "answered twice",
     "unparseable": "obstacle: yes-ish",
 }
