@@ -416,3 +416,16 @@ def test_obstacle_condition_without_a_beam_ahead_is_refused(tmp_path: Path, cond
         r"\+-10 deg of straight ahead, and this LIDAR has none \(beams from 1 to 2\.553 rad\)$",
     ):
         load_scenario_file(path)
+
+
+def test_the_warning_rule_is_a_field_and_settings_override_it(tmp_path: Path) -> None:
+    """`warning_when_clear: required` in a file makes the oracle strict; a run's setting wins."""
+    from harness.runner.settings import RunSettings, warning_rule
+
+    strict = load_scenario_file(write(tmp_path, changed("warning_when_clear: required\n")))
+    assert warning_rule(strict, RunSettings()) == "required"
+    assert warning_rule(strict, RunSettings(warning_when_clear="optional")) == "optional"
+    assert resolve_scenario("approach_wall").warning_when_clear == "optional"
+    path = write(tmp_path, changed("warning_when_clear: always\n"), "bad.yaml")
+    with pytest.raises(ConfigError, match=rf"^{path}: warning_when_clear: .*'optional'"):
+        load_scenario_file(path)

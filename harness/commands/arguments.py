@@ -16,6 +16,7 @@ import os
 import stat
 from collections.abc import Callable, Iterable, Mapping
 from dataclasses import replace
+from typing import TYPE_CHECKING
 
 from harness.errors import ConfigError
 from harness.links.base import LinkOptions, known_links
@@ -27,6 +28,9 @@ from harness.ros.names import (
     resolve_topic,
     shown,
 )
+
+if TYPE_CHECKING:
+    from harness.runner.settings import RunSettings
 
 DEFAULT_LINK = "ros2"
 SERIAL_LINKS = ("rplidar", "ldlidar")
@@ -148,6 +152,30 @@ def add_scenario_overrides(parser: argparse.ArgumentParser) -> None:
     )
 
 
+WARNING_RULES = ("optional", "required")
+
+
+def warning_rule(text: str) -> str:
+    """--warning-when-clear's value (for option parsers without `choices`)."""
+    if text not in WARNING_RULES:
+        raise argparse.ArgumentTypeError(f"give optional or required, got {text[:40]!r}")
+    return text
+
+
+def judging_settings(args: argparse.Namespace) -> RunSettings:
+    """The run's overrides from --seed, --threshold, --faults, --status-regex and
+    --warning-when-clear (the options of add_scenario_overrides and add_judging_options)."""
+    from harness.runner.settings import RunSettings
+
+    return RunSettings(
+        seed=args.seed,
+        threshold=args.threshold,
+        faults=fault_list(args.faults),
+        status_pattern=args.status_regex,
+        warning_when_clear=args.warning_when_clear,
+    )
+
+
 def add_judging_options(parser: argparse.ArgumentParser, *, deadline: bool = True) -> None:
     """How answers are judged and waited for: threshold, status regex, and (lockstep
     commands, `deadline`) the per-scan timeout."""
@@ -161,6 +189,13 @@ def add_judging_options(parser: argparse.ArgumentParser, *, deadline: bool = Tru
         "--status-regex",
         metavar="REGEX",
         help="parse the status with this regex (named groups distance, angle)",
+    )
+    parser.add_argument(
+        "--warning-when-clear",
+        choices=WARNING_RULES,
+        help="must the node publish warning False when nothing is within the threshold? "
+        "optional (the lab's rule: a Bool only when close passes) or required "
+        "(default: the scenario's, optional in every shipped one)",
     )
     if not deadline:
         return

@@ -23,8 +23,8 @@ from harness.commands.arguments import (
     add_scenario_overrides,
     check_status_regex,
     duration,
-    fault_list,
     given,
+    judging_settings,
     link_options,
 )
 from harness.commands.cluster_options import add_cluster_options, describe_cluster, workers
@@ -198,18 +198,13 @@ def run(args: argparse.Namespace, console: Console) -> int:
     from harness.grading.class_table import class_csv, class_html, class_rich_table
     from harness.grading.discover import discover
     from harness.grading.grade import WORKER_RETRIES, GradeConfig, grade_class
-    from harness.runner.settings import RunSettings, check_settings
+    from harness.runner.settings import check_settings
 
     check_grading_options(args)
     check_cluster_options(args.scheduler, args.workers)
     options = link_options(args)  # topics and parameters: refused now, before any folder
     scenarios = selected_scenarios(args.scenario)
-    settings = RunSettings(
-        seed=args.seed,
-        threshold=args.threshold,
-        faults=fault_list(args.faults),
-        status_pattern=args.status_regex,
-    )
+    settings = judging_settings(args)
     check_settings(scenarios, settings)  # a bad --faults or --threshold: a usage error now
     check_status_regex(args)
     out = Path(args.out)

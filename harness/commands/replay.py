@@ -102,6 +102,7 @@ def run(args: argparse.Namespace, console: Console) -> int:
             options,
             threshold=args.threshold,
             status_pattern=args.status_regex,
+            warning_when_clear=args.warning_when_clear,
             link_faults=link_faults,
             seed=args.seed,
         )

@@ -82,6 +82,7 @@ def settings_from(args: argparse.Namespace) -> RunSettings:
         threshold=args.threshold,
         faults=fault_list(args.faults),
         status_pattern=args.status_regex,
+        warning_when_clear=args.warning_when_clear,
         gui=args.gui,
     )
 

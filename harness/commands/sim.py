@@ -110,10 +110,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace, console: Console) -> int:
-    from harness.commands.arguments import check_status_regex, fault_list
+    from harness.commands.arguments import check_status_regex, judging_settings
     from harness.live.session import LiveSession, LiveSettings
     from harness.live.world import resolve_world
-    from harness.runner.settings import RunSettings
 
     if args.realtime:
         raise ConfigError("--realtime: a live session always runs in real time (see --rate)")
@@ -128,12 +127,7 @@ def run(args: argparse.Namespace, console: Console) -> int:
         rate=args.rate,
         duration=args.duration,
         node=node,
-        run=RunSettings(
-            seed=args.seed,
-            threshold=args.threshold,
-            faults=fault_list(args.faults),
-            status_pattern=args.status_regex,
-        ),
+        run=judging_settings(args),
     )
 
     def ready(domain: int) -> None:

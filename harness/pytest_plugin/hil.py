@@ -91,6 +91,12 @@ def _fault_list(faults: Faults) -> list[str | dict[str, Any]] | None:
     return items
 
 
+def _rule_problem(rule: str | None) -> str | None:
+    if rule is None or rule in ("optional", "required"):
+        return None
+    return f"warning_when_clear must be 'optional' or 'required', got {rule!r:.40}"
+
+
 class Hil:
     """Run scenarios against the node under test; see docs/pytest.md."""
 
@@ -100,6 +106,7 @@ class Hil:
         options: LinkOptions,
         *,
         seed: int | None = None,
+        warning_when_clear: str | None = None,
         port_wait: float = DEFAULT_PORT_WAIT_S,
         base_dir: Path | None = None,
         record: Callable[[str, object], None] | None = None,
@@ -107,6 +114,7 @@ class Hil:
         self.link = link
         self.options = options
         self.seed = seed
+        self.warning_when_clear = warning_when_clear
         self.port_wait = port_wait
         self.base_dir = base_dir  # relative scenario paths may be relative to the test file
         self.results: list[HilResult] = []
@@ -195,11 +203,13 @@ class Hil:
         *,
         link: str | None = None,
         status_regex: str | None = None,
+        warning_when_clear: str | None = None,
         **overrides: Any,
     ) -> HilResult:
         """Run one scenario (a shipped name, a file, or a ``hil_case``) and judge every tick.
 
-        `threshold`, `faults` and `seed` override the scenario file's;
+        `threshold`, `faults`, `seed` and `warning_when_clear` ("required" or
+        "optional") override the scenario file's;
         `overrides` are LinkOptions fields (``node=``, ``params=``,
         ``scan_timeout=`` ...). Returns the result; it does not assert.
         """
@@ -209,6 +219,7 @@ class Hil:
         if isinstance(scenario, HilCase) and faults is None:
             faults = scenario.faults
         seed = seed if seed is not None else self.seed
+        rule = warning_when_clear if warning_when_clear is not None else self.warning_when_clear
         try:
             chosen, fault_items, options = self._checked(
                 scenario, threshold, faults, seed, link, status_regex, overrides
@@ -216,11 +227,15 @@ class Hil:
         except ConfigError as err:
             problem: str | None = str(err)  # failed outside the handler: no chained traceback
         else:
-            problem = None
+            problem = _rule_problem(rule)
         if problem is not None:
             _fail(problem)
         settings = RunSettings(
-            seed=seed, threshold=threshold, faults=fault_items, status_pattern=status_regex
+            seed=seed,
+            threshold=threshold,
+            faults=fault_items,
+            status_pattern=status_regex,
+            warning_when_clear=rule,
         )
         result = self._run(chosen, link, options, settings)
         self.results.append(result)

@@ -105,6 +105,13 @@ OPTIONS = (
     ),
     _Option("seed", "N", "seed for every run (default: each scenario's)", _lazy("seed")),
     _Option(
+        "warning_when_clear",
+        "RULE",
+        "must the node publish warning False when nothing is within the threshold: "
+        "optional (the lab's rule) or required (default: each scenario's, optional)",
+        _lazy("warning_rule"),
+    ),
+    _Option(
         "timeout",
         "S",
         f"seconds to wait for the answers to one scan (default {DEFAULT_TIMEOUT_S:g})",
@@ -155,6 +162,7 @@ class HilConfig:
     port: str | None = None
     domain_id: int | None = None
     seed: int | None = None
+    warning_when_clear: str | None = None
     timeout: float = DEFAULT_TIMEOUT_S
     ready_timeout: float = DEFAULT_READY_TIMEOUT_S
     port_wait: float = DEFAULT_PORT_WAIT_S

@@ -199,6 +199,7 @@ def hil(
         hil_link,
         hil_link_options,
         seed=hil_config.seed,
+        warning_when_clear=hil_config.warning_when_clear,
         port_wait=hil_config.port_wait,
         base_dir=request.path.parent,
         record=lambda name, value: request.node.user_properties.append((name, value)),

@@ -67,6 +67,7 @@ def replay(
     *,
     threshold: float | None = None,
     status_pattern: str | None = None,
+    warning_when_clear: str | None = None,
     on_tick: Callable[[TickRecord], None] | None = None,
     link_faults: LinkFaults = NO_LINK_FAULTS,
     seed: int | None = None,
@@ -89,7 +90,12 @@ def replay(
 
     def body(link: Link) -> RunResult:
         started = time.perf_counter()
-        oracle = Oracle(threshold, noise_sigma=noise_sigma, status_pattern=status_pattern)
+        oracle = Oracle(
+            threshold,
+            noise_sigma=noise_sigma,
+            status_pattern=status_pattern,
+            warning_required_when_clear=warning_when_clear == "required",
+        )
         replayed = RunResult(name, link.name, seed, threshold, faults, noise_sigma)
         check_link_faults(link_faults, link)
         judge_frames(

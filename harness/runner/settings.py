@@ -22,6 +22,7 @@ class RunSettings:
     threshold: float | None = None
     faults: Sequence[str | dict[str, Any]] | None = None
     status_pattern: str | None = None
+    warning_when_clear: str | None = None  # "required" or "optional"; None: the scenario's
     gui: bool = False
 
 
@@ -36,7 +37,10 @@ def judging(
     """The oracle for one run of `scenario`, and the empty result its verdicts go into."""
     threshold = effective_threshold(scenario, settings)
     oracle = Oracle(
-        threshold, noise_sigma=profile.noise_sigma, status_pattern=settings.status_pattern
+        threshold,
+        noise_sigma=profile.noise_sigma,
+        status_pattern=settings.status_pattern,
+        warning_required_when_clear=warning_rule(scenario, settings) == "required",
     )
     result = RunResult(
         scenario=scenario.name,
@@ -47,6 +51,11 @@ def judging(
         noise_sigma=profile.noise_sigma,
     )
     return oracle, result
+
+
+def warning_rule(scenario: Scenario, settings: RunSettings) -> str:
+    """ "required" or "optional": must a node publish warning False when the way is clear?"""
+    return settings.warning_when_clear or scenario.warning_when_clear
 
 
 def effective_threshold(scenario: Scenario, settings: RunSettings) -> float:

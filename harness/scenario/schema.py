@@ -322,6 +322,9 @@ class Scenario(_Strict):
         default_factory=list, max_length=50
     )
     threshold: Range = 0.5
+    # "required": the node must publish warning False whenever nothing is within the
+    # threshold; "optional" (the lab's rule): a Bool only when close is fine too.
+    warning_when_clear: Literal["optional", "required"] = "optional"
     seed: Seed = 0
     source: str = Field(default="", exclude=True)  # file the scenario came from
 

@@ -34,6 +34,7 @@ def test_options_and_ini_keys_are_listed_in_help(pytester: pytest.Pytester) -> N
     ("args", "message"),
     [
         (["--hil-seed", "x"], "argument --hil-seed: seed must be a whole number, got 'x'"),
+        (["--hil-warning-when-clear", "yes"], "give optional or required, got 'yes'"),
         (["--hil-domain-id", "999"], "domain id must be a whole number 0..232, got '999'"),
         (["--hil-timeout", "0"], "timeout must be a positive number, got '0'"),
         (["--hil-param", "threshold=0.3"], "expected NAME:=VALUE, got 'threshold=0.3'"),

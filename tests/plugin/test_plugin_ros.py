@@ -51,3 +51,24 @@ def test_a_buggy_node_fails_with_the_oracles_explanation(pytester: pytest.Pytest
             "status 'Min distance: 0.350 m, angle: 89.7* gives 89.7* (looks like degrees*",
         ]
     )
+
+
+def test_the_strict_warning_rule_from_the_option_and_per_run(pytester: pytest.Pytester) -> None:
+    """A node publishing the Bool only when it is True: passes by default, fails under
+    --hil-warning-when-clear required, and a run's own argument wins over the option."""
+    pytester.makepyfile(
+        """
+        def test_default_rule(hil):
+            assert hil.run("approach_wall", warning_when_clear="optional").ok
+
+        def test_session_rule(hil):
+            result = hil.run("approach_wall")
+            assert "expected warning False; got no Bool" in result.explanation
+            assert not result.ok
+        """
+    )
+    node = f"{sys.executable} {STUDENT} correct_bool_when_close"
+    result = pytester.runpytest_subprocess(
+        "--hil-node", node, "--hil-warning-when-clear", "required", *SLACK, timeout=90
+    )
+    result.assert_outcomes(passed=2)

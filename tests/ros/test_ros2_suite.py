@@ -186,3 +186,13 @@ def test_realtime_mode_paces_scans_at_the_sensor_rate(tmp_path: Path) -> None:
     assert 'name="ticks" value="11"' in xml
     wall = float(xml.split('name="beside_wall" time="')[1].split('"')[0])
     assert wall >= 10 * 0.1  # ten periods of the gazebo preset's 10 Hz, at the least
+
+
+def test_the_strict_warning_rule_fails_a_bool_only_when_close() -> None:
+    """The lab allows a Bool only when True; --warning-when-clear required does not."""
+    node = student("correct_bool_when_close")
+    lenient = fossbot_hil("run", "approach_wall", "--node", node)
+    assert lenient.returncode == 0, lenient.stdout + lenient.stderr
+    strict = fossbot_hil("run", "approach_wall", "--node", node, "--warning-when-clear", "required")
+    assert strict.returncode == 1, strict.stdout + strict.stderr
+    assert "expected warning False; got no Bool" in strict.stdout
