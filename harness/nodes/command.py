@@ -12,10 +12,12 @@ import os
 import shlex
 import shutil
 import sys
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from harness.errors import ConfigError
+from harness.nodes.setup_problems import is_python
 
 AMENT_MARKERS = Path("share/ament_index/resource_index/packages")
 
@@ -50,6 +52,9 @@ def shell_node(command: str) -> NodeCommand:
     if not argv:
         raise ConfigError("--node: the command is empty")
     program = argv[0]
+    if program.endswith(".py") and Path(program).is_file():  # as grade runs a script
+        argv = [sys.executable, *argv]
+        program = argv[0]
     if "/" in program:
         if not Path(program).is_file():
             raise ConfigError(f"--node {command!r}: no such file {program}")
@@ -57,7 +62,25 @@ def shell_node(command: str) -> NodeCommand:
             raise ConfigError(f"--node {command!r}: {program} is not executable")
     elif shutil.which(program) is None:
         raise ConfigError(f"--node {command!r}: {program!r} not found on PATH")
+    script = _script_of(argv)
+    if script is not None and not Path(script).is_file():
+        raise ConfigError(f"--node {command!r}: no such script {script}")
     return NodeCommand(tuple(argv), description=command)
+
+
+def _script_of(argv: Sequence[str]) -> str | None:
+    """The script a Python command line runs (None for -m, -c or no script)."""
+    if not is_python(argv[0]):
+        return None
+    args = iter(argv[1:])
+    for arg in args:
+        if arg.startswith(("-m", "-c")):
+            return None
+        if arg in ("-W", "-X"):  # options that take a value
+            next(args, None)
+        elif not arg.startswith("-"):
+            return arg
+    return None
 
 
 def _prefixes(install: Path) -> list[Path]:

@@ -2,14 +2,16 @@
 
 from __future__ import annotations
 
+import shlex
 import time
 from collections.abc import Callable, Sequence
 from contextlib import AbstractContextManager, nullcontext
 
-from harness.errors import Interrupted
+from harness.errors import ConfigError, Interrupted
 from harness.judge.records import RunResult, TickRecord
 from harness.links.base import Link, LinkOptions, create_link, link_class
 from harness.nodes.forkserver import scope as fork_servers
+from harness.nodes.setup_problems import setup_problem
 from harness.runner.link_pipeline import LinkPipeline
 from harness.runner.scenario_run import (
     closed,
@@ -72,6 +74,7 @@ def run_suite(
                 result.startup_s += taking  # starting links is start-up too
                 if result.not_started:
                     failed_start = scenario.name
+                    _check_setup(result, options)
                 pipeline.retire(link, _reporter(result, link, report))
         except KeyboardInterrupt as err:
             pipeline.drain()  # every process reaped; finished scenarios reported first
@@ -80,6 +83,14 @@ def run_suite(
         finally:  # every link closed (in order: the last results are reported here)
             pipeline.drain()
     return results
+
+
+def _check_setup(result: RunResult, options: LinkOptions) -> None:
+    """A node that could not start for want of rclpy is a usage error, not a verdict."""
+    argv = shlex.split(options.node) if options.node else ()
+    problem = setup_problem(f"{result.error}\n{result.diagnostics}", argv)
+    if problem is not None:
+        raise ConfigError(problem)
 
 
 def _reporter(

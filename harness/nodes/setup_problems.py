@@ -1,0 +1,45 @@
+"""A node that cannot start because of how it was set up, not because of its code (pure).
+
+A student who runs ``--node "python3 my_node.py"`` outside the harness's
+virtual environment gets a Python without rclpy; the node dies on its first
+import. That is a configuration error to fix before anything can be judged,
+so the harness says which interpreter lacks what and which one has it,
+instead of reporting the scenario as an ERROR.
+"""
+
+from __future__ import annotations
+
+import re
+import sys
+from collections.abc import Sequence
+from pathlib import Path
+
+ROS_MODULES = ("rclpy", "sensor_msgs", "std_msgs", "rosgraph_msgs", "builtin_interfaces")
+_MISSING = re.compile(r"ModuleNotFoundError: No module named '([A-Za-z_][\w.]*)'")
+PYTHON = re.compile(r"python(\d+(\.\d+)?)?$")
+
+
+def is_python(program: str) -> bool:
+    """Does `program` (a path or a name) look like a Python interpreter?"""
+    return bool(PYTHON.match(Path(program).name))
+
+
+def setup_problem(output: str, argv: Sequence[str]) -> str | None:
+    """The setup mistake `output` (the node's last stderr lines, its exit summary) shows,
+    in one line with the fix; None when the node failed for a reason of its own."""
+    missing = _MISSING.search(output)
+    if missing is None or missing[1].split(".")[0] not in ROS_MODULES:
+        return None
+    module = missing[1].split(".")[0]
+    program = argv[0] if argv else "the node's interpreter"
+    if argv and is_python(program):
+        return (
+            f"the node's Python ({program}) cannot import {module}: run the node with "
+            f"this harness's Python ({sys.executable}), activate the harness's virtual "
+            "environment, or source ROS 2 Jazzy"
+        )
+    return (
+        f"the node cannot import {module} (ModuleNotFoundError): start it with this "
+        f"harness's Python ({sys.executable}), activate the harness's virtual environment, "
+        "or source ROS 2 Jazzy"
+    )
