@@ -18,6 +18,7 @@ def test_list_names_every_shipped_scenario(capsys: pytest.CaptureFixture[str]) -
     out = capsys.readouterr().out
     for name in ("approach_wall", "drive_past_10m", "out_of_range"):
         assert name in out
+    assert all(line == line.rstrip() for line in out.splitlines()), "trailing spaces"
 
 
 def test_run_inprocess_passes() -> None:

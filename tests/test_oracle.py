@@ -101,7 +101,11 @@ def test_ties_any_beam_is_right() -> None:
     assert judge(scan, ans(good(scan, 40))).ok
     assert judge(scan, ans(good(scan, 200))).ok
     bad = judge(scan, ans(f"Obstacle at 1.0 m, angle {angle(scan, 120):.3f}"))
-    assert not bad.ok and "also beams 200" in bad.explanation
+    assert not bad.ok and "(beam 40; also beam 200)" in bad.explanation
+    assert "give or take 0.0" in bad.explanation and "-pi..pi and 0..2pi both" in bad.explanation
+    three = make_scan({40: 1.0, 200: 1.0, 300: 1.0})
+    worse = judge(three, ans(f"Obstacle at 1.0 m, angle {angle(three, 120):.3f}"))
+    assert "(beam 40; also beams 200, 300)" in worse.explanation
 
 
 # -- range_max convention -------------------------------------------------------

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import io
 
 from rich.console import Console
 
@@ -18,5 +19,9 @@ def run(args: argparse.Namespace, console: Console) -> int:
     from harness.report.terminal import scenario_table
     from harness.scenario.files import shipped_scenarios
 
-    console.print(scenario_table(shipped_scenarios()))
+    plain = Console(file=io.StringIO(), width=console.width, color_system=None)
+    plain.print(scenario_table(shipped_scenarios()))
+    text = plain.file.getvalue()  # type: ignore[attr-defined]
+    for line in text.splitlines():  # a table pads every line to its width: not on output
+        console.print(line.rstrip(), markup=False, highlight=False, soft_wrap=True)
     return 0

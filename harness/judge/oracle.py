@@ -293,7 +293,8 @@ class Oracle:
         if len(exp.indices) > 1:
             others = ", ".join(str(i) for i in exp.indices[1:6])
             more = ", ..." if len(exp.indices) > 6 else ""
-            beam += f"; also beams {others}{more}"
+            also = "beam" if len(exp.indices) == 2 else "beams"
+            beam += f"; also {also} {others}{more}"
         text = f"nearest valid return {_num(exp.distance)} m at {_num(exp.angle)} rad ({beam})"
         if exp.may_be_clear:
             text += " = range_max, so 'no obstacle' is accepted too"
@@ -334,7 +335,8 @@ class Oracle:
         ok = any(self.angle_matches(claim.angle, a, tol, claim.angle_decimals) for a in truths)
         if not ok:
             out.append(
-                f"expected angle {_num(exp.angle, 4)} rad (± {tol:.2g}, any wrap);"
+                f"expected angle {_num(exp.angle, 4)} rad (give or take {tol:.2g} rad; "
+                "-pi..pi and 0..2pi both accepted);"
                 f" status {quoted} gives {_num(claim.angle, 4)}"
                 + _angle_hint(scan, truths, claim.angle, claim.angle_decimals)
             )
