@@ -22,39 +22,13 @@ from pathlib import Path
 
 import pytest
 from command_line import COMMAND
-from grading_class import STUDENT_NODE
+from grading_class import HANGS, KILLS_ITS_WORKER, VARIANT
 
 pytestmark = [pytest.mark.ros, pytest.mark.slow, pytest.mark.timeout(300)]
 
 SCHEDULER = [sys.executable, "-m", "distributed.cli.dask_scheduler"]
 WORKER = [sys.executable, "-m", "distributed.cli.dask_worker"]
 GRADE = ["grade", "--scenario", "approach_wall", "--ready-timeout", "4"]
-VARIANT = (
-    "import runpy\nimport sys\n\n"
-    'sys.argv[1:1] = ["{variant}"]\n'
-    f'runpy.run_path({str(STUDENT_NODE)!r}, run_name="__main__")\n'
-)
-HANGS = (
-    "import signal\nimport time\n\n"
-    "signal.signal(signal.SIGTERM, signal.SIG_IGN)  # and never comes up\n"
-    "while True:\n    time.sleep(1)\n"
-)
-# Walks up its ancestors to the Dask worker process (a nanny's spawned child, or a
-# `dask worker --no-nanny`) and kills it, as a node gone badly wrong might.
-KILLS_ITS_WORKER = """\
-import os
-import signal
-
-pid = os.getppid()
-while pid > 1:
-    with open(f"/proc/{pid}/cmdline", "rb") as handle:
-        command = handle.read().replace(b"\\0", b" ")
-    if b"spawn_main" in command or b"dask_worker" in command:
-        os.kill(pid, signal.SIGKILL)
-        break
-    with open(f"/proc/{pid}/stat", "rb") as handle:
-        pid = int(handle.read().rsplit(b")", 1)[1].split()[1])
-"""
 STUDENTS = {
     "ana": VARIANT.format(variant="correct"),
     "ben": VARIANT.format(variant="angle_in_degrees"),
