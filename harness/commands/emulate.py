@@ -1,4 +1,9 @@
-"""`fossbot-hil emulate`: serve a scenario's scans as a LIDAR device."""
+"""`fossbot-hil emulate`: serve a scenario's scans as a LIDAR device.
+
+Exit 0 when it ends (the scenario's end, Ctrl-C or SIGTERM) and a client
+read from the device; 1 when the scenario ran out and nothing ever read,
+so a script notices. The summary says which either way.
+"""
 
 from __future__ import annotations
 
@@ -24,6 +29,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument("--seed", type=seed, help="override the scenario's seed")
     parser.add_argument("--faults", metavar="NAME[,NAME]", help="fault profiles to apply")
+    parser.add_argument(
+        "-v",
+        "--verbose",
+        action="store_true",
+        help="log every request, answer and protocol error (default: a status line every 5 s)",
+    )
 
 
 def run(args: argparse.Namespace, console: Console) -> int:
@@ -41,14 +52,18 @@ def run(args: argparse.Namespace, console: Console) -> int:
         scenario,
         port=args.port,
         settings=settings,
-        announce=lambda line: print(line, flush=True),
+        announce=_print_safe,
+        verbose=args.verbose,
     )
-    rate = summary.mean_rate_error_pct
-    console.print(
-        f"served {summary.revolutions_streamed} of {summary.revolutions} revolutions "
-        f"({summary.bytes_written} bytes"
-        + (f", line rate error {rate:+.2f} %" if rate is not None else "")
-        + ")",
-        markup=False,
-    )
+    for line in summary.lines():
+        _print_safe(line)
+    if summary.stopped_by is None and summary.client_read is False:
+        return 1
     return 0
+
+
+def _print_safe(line: str) -> None:
+    """A line at once (scripts read the port's path first); the host's bytes shown safely."""
+    from harness.safe_text import for_terminal
+
+    print(for_terminal(line), flush=True)

@@ -13,6 +13,7 @@ import struct
 from collections.abc import Sequence
 from dataclasses import dataclass
 
+from harness.devices.events import DeviceEvent, Listener
 from harness.devices.revolution import Sample
 
 HEADER = 0x54
@@ -143,6 +144,8 @@ class LdlidarDevice:
         self.speed_deg_s = speed_deg_s
         self.samples_per_s = samples_per_s
         self._pending: list[tuple[Sample, float]] = []  # samples and their times (ms)
+        self.counters: dict[str, int] = {"ignored_host_bytes": 0}
+        self.listener: Listener | None = None  # told of host bytes, which it ignores
 
     @property
     def samples_per_revolution(self) -> int:
@@ -177,6 +180,22 @@ class LdlidarDevice:
                 timestamp_ms=int(chunk[0][1]),
             )
         return bytes(out)
+
+    def receive(self, data: bytes) -> bytes:
+        """Host bytes: an LD06/LD19 takes no commands, so they are counted and ignored.
+
+        Counted because they say something on a bench: a driver that sends
+        requests (0xA5 ...) is an RPLIDAR driver pointed at the wrong device.
+        """
+        self.counters["ignored_host_bytes"] += len(data)
+        if self.listener is not None:
+            note = (
+                "an RPLIDAR request: this is an RPLIDAR driver; an LD06/LD19 takes no commands"
+                if data[:1] == b"\xa5"
+                else ""
+            )
+            self.listener(DeviceEvent("ignored_host_bytes", bytes(data), note=note))
+        return b""
 
     def reset(self) -> None:
         """Forget samples waiting for a packet (the stream was interrupted)."""

@@ -9,7 +9,14 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
+from harness.devices.revolution import Sample, samples_at_beams, samples_from_scan
 from harness.errors import ConfigError
+from harness.lidar.scan import Scan
+
+# A revolution of standard nodes may fill this share of the line's time per
+# revolution; more beams than that are thinned (the A1's express mode and
+# its replies need room too).
+LINE_SHARE = 0.9
 
 
 @dataclass(frozen=True)
@@ -23,6 +30,26 @@ class DeviceProfile:
     make_device: Callable[[float], Any]  # (revolutions per second) -> device
     samples_per_rev: Callable[[Any, float], int]  # (device, rate_hz) -> native samples
     streams_unasked: bool  # LD19: always streaming; RPLIDAR: only after a SCAN request
+    at_beam_angles: Callable[[Any], bool] = lambda device: False  # (device) -> no resampling?
+
+    def revolution(
+        self, device: Any, scan: Scan, rate_hz: float, max_range_m: float | None
+    ) -> list[Sample]:
+        """The samples `device` sends for one revolution of `scan` at `rate_hz`.
+
+        Where the device reports each sample's own angle (the A1's standard
+        nodes) every beam goes out at the angle it was cast, as many as the
+        line carries in one revolution (else the device's native count,
+        still at the beams' angles); otherwise the revolution is resampled
+        to the native count at evenly spaced angles.
+        """
+        native = self.samples_per_rev(device, rate_hz)
+        if self.at_beam_angles(device):
+            bytes_per_rev = LINE_SHARE * self.baudrate / 10 / rate_hz
+            fits = scan.ranges.size * device.bytes_per_sample <= bytes_per_rev
+            count = None if fits else native
+            return samples_at_beams(scan, max_count=count, max_range_m=max_range_m)
+        return samples_from_scan(scan, samples_per_rev=native, max_range_m=max_range_m)
 
 
 def _rplidar(rate_hz: float) -> Any:
@@ -46,6 +73,7 @@ PROFILES: dict[str, DeviceProfile] = {
         make_device=_rplidar,
         samples_per_rev=lambda device, rate_hz: device.samples_per_revolution(rate_hz),
         streams_unasked=False,
+        at_beam_angles=lambda device: device.mode != "express",  # standard nodes (or idle)
     ),
     "ldlidar": DeviceProfile(
         name="ldlidar",

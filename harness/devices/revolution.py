@@ -84,6 +84,36 @@ def samples_from_scan(
     ]
 
 
+def samples_at_beams(
+    scan: Scan,
+    *,
+    max_count: int | None = None,
+    max_range_m: float | None = None,
+    quality: int = DEFAULT_QUALITY,
+) -> list[Sample]:
+    """One sample per beam, at the angle the simulator cast it, in increasing device angle.
+
+    A device that reports each sample's own angle (the RPLIDAR's standard
+    nodes, 1/64 degree) need not resample: it can say exactly where each
+    beam looked. With ``max_count`` below the number of beams, that many
+    beams are kept, spread evenly over the scan, each still at its own angle.
+    """
+    n = scan.ranges.size
+    index = np.arange(n)
+    if max_count is not None:
+        if max_count < 1:
+            raise ValueError(f"max_count must be positive, got {max_count}")
+        if n > max_count:
+            index = np.unique(np.floor(np.arange(max_count) * (n / max_count)).astype(np.int64))
+    angles = np.asarray(device_angle_deg(scan.angles()), dtype=np.float64).reshape(-1)[index]
+    distances = encode_distances_mm(scan.ranges, max_range_m)[index]
+    order = np.argsort(angles, kind="stable")
+    qualities = np.where(distances > 0.0, int(quality), 0)
+    return [
+        Sample(float(angles[i]), float(distances[i]), int(qualities[i])) for i in order.tolist()
+    ]
+
+
 def _nearest_beam(scan: Scan, device_deg: np.ndarray, distances: np.ndarray) -> np.ndarray:
     """Distances seen at the given device angles: nearest beam, 0 if none is near."""
     n = scan.ranges.size

@@ -19,6 +19,7 @@ from dataclasses import dataclass
 from functools import reduce
 from operator import xor
 
+from harness.devices.events import DeviceEvent, Listener
 from harness.devices.revolution import DEFAULT_QUALITY, Sample
 
 # -- wire constants (Slamtec protocol v2.x, sl_lidar_cmd.h) --------------------
@@ -39,6 +40,20 @@ CMD_EXPRESS_SCAN = 0x82
 CMD_GET_LIDAR_CONF = 0x84
 CMD_SET_MOTOR_PWM = 0xF0
 CMD_GET_ACC_BOARD_FLAG = 0xFF
+
+COMMAND_NAMES: dict[int, str] = {
+    CMD_STOP: "STOP",
+    CMD_SCAN: "SCAN",
+    CMD_FORCE_SCAN: "FORCE_SCAN",
+    CMD_RESET: "RESET",
+    CMD_GET_INFO: "GET_INFO",
+    CMD_GET_HEALTH: "GET_HEALTH",
+    CMD_GET_SAMPLERATE: "GET_SAMPLERATE",
+    CMD_EXPRESS_SCAN: "EXPRESS_SCAN",
+    CMD_GET_LIDAR_CONF: "GET_LIDAR_CONF",
+    CMD_SET_MOTOR_PWM: "MOTOR_PWM",
+    CMD_GET_ACC_BOARD_FLAG: "GET_ACC_BOARD_FLAG",
+}
 
 ANS_DEVINFO = 0x04
 ANS_HEALTH = 0x06
@@ -119,6 +134,11 @@ def default_scan_modes(
 
 
 # -- host side: requests --------------------------------------------------------
+
+
+def _command_name(cmd: int) -> str:
+    """A request's name, or its byte for a command the device does not know."""
+    return COMMAND_NAMES.get(cmd, f"0x{cmd:02X}")
 
 
 def _xor_all(data: bytes | bytearray) -> int:
@@ -354,6 +374,9 @@ class RplidarDevice:
         self.rebooting = False
         self.session = 0  # bumped whenever a scan starts or ends: stale bytes can be dropped
         self.counters: dict[str, int] = dict.fromkeys(COUNTER_NAMES, 0)
+        self.requests_by_command: dict[str, int] = {}  # well-formed requests, by name
+        # Told of every request and protocol error (called on the caller's thread).
+        self.listener: Listener | None = None
         self._rx = bytearray()
         self._mode = "idle"
         self._forced = False
@@ -390,6 +413,11 @@ class RplidarDevice:
         """Samples per unit on the wire: one node, or one 32-sample capsule in express."""
         return SAMPLES_PER_CAPSULE if self._mode == "express" else 1
 
+    @property
+    def bytes_per_sample(self) -> float:
+        """Line bytes per sample in the current (or, when idle, standard) mode."""
+        return CAPSULE_LEN / SAMPLES_PER_CAPSULE if self._mode == "express" else NODE_LEN
+
     def samples_per_revolution(self, rate_hz: float) -> int:
         """How many samples one revolution holds at this rotation rate."""
         return max(1, round(1e6 / (self.sample_us * rate_hz)))
@@ -417,14 +445,15 @@ class RplidarDevice:
         when ``session`` changes.
         """
         if self.rebooting:
-            self.counters["ignored_rebooting"] += len(data)
+            self._error("ignored_rebooting", bytes(data), len(data))
             return b""
         self._rx += data
         out = bytearray()
         while (request := self._next_request()) is not None:
             out += self._handle(*request)
             if self.rebooting:  # RESET: whatever followed it dies with the core
-                self.counters["ignored_rebooting"] += len(self._rx)
+                if self._rx:
+                    self._error("ignored_rebooting", bytes(self._rx), len(self._rx))
                 self._rx.clear()
                 break
         return bytes(out)
@@ -432,7 +461,7 @@ class RplidarDevice:
     def drop_partial_request(self) -> None:
         """Abandon an incomplete request (the front end saw the line go quiet)."""
         if self._rx:
-            self.counters["truncated"] += 1
+            self._error("truncated", bytes(self._rx))
             self._rx.clear()
 
     def finish_reset(self) -> bytes:
@@ -440,44 +469,85 @@ class RplidarDevice:
         self.rebooting = False
         return self.reset_banner
 
-    def _next_request(self) -> tuple[int, bytes] | None:
+    def _error(
+        self, kind: str, data: bytes, count: int = 1, *, command: str = "", note: str = ""
+    ) -> None:
+        """Count a protocol error and tell the listener what it was about."""
+        self.counters[kind] += count
+        if self.listener is not None:
+            self.listener(DeviceEvent(kind, data, command=command, note=note))
+
+    def _next_request(self) -> tuple[int, bytes, bytes] | None:
+        """(command, payload, the request's bytes) of the next whole request, if any."""
         rx = self._rx
         while rx:
             if rx[0] != SYNC:
                 skip = rx.find(SYNC)
                 skip = len(rx) if skip < 0 else skip
+                self._error("garbage_bytes", bytes(rx[:skip]), skip)
                 del rx[:skip]
-                self.counters["garbage_bytes"] += skip
                 continue
             if len(rx) < 2:
                 return None
             cmd = rx[1]
             if cmd == SYNC:  # no command is 0xA5: the first sync byte was noise
                 del rx[:1]
-                self.counters["garbage_bytes"] += 1
+                self._error("garbage_bytes", bytes((SYNC,)))
                 continue
             if not cmd & CMD_HAS_PAYLOAD:
+                raw = bytes(rx[:2])
                 del rx[:2]
-                return cmd, b""
+                return cmd, b"", raw
             if len(rx) < 3 or len(rx) < 4 + rx[2]:
                 return None
             packet = bytes(rx[: 4 + rx[2]])
             del rx[: len(packet)]
             if _xor_all(packet[:-1]) != packet[-1]:
-                self.counters["bad_checksum"] += 1
+                want = _xor_all(packet[:-1])
+                self._error(
+                    "bad_checksum",
+                    packet,
+                    command=_command_name(cmd),
+                    note=f"checksum {packet[-1]:02X}, expected {want:02X}: request dropped",
+                )
                 continue
-            return cmd, packet[3:-1]
+            return cmd, packet[3:-1], packet
         return None
 
-    def _handle(self, cmd: int, payload: bytes) -> bytes:
+    def _handle(self, cmd: int, payload: bytes, raw: bytes = b"") -> bytes:
         handler = self._handlers.get(cmd)
         if handler is None:
-            self.counters["unknown_command"] += 1
+            self._error("unknown_command", raw, command=_command_name(cmd))
             return b""
         self.counters["requests"] += 1
+        name = COMMAND_NAMES[cmd]
+        self.requests_by_command[name] = self.requests_by_command.get(name, 0) + 1
+        was = self._mode
         if cmd != CMD_SET_MOTOR_PWM:
             self._leave_scan()
-        return handler(payload)
+        errors = sum(self.counters.values())
+        reply = handler(payload)
+        if self.listener is not None:
+            rejected = sum(self.counters.values()) != errors  # the handler logged why
+            note = "" if rejected else self._after(cmd, was)
+            self.listener(DeviceEvent("request", raw, name, reply, note))
+        return reply
+
+    def _after(self, cmd: int, was: str) -> str:
+        """What a request changed, in words, for the log."""
+        motor = "motor on" if self.motor_on else "motor OFF: nothing streams until it runs"
+        if cmd in (CMD_SCAN, CMD_EXPRESS_SCAN):
+            kind = "standard nodes" if cmd == CMD_SCAN else "express capsules"
+            return f"scan started ({kind}), {motor}"
+        if cmd == CMD_FORCE_SCAN:
+            return "scan started (standard nodes, streams whatever the motor)"
+        if cmd == CMD_SET_MOTOR_PWM:
+            return f"pwm {self.pwm}: {motor}"
+        if cmd == CMD_RESET:
+            return "rebooting; the banner follows"
+        if was != "idle":
+            return "scan stopped"
+        return ""
 
     def _leave_scan(self) -> None:
         if self._mode != "idle":
@@ -505,7 +575,7 @@ class RplidarDevice:
 
     def _scan_refused(self) -> bool:
         if self.health_status == HEALTH_ERROR:
-            self.counters["refused_scan"] += 1
+            self._error("refused_scan", b"")
             return True
         return False
 
@@ -520,7 +590,7 @@ class RplidarDevice:
 
     def _on_express_scan(self, payload: bytes) -> bytes:
         if len(payload) != 5:
-            self.counters["bad_payload"] += 1
+            self._error("bad_payload", payload, command="EXPRESS_SCAN", note="want 5 bytes")
             return b""
         working_mode = payload[0]
         legacy = working_mode == 0 or (
@@ -528,7 +598,7 @@ class RplidarDevice:
             and self.scan_modes[working_mode].ans_type == ANS_CAPSULED
         )
         if not legacy:
-            self.counters["unsupported_mode"] += 1
+            self._error("unsupported_mode", payload, command="EXPRESS_SCAN")
             return b""
         if self._scan_refused():
             return b""
@@ -550,13 +620,14 @@ class RplidarDevice:
 
     def _on_get_lidar_conf(self, payload: bytes) -> bytes:
         if len(payload) < 4:
-            self.counters["bad_payload"] += 1
+            self._error("bad_payload", payload, command="GET_LIDAR_CONF", note="want >= 4 bytes")
             return b""
         conf_type = struct.unpack_from("<I", payload)[0]
         mode_id = struct.unpack_from("<H", payload, 4)[0] if len(payload) >= 6 else 0
         data = self._conf_value(conf_type, mode_id)
         if data is None:
-            self.counters["unknown_conf"] += 1
+            note = f"type 0x{conf_type:X}, mode {mode_id}: no answer, as on a device without it"
+            self._error("unknown_conf", payload, command="GET_LIDAR_CONF", note=note)
             return b""
         body = struct.pack("<I", conf_type) + data
         return encode_descriptor(len(body), SEND_SINGLE, ANS_GET_LIDAR_CONF) + body
@@ -578,7 +649,7 @@ class RplidarDevice:
 
     def _on_motor_pwm(self, payload: bytes) -> bytes:
         if len(payload) != 2:
-            self.counters["bad_payload"] += 1
+            self._error("bad_payload", payload, command="MOTOR_PWM", note="want 2 bytes")
             return b""
         self.pwm = struct.unpack("<H", payload)[0]
         if self.pwm_controls_motor:

@@ -132,6 +132,29 @@ class BoardLink(Ros2Link):
             return False  # the driver has not asked for a scan yet
         return self.observer.ready()
 
+    def _never_ready(self) -> str:
+        """A board that never answers: what went down the line, what came back, and why."""
+        if not self.physical or self.server is None:
+            return super()._never_ready()
+        ready = (
+            f"the board never became ready within {self.options.ready_timeout:g} s "
+            f"({self.profile.description})"
+        )
+        graph = self.observer.graph_summary() if self.observer is not None else ""
+        return f"{ready}: on the line {self.line_report()}" + (f" ({graph})" if graph else "")
+
+    def line_report(self) -> str:
+        """The serial line's story: sent, came back, likely cause (for errors)."""
+        from harness.serial_line.diagnosis import diagnose
+
+        assert self.server is not None and self.port is not None
+        return diagnose(
+            self.server.stats(),
+            port=f"--port {self.port.name}" if self.physical else self.port.name,
+            baudrate=self.profile.baudrate,
+            streams_unasked=self.profile.streams_unasked,
+        ).text()
+
     def node_gone(self, when: str = "") -> str | None:
         if self.server is not None and self.server.error is not None:
             return f"{self.profile.name} line: {self.server.error}"
@@ -152,17 +175,11 @@ class BoardLink(Ros2Link):
     # -- delivery ---------------------------------------------------------
     def _deliver(self, scan: Scan, tick: int, *, clock: float | None = None) -> int:
         """Send the revolution down the line; wait (bounded) for the driver's /scan of it."""
-        from harness.devices.revolution import samples_from_scan
-
         assert self.observer is not None and self.server is not None
         obs = self.observer
         obs.publish_clock(scan.stamp if clock is None else clock)
         rate = 1.0 / scan.scan_time if scan.scan_time > 0 else self.options.scan_rate_hz
-        samples = samples_from_scan(
-            scan,
-            samples_per_rev=self.profile.samples_per_rev(self.device, rate),
-            max_range_m=scan.range_max,
-        )
+        samples = self.profile.revolution(self.device, scan, rate, scan.range_max)
         pushed = time.time_ns()
         self.server.send_revolution(samples, tick, 1.0 / rate)  # real time: its own period
         self._seen, self._delivery_problem, self._lost = None, None, None
@@ -188,6 +205,8 @@ class BoardLink(Ros2Link):
                         f"{self._lost_in_a_row} revolutions in a row (line faults lose some, "
                         "not all)"
                     )
+                if not gone and self.physical:
+                    missing += f" (on the line: {self.line_report()})"
                 self._delivery_problem = gone or missing
                 return time.time_ns()
             obs.spin(min(POLL_S, deadline - time.perf_counter()))

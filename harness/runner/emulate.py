@@ -4,36 +4,110 @@ For users testing their own drivers: the harness is the device, in real
 time, and nothing else runs. With no port named, a pty pair stands in for
 the cable and its path is printed first, so a script can read it and point
 its driver there. No ROS is needed.
+
+It explains itself: with ``verbose`` every request, answer and protocol
+error is logged as it happens; otherwise a one-line status every few
+seconds. Ctrl-C or SIGTERM ends it normally, with the same summary as the
+scenario's end: what was asked, what was served, what went wrong, and the
+likely cause when no client read anything.
 """
 
 from __future__ import annotations
 
+import threading
 import time
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
 from harness.devices.profiles import DeviceProfile
-from harness.devices.revolution import samples_from_scan
-from harness.errors import ConfigError
-from harness.faults.link import LINE_KINDS, LineDamage, LinkFaults, scan_periods
+from harness.errors import ConfigError, Interrupted
+from harness.faults.link import LINE_KINDS, LinkFaults, scan_periods
 from harness.runner.settings import RunSettings, effective_seed, fault_profile
 from harness.scenario.schema import Scenario
 
 IDLE_WAIT_S = 5.0  # after the last revolution: let the line drain
+STATUS_EVERY_S = 5.0  # without verbose: one status line this often
 
 
 @dataclass(frozen=True)
 class EmulationSummary:
-    """What was served, for the closing line and for tests."""
+    """What was served, for the closing lines and for tests."""
 
-    revolutions: int
-    revolutions_streamed: int  # the rest found the device idle (not asked to scan)
+    revolutions: int  # simulated
+    revolutions_streamed: int  # queued on the line; the rest found the device idle
     bytes_written: int
     requests_seen: int | None
     mean_rate_error_pct: float | None
     period_jitter_p99_ms: float | None
+    port: str = ""
+    elapsed_s: float = 0.0
+    stopped_by: str | None = None  # "SIGINT" / "SIGTERM"; None: the scenario ended
+    revolutions_whole: int = 0  # every byte written
+    revolutions_cut: int = 0  # a request (STOP, another SCAN) cut off the rest
+    revolutions_idle: int = 0  # the device encoded nothing: not scanning, or motor off
+    reply_bytes: int = 0
+    host_bytes: int = 0
+    requests_by_command: dict[str, int] = field(default_factory=dict)
+    errors: dict[str, int] = field(default_factory=dict)  # protocol and line errors, by name
+    client_seen: bool | None = None  # a client opened the port (None: cannot be seen)
+    likely: str = ""  # the likely cause when nothing was read
+
+    @property
+    def client_read(self) -> bool | None:
+        """Did a client read anything? None where a real line cannot tell (a stream to a UART)."""
+        if self.client_seen is not None:
+            return self.client_seen and self.bytes_written > 0
+        if self.requests_by_command:
+            return self.bytes_written > 0
+        return None if self.bytes_written else False
+
+    def lines(self) -> list[str]:
+        """The summary as printed: a headline that never reads like success when it was not."""
+        how = f"stopped by {self.stopped_by}" if self.stopped_by else "scenario ended"
+        head = f"{how} after {self.elapsed_s:.1f} s: "
+        if self.client_seen is False:
+            head += (
+                f"NO CLIENT: nothing opened {self.port}; {self.revolutions} revolutions "
+                "simulated, none served"
+            )
+        elif self.client_read is False:
+            head += f"NOTHING SERVED: no client read anything on {self.port}"
+        elif self.revolutions_whole == 0 and self.revolutions_cut == 0:
+            head += f"NO SCAN SERVED: the client on {self.port} never received a revolution"
+        else:
+            head += f"served {self.revolutions_whole} whole revolutions on {self.port}"
+        rate = self.mean_rate_error_pct
+        lines = [
+            head,
+            "  requests: " + _counts(self.requests_by_command),
+            f"  revolutions: {self.revolutions} simulated, {self.revolutions_whole} served whole, "
+            f"{self.revolutions_cut} cut short by a request, "
+            f"{self.revolutions_idle} found the device idle",
+            f"  bytes: {self.bytes_written} to the client ({self.reply_bytes} in answers), "
+            f"{self.host_bytes} from it"
+            + (f"; line rate error {rate:+.2f} %" if rate is not None else ""),
+            "  errors: " + _counts(self.errors),
+            "  client: " + _client_text(self),
+        ]
+        if self.likely and not (self.revolutions_whole or self.revolutions_cut):
+            lines.append(f"  likely cause: {self.likely}")
+        return lines
+
+
+def _counts(counts: dict[str, int]) -> str:
+    return ", ".join(f"{name} {n}" for name, n in counts.items() if n) or "none"
+
+
+def _client_text(summary: EmulationSummary) -> str:
+    read = summary.client_read
+    if read is None:
+        return "unknown (a real line cannot tell whether anything read the stream)"
+    if summary.client_seen is False:
+        return "never connected"
+    return "read from the device" if read else "never read"
 
 
 def check_device_faults(faults: LinkFaults) -> None:
@@ -47,6 +121,48 @@ def check_device_faults(faults: LinkFaults) -> None:
         )
 
 
+class _Log:
+    """Lines for the user from two threads (the server's events, the loop's status)."""
+
+    def __init__(self, write: Callable[[str], None], started: float, verbose: bool) -> None:
+        self._write, self._started, self.verbose = write, started, verbose
+        self._lock = threading.Lock()
+        self._errors_seen: set[str] = set()
+
+    def line(self, text: str) -> None:
+        with self._lock:
+            self._write(f"[{time.monotonic() - self._started:7.2f} s] {text}")
+
+    def event(self, event: Any) -> None:
+        """A device or line event: every one with verbose, else each kind of error once."""
+        if self.verbose:
+            self.line(event.text())
+        elif event.is_error and event.kind not in self._errors_seen:
+            self._errors_seen.add(event.kind)
+            self.line(f"{event.text()} [first of its kind; -v logs every one]")
+
+
+def status_line(stats: Any) -> str:
+    """One line on the state of the line: the client, scanning or idle, what was served."""
+    if stats.peer_present is None:
+        client = "client: cannot be seen on a real port"
+        if stats.host_bytes:
+            client += f" ({stats.host_bytes} bytes from it)"
+    elif stats.peer_present:
+        baud = f" at {stats.host_baud} baud" if stats.host_baud else ""
+        client = f"client: connected{baud}"
+    else:
+        client = "client: none" + (" (one came and went)" if stats.peer_seen else "")
+    mode = stats.device_mode or "streaming"
+    state = "idle" if mode == "idle" else f"scanning ({mode})" if mode != "streaming" else mode
+    errors = sum(stats.device_errors.values()) + stats.wrong_baud + stats.motor_off_revolutions
+    return (
+        f"{client} | {state} | {stats.revolutions_sent} revolutions, "
+        f"{stats.bytes_written} bytes served | requests {stats.requests_seen or 0} | "
+        f"errors {errors}"
+    )
+
+
 def emulate(
     profile: DeviceProfile,
     scenario: Scenario,
@@ -54,9 +170,16 @@ def emulate(
     port: str | None = None,
     settings: RunSettings | None = None,
     announce: Callable[[str], None] = print,
+    verbose: bool = False,
+    status_every_s: float = STATUS_EVERY_S,
 ) -> EmulationSummary:
-    """Serve every revolution of `scenario` in real time until it ends."""
+    """Serve every revolution of `scenario` in real time until it ends or is stopped.
+
+    Ctrl-C or SIGTERM (``KeyboardInterrupt``) stops it like the scenario's
+    end: the summary says which.
+    """
     settings = settings or RunSettings()
+    from harness.serial_line.diagnosis import diagnose, line_errors
     from harness.serial_line.ports import PtyPort, SerialPort
     from harness.serial_line.server import DeviceServer
     from harness.sim.simulation import Simulation
@@ -67,40 +190,53 @@ def emulate(
     check_device_faults(faults.link)
     drift = faults.link.get("rate_drift")
     device = profile.make_device(spec.rate_hz)
-    line = SerialPort(port, profile.baudrate) if port else PtyPort()
-    announce(f"port: {port or line.slave_path}")
+    line: PtyPort | SerialPort = SerialPort(port, profile.baudrate) if port else PtyPort()
+    name = line.slave_path if isinstance(line, PtyPort) else line.name
+    started = time.monotonic()
+    log = _Log(announce, started, verbose)
     rng = np.random.default_rng(seed)
     revolutions = 0
+    stopped_by: str | None = None
     server = DeviceServer(
         device,
         line,
         mode="realtime",
         baudrate=profile.baudrate,
         revolution_period_s=spec.scan_time,
+        listener=log.event,
     )
     if faults.link.on_line:
+        from harness.faults.link import LineDamage
+
         server.damage = LineDamage(faults.link, seed)
     periods = scan_periods(drift, spec.rate_hz, seed) if drift is not None else None
     try:
-        with server, Simulation(scenario) as sim:
-            started = time.monotonic()
+        announce(f"port: {name}")  # from here on, a stop is a normal end
+        # The simulation first: building it silences stdout (fd 1) for a moment,
+        # which would swallow what the server thread logs meanwhile.
+        with Simulation(scenario) as sim, server:
+            status_due = started + status_every_s
             for tick in sim.ticks(periods):
                 due = started + tick.t
                 while (left := due - time.monotonic()) > 0:
                     time.sleep(min(left, 0.05))  # pacing the scenario clock, not syncing
                     server.wait_idle(0)  # surfaces a vanished port promptly
+                    if time.monotonic() >= status_due:
+                        log.line(status_line(server.stats()))
+                        status_due += status_every_s
                 scan = faults.emit(tick.truth, spec, rng, stamp=tick.t)
-                samples = samples_from_scan(
-                    scan,
-                    samples_per_rev=profile.samples_per_rev(device, 1.0 / tick.period),
-                    max_range_m=spec.range_max,
-                )
+                samples = profile.revolution(device, scan, 1.0 / tick.period, spec.range_max)
+                revolutions += 1  # first: a stop may come inside send_revolution
                 server.send_revolution(samples, tick.tick, tick.period)
-                revolutions += 1
             server.wait_idle(IDLE_WAIT_S)
-            stats = server.stats()
+    except KeyboardInterrupt as err:  # Ctrl-C or SIGTERM: a normal end, with its summary
+        stopped_by = Interrupted.of(err).name
     finally:
         line.close()
+    stats = server.stats()  # the thread has stopped: the counts are final
+    report = diagnose(
+        stats, port=name, baudrate=profile.baudrate, streams_unasked=profile.streams_unasked
+    )
     pacing = stats.pacing
     return EmulationSummary(
         revolutions=revolutions,
@@ -109,4 +245,16 @@ def emulate(
         requests_seen=stats.requests_seen,
         mean_rate_error_pct=pacing.mean_rate_error_pct if pacing else None,
         period_jitter_p99_ms=pacing.period_jitter_p99_ms if pacing else None,
+        port=name,
+        elapsed_s=time.monotonic() - started,
+        stopped_by=stopped_by,
+        revolutions_whole=stats.revolutions_whole,
+        revolutions_cut=stats.revolutions_cut,
+        revolutions_idle=stats.revolutions_dropped,
+        reply_bytes=stats.reply_bytes,
+        host_bytes=stats.host_bytes,
+        requests_by_command=stats.requests_by_command,
+        errors=line_errors(stats),
+        client_seen=stats.peer_seen,
+        likely=report.likely,
     )

@@ -12,6 +12,7 @@ import errno
 import fcntl
 import os
 import select
+import termios
 import time
 import tty
 from abc import ABC, abstractmethod
@@ -22,6 +23,12 @@ from harness.errors import ConfigError, LinkError
 from harness.serial_line.port_lock import DEFAULT_WAIT_S, PortLock, hold_port
 
 _NO_PEER_STEP_S = 0.01  # how often a pty without a reader is re-checked
+# termios speed constants (B9600, ...) and the rates they stand for.
+_BAUD_OF_SPEED = {
+    getattr(termios, f"B{rate}"): rate
+    for rate in (1200, 2400, 4800, 9600, 19200, 38400, 57600, 115200, 230400, 460800, 921600)
+    if hasattr(termios, f"B{rate}")
+}
 
 
 def _one_line(err: BaseException) -> str:
@@ -57,6 +64,10 @@ class DevicePort(ABC):
 
     def peer_present(self) -> bool | None:
         """Whether something has the other end open, or None where it cannot be known."""
+        return None
+
+    def host_baud(self) -> int | None:
+        """The baud rate the host set on its end, or None where it cannot be seen."""
         return None
 
     @abstractmethod
@@ -178,6 +189,19 @@ class PtyPort(DevicePort):
 
     def dtr_asserted(self) -> None:
         return None
+
+    def host_baud(self) -> int | None:
+        """The rate the board's driver set on the slave (Linux shares a pty's termios).
+
+        A pty carries bytes whatever the rate, so a driver set to the wrong
+        baud works here and fails on a real cable: this is how the emulator
+        can still tell. None for a rate outside the standard table.
+        """
+        try:
+            speed = termios.tcgetattr(self.fileno())[5]
+        except termios.error:
+            return None
+        return _BAUD_OF_SPEED.get(speed)
 
     def close(self) -> None:
         fd, self._fd = self._fd, None

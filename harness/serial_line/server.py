@@ -71,6 +71,7 @@ NextStart = Literal["extra", "replace"]
 _LOCKSTEP_CHUNK = 4096  # bytes offered per write in lockstep (a pty takes them at once)
 _HARDWARE_CHUNK_S = 0.02  # a real UART: offer 20 ms of line time per write
 _DTR_POLL_S = 0.02
+_BAUD_SETTLE_S = 0.1  # a client sets its baud just after it opens: look after this
 _STOP_JOIN_S = 2.0
 
 
@@ -81,6 +82,22 @@ class Delivery:
     tick: int
     started_at: float  # time.monotonic()
     finished_at: float
+
+
+@dataclass(frozen=True)
+class LineEvent:
+    """Something on the line rather than in the protocol: a client came or went,
+    its baud rate, the motor line. Logged like a device's events."""
+
+    kind: str  # client_opened, client_closed, wrong_baud, baud_ok, motor, motor_off
+    note: str
+
+    @property
+    def is_error(self) -> bool:
+        return self.kind in ("wrong_baud", "motor_off")
+
+    def text(self) -> str:
+        return f"{'error ' + self.kind + ': ' if self.is_error else ''}{self.note}"
 
 
 @dataclass(frozen=True)
@@ -100,10 +117,19 @@ class ServerStats:
     stream_bytes_dropped: int  # unsent revolution bytes dropped when the device stopped
     overrun_bytes: int  # realtime: bytes the line "sent" that the port did not take
     underruns: int  # realtime: the next revolution was late at its slot
+    revolutions_whole: int  # revolutions whose every byte the port took
+    revolutions_cut: int  # revolutions whose remaining bytes a request (e.g. STOP) cut off
+    motor_off_revolutions: int  # scanning was asked for, but the motor was off: nothing sent
+    client_opens: int  # times a client opened the pty (0 where that cannot be seen)
+    wrong_baud: int  # times a client set a baud rate other than the device's
     peer_present: bool | None
+    peer_seen: bool | None  # a client ever had the port open (None: cannot be seen)
+    host_baud: int | None  # the client's baud rate where it can be seen (a pty)
     dtr: bool | None
     device_mode: str | None
     pacing: PacingReport | None
+    requests_by_command: dict[str, int]  # the device's well-formed requests, by name
+    device_errors: dict[str, int]  # the device's protocol error counters that are not 0
 
 
 def _no_return(sample: Any) -> Any:
@@ -146,6 +172,7 @@ class DeviceServer:
         reset_s: float = 0.1,
         request_gap_s: float = 0.1,
         poll_s: float = 0.01,
+        listener: Callable[[Any], None] | None = None,
     ) -> None:
         if mode not in ("lockstep", "realtime"):
             raise ValueError(f"mode must be lockstep or realtime, not {mode!r}")
@@ -169,6 +196,11 @@ class DeviceServer:
         self.poll_s = poll_s
         self._unit_override = unit_samples
         self.damage: Any = None  # a harness.faults.link.LineDamage, set before the run starts
+        # Told (on the server thread) of line events and, through the device, of
+        # each request and protocol error: what `emulate -v` prints.
+        self.listener = listener
+        if listener is not None and hasattr(device, "listener"):
+            device.listener = listener
         self._encode = self._encoder(device)
         self._ld_style = "start_ms" in self._encode_params
         self.pacer = LinePacer(baudrate, bits_per_byte) if mode == "realtime" else None
@@ -200,6 +232,7 @@ class DeviceServer:
         self._stream = bytearray()
         self._rev_left = 0  # bytes of the current revolution (not its marker) still in _stream
         self._current: tuple[int, float | None] | None = None  # tick, first write time
+        self._rev_lost = 0  # bytes of the current revolution the port did not take
         self._marker_sent = False  # a start marker stands in for the next revolution's start
         self._marker_size = 0  # samples in the last marker
         self._carry = 0  # samples a packetizing encoder holds for its next packet
@@ -209,6 +242,12 @@ class DeviceServer:
         self._was_streaming = self._streaming()
         self._dtr: bool | None = None
         self._dtr_polled = 0.0
+        self._peer: bool | None = None  # the client has the port open (pty only)
+        # Ptys tell whether a client has them open; a real UART cannot (None).
+        self._peer_seen: bool | None = None if port.peer_present() is None else False
+        self._peer_since = 0.0
+        self._host_baud: int | None = None
+        self._motor_off_streak = False
         self._stalled = False
         self._session = getattr(device, "session", None)
         self._reboot_at: float | None = None
@@ -228,6 +267,11 @@ class DeviceServer:
                 "stream_bytes_dropped",
                 "overrun_bytes",
                 "underruns",
+                "revolutions_whole",
+                "revolutions_cut",
+                "motor_off_revolutions",
+                "client_opens",
+                "wrong_baud",
             ),
             0,
         )
@@ -324,14 +368,20 @@ class DeviceServer:
             peer = None
         mode = getattr(self.device, "mode", None)
         counters = getattr(self.device, "counters", None)
-        requests = counters.get("requests") if isinstance(counters, dict) else None
+        counters = dict(counters) if isinstance(counters, dict) else {}
+        requests = counters.pop("requests", None)
+        by_command = getattr(self.device, "requests_by_command", None)
         return ServerStats(
             mode=self.mode,
             requests_seen=requests,
             peer_present=peer,
+            peer_seen=self._peer_seen,
+            host_baud=self._host_baud,
             dtr=self._dtr,
             device_mode=mode if isinstance(mode, str) else None,
             pacing=pacing,
+            requests_by_command=dict(by_command) if isinstance(by_command, dict) else {},
+            device_errors={k: v for k, v in counters.items() if v},
             **counts,
         )
 
@@ -475,20 +525,67 @@ class DeviceServer:
             self._reply += reply
             self._n["reply_bytes"] += len(reply)
 
+    def _tell(self, event: Any) -> None:
+        if self.listener is not None:
+            self.listener(event)
+
     def _poll_dtr(self, now: float) -> None:
-        if not self.follow_dtr or now - self._dtr_polled < _DTR_POLL_S:
+        if now - self._dtr_polled < _DTR_POLL_S:
             return
         self._dtr_polled = now
+        self._poll_peer(now)
+        if not self.follow_dtr:
+            return
         dtr = self.port.dtr_asserted()
         if dtr is None or dtr == self._dtr:
             return
         self._dtr = dtr
         set_motor = getattr(self.device, "set_motor", None)
         if set_motor is not None:
-            set_motor(dtr if self.motor_on_when_dtr else not dtr)
+            on = dtr if self.motor_on_when_dtr else not dtr
+            set_motor(on)
             self._changed.set()
+            line = "asserted" if dtr else "deasserted"
+            self._tell(LineEvent("motor", f"board's DTR {line}: motor {'on' if on else 'off'}"))
+
+    def _poll_peer(self, now: float) -> None:
+        """Whether a client has the port open, and at which baud (ptys tell both)."""
+        peer = self.port.peer_present()
+        if peer is None:
+            return
+        if self._peer_seen is None:
+            self._peer_seen = False
+        if peer != self._peer:
+            self._peer = peer
+            if peer:
+                self._peer_seen = True
+                self._peer_since = now
+                self._n["client_opens"] += 1
+                self._tell(LineEvent("client_opened", f"a client opened {self.port.name}"))
+            elif self._peer_seen:
+                self._host_baud = None
+                self._tell(LineEvent("client_closed", f"the client closed {self.port.name}"))
+        if not peer or now - self._peer_since < _BAUD_SETTLE_S:
+            return
+        baud = self.port.host_baud()
+        if baud is None or baud == self._host_baud:
+            return
+        self._host_baud = baud
+        if baud != self.baudrate:
+            self._n["wrong_baud"] += 1
+            self._tell(
+                LineEvent(
+                    "wrong_baud",
+                    f"the client set its line to {baud} baud; this device talks at "
+                    f"{self.baudrate} (a pty carries the bytes anyway, a real cable "
+                    "would garble them)",
+                )
+            )
+        else:
+            self._tell(LineEvent("baud_ok", f"the client's line is at {baud} baud"))
 
     def _on_host_bytes(self, data: bytes) -> None:
+        self._poll_peer(time.monotonic())  # so "a client opened" comes before its requests
         self._n["host_bytes"] += len(data)
         self._n["host_reads"] += 1
         receive = getattr(self.device, "receive", None)
@@ -510,6 +607,8 @@ class DeviceServer:
         if over:
             # What the device was streaming is over: unsent bytes of it would
             # corrupt the replies that follow, and a new scan starts afresh.
+            if self._current is not None:
+                self._n["revolutions_cut"] += 1
             self._n["stream_bytes_dropped"] += len(self._stream)
             self._stream.clear()
             self._rev_left = 0
@@ -550,11 +649,14 @@ class DeviceServer:
             data = self.damage.damage(data)
         if not data:
             self._n["revolutions_dropped"] += 1
+            self._note_motor_off()
             return
+        self._motor_off_streak = False
         self._marker_sent = False
         self._stalled = False  # new bytes: try the port at once
         self._stream += data
         self._rev_left = len(data)
+        self._rev_lost = 0
         self._current = (tick, None)
         self._last_samples, self._last_tick = samples, tick
         self._n["revolutions_sent"] += 1
@@ -565,6 +667,23 @@ class DeviceServer:
             self._next_due = nominal + period
         else:
             self._append_marker(samples, tick + 1, now)
+
+    def _note_motor_off(self) -> None:
+        """A scan was asked for but nothing streams: the motor is off. Said once a streak."""
+        if getattr(self.device, "mode", "idle") == "idle":
+            return
+        if getattr(self.device, "motor_on", True):
+            return
+        self._n["motor_off_revolutions"] += 1
+        if not self._motor_off_streak:
+            self._motor_off_streak = True
+            self._tell(
+                LineEvent(
+                    "motor_off",
+                    "a scan was asked for but the motor is off (the board's DTR asserted, "
+                    "or MOTOR_PWM 0): an A1 streams nothing until it turns",
+                )
+            )
 
     def _encode_counted(self, samples: Sequence[Any], ms: int) -> bytes:
         """Encode with a packetizing encoder, tracking the samples it holds back."""
@@ -635,7 +754,10 @@ class DeviceServer:
             started = now
             self._current = (tick, now)
         self._rev_left -= n
+        self._rev_lost += n - written
         if self._rev_left <= 0:
+            if not self._rev_lost:
+                self._n["revolutions_whole"] += 1
             with self._lock:
                 self._deliveries.append(Delivery(tick, started, now))
             self._current = None

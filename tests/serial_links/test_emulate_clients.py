@@ -2,7 +2,8 @@
 
 The `rplidar` package (what FOSSBot code uses) and Adafruit's client must get
 device info, health and scans whose angles and distances match the
-simulated scans within the A1's quantisation (1/64 degree, 1/4 mm).
+simulated beams within the A1's quantisation (1/64 degree, 1/4 mm): in
+standard mode each sample is reported at the angle its beam was cast.
 """
 
 from __future__ import annotations
@@ -15,8 +16,7 @@ import numpy as np
 import pytest
 from pty_clients import tolerate_missing_dtr_on_pty
 
-from harness.devices.profiles import profile
-from harness.devices.revolution import samples_from_scan
+from harness.devices.revolution import device_angle_deg, encode_distances_mm
 from harness.runner.settings import RunSettings, fault_profile
 from harness.scenario.files import resolve_scenario
 from harness.sim.simulation import Simulation
@@ -28,34 +28,30 @@ ANGLE_TOL_DEG = 1 / 64 + 1e-6
 DISTANCE_TOL_MM = 0.25 + 1e-6
 
 
-def simulated_revolutions() -> list[list[tuple[float, float]]]:
-    """What the emulator serves, tick by tick: (device angle, distance mm) with a return."""
+def simulated_revolutions() -> list[np.ndarray]:
+    """The simulated beams, tick by tick: rows of (device angle of the beam, distance mm)."""
     scenario = resolve_scenario(SCENARIO)
     spec = scenario.lidar_spec
-    device = profile("rplidar").make_device(spec.rate_hz)
     faults = fault_profile(scenario, RunSettings())
     rng = np.random.default_rng(scenario.seed)
     revolutions = []
     with Simulation(scenario) as sim:
         for tick in sim.ticks():
             scan = faults.emit(tick.truth, spec, rng, stamp=tick.t)
-            samples = samples_from_scan(
-                scan,
-                samples_per_rev=device.samples_per_revolution(spec.rate_hz),
-                max_range_m=spec.range_max,
-            )
-            revolutions.append([(s.angle_deg, s.distance_mm) for s in samples if s.distance_mm])
+            angles = np.asarray(device_angle_deg(scan.angles()))
+            distances = encode_distances_mm(scan.ranges, spec.range_max)
+            revolutions.append(np.column_stack([angles, distances])[distances > 0])
     return revolutions
 
 
-def matches(client_scan: list[tuple[float, float]], expected: list[tuple[float, float]]) -> bool:
-    """Every return the client read is one the simulation produced, within quantisation."""
-    if len(client_scan) != len(expected):
-        return False
-    return all(
-        abs(a - ea) <= ANGLE_TOL_DEG and abs(d - ed) <= DISTANCE_TOL_MM
-        for (a, d), (ea, ed) in zip(sorted(client_scan), sorted(expected), strict=True)
-    )
+def matches(client_scan: list[tuple[float, float]], beams: np.ndarray) -> bool:
+    """Every return the client read is a simulated beam: its angle within 1/64 degree."""
+    for angle, distance in client_scan:
+        gap = np.abs((beams[:, 0] - angle + 180.0) % 360.0 - 180.0)
+        near = (gap <= ANGLE_TOL_DEG) & (np.abs(beams[:, 1] - distance) <= DISTANCE_TOL_MM)
+        if not near.any():
+            return False
+    return bool(client_scan)
 
 
 @pytest.fixture

@@ -150,3 +150,26 @@ def test_unplugged_adapter_fails_the_run_promptly(board: Board, tmp_path: Path) 
     assert harness.returncode == 1, out + err
     assert "link lost" in out, out + err
     assert elapsed < 5.0, f"the run took {elapsed:.1f} s to notice the unplugged adapter"
+
+
+def test_a_board_that_never_answers_is_told_what_went_down_the_line(
+    board: Board, tmp_path: Path
+) -> None:
+    """Nothing on the far end: the error says what was sent, that nothing came back, and why."""
+    scenario = tmp_path / "facing_wall.yaml"
+    scenario.write_text(SHORT)
+    harness = subprocess.run(
+        [
+            *(sys.executable, "-m", "harness.cli", "run", str(scenario), "--link", "rplidar"),
+            *("--port", board.cable.harness_end, "--domain-id", str(board.domain_id)),
+            *("--ready-timeout", "2"),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    text = harness.stdout + harness.stderr
+    assert harness.returncode == 1, text
+    assert "the board never became ready within 2 s" in text
+    assert "came back nothing (0 bytes)" in text
+    assert "likely cause: the board never sent a request" in text
