@@ -179,7 +179,8 @@ def _progress(console: Console, student: Student, grade: object) -> None:
         built = not grade.first_failure.startswith("did not build")
         parts.append(f"{'built' if built else 'build failed'} in {grade.build_s:.1f} s")
     if grade.run_s is not None:
-        parts.append(f"{grade.score} passed in {grade.run_s:.1f} s")
+        held = f" ({grade.ticks_held} ticks held)" if grade.ticks_held else ""
+        parts.append(f"{grade.score} passed{held} in {grade.run_s:.1f} s")
     else:
         parts.append("not run")
     name = for_terminal(student.name)  # a folder name is the student's choice
@@ -195,7 +196,12 @@ def run(args: argparse.Namespace, console: Console) -> int:
     from harness.atomic_write import write_atomically
     from harness.cluster.client import check_cluster_options, dashboard, open_client
     from harness.grading.build import colcon_executable
-    from harness.grading.class_table import class_csv, class_html, class_rich_table
+    from harness.grading.class_table import (
+        class_csv,
+        class_html,
+        class_rich_table,
+        scenario_legend,
+    )
     from harness.grading.discover import discover
     from harness.grading.grade import WORKER_RETRIES, GradeConfig, grade_class
     from harness.runner.settings import check_settings
@@ -253,15 +259,17 @@ def run(args: argparse.Namespace, console: Console) -> int:
         meta = [
             ("scenarios", ", ".join(names)),
             ("link", args.link),
-            ("node", f"{args.package}/{args.executable}"),
+            ("package students", f"{args.package}/{args.executable}"),
             ("seed", "per scenario" if args.seed is None else str(args.seed)),
             ("threshold", "per scenario" if args.threshold is None else f"{args.threshold:g} m"),
+            ("warning when clear", args.warning_when_clear or "per scenario (optional)"),
             ("graded", time.strftime("%Y-%m-%d %H:%M")),
         ]
         csv_path = write_atomically(out / "grades.csv", class_csv(grades, names))
         html_path = write_atomically(out / "grades.html", class_html(grades, names, meta=meta))
         console.print()
-        console.print(class_rich_table(grades, names))
+        console.print(class_rich_table(grades, names, width=console.width))
+        console.print(scenario_legend(names), markup=False, highlight=False)
         console.print()
         console.print(
             f"graded {count} in {wall_s:.1f} s; wrote {csv_path} and {html_path}",

@@ -12,7 +12,7 @@ from __future__ import annotations
 import csv
 import io
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from urllib.parse import quote
 
 from rich.table import Table
@@ -20,7 +20,7 @@ from rich.text import Text
 
 from harness.safe_text import TEXT_LIMIT, clip, for_csv, for_html, for_terminal
 
-__all__ = ["StudentGrade", "class_csv", "class_html", "class_rich_table"]
+__all__ = ["StudentGrade", "class_csv", "class_html", "class_rich_table", "scenario_legend"]
 
 PASS, FAIL, ERROR, NOT_RUN = "PASS", "FAIL", "ERROR", "NOT RUN"
 VERDICT_STYLE = {PASS: "green", FAIL: "red", ERROR: "red", NOT_RUN: "yellow"}
@@ -37,6 +37,8 @@ class StudentGrade:
     artifacts: tuple[tuple[str, str], ...] = ()  # (label, path relative to the table)
     build_s: float | None = None  # None: nothing was built (a script, or no node)
     run_s: float | None = None
+    ticks: dict[str, tuple[int, int]] = field(default_factory=dict)  # (held, judged)
+    node: str = ""  # the node the suite ran, e.g. "lidar_node.py (script)"
 
     @property
     def passed(self) -> int:
@@ -46,6 +48,20 @@ class StudentGrade:
     def score(self) -> str:
         return f"{self.passed}/{len(self.verdicts)}"
 
+    def scenario_ticks(self, scenario: str) -> str:
+        """'88/95': the ticks of `scenario` whose expectations held, of those judged."""
+        if scenario not in self.ticks:
+            return ""
+        held, judged = self.ticks[scenario]
+        return f"{held}/{judged}"
+
+    @property
+    def ticks_held(self) -> str:
+        """The partial score over every scenario judged: '480/544 (88%)'."""
+        held = sum(h for h, _ in self.ticks.values())
+        judged = sum(j for _, j in self.ticks.values())
+        return f"{held}/{judged} ({100 * held // judged}%)" if judged else ""
+
 
 def _cell(text: str) -> str:
     """A CSV cell a spreadsheet shows as text, never runs as a formula."""
@@ -53,12 +69,15 @@ def _cell(text: str) -> str:
 
 
 def class_csv(grades: Sequence[StudentGrade], scenarios: Sequence[str]) -> bytes:
-    """student, one column per scenario, passed, first_failure (UTF-8, RFC 4180 quoting)."""
+    """student, node, per scenario its verdict and ticks held, passed, ticks_held,
+    first_failure (UTF-8, RFC 4180 quoting)."""
     buffer = io.StringIO()
     writer = csv.writer(buffer, lineterminator="\r\n")
-    writer.writerow(["student", *scenarios, "passed", "first_failure"])
+    per_scenario = [c for s in scenarios for c in (s, f"{s} ticks")]
+    writer.writerow(["student", "node", *per_scenario, "passed", "ticks_held", "first_failure"])
     for g in grades:
-        row = [g.name, *(g.verdicts.get(s, NOT_RUN) for s in scenarios), g.score, g.first_failure]
+        cells = [c for s in scenarios for c in (g.verdicts.get(s, NOT_RUN), g.scenario_ticks(s))]
+        row = [g.name, g.node, *cells, g.score, g.ticks_held, g.first_failure]
         writer.writerow([_cell(c) for c in row])
     return buffer.getvalue().encode("utf-8")
 
@@ -77,6 +96,7 @@ td.NOT-RUN { background: #fdf5d8; color: #7a5c00; }
 td.why { font-size: .92em; word-break: break-word; }
 td.student small { color: #555; }
 td.student a { color: #555; }
+td.v small { font-weight: normal; color: #555; }
 @media print { body { margin: 0; font-size: 10px; } a { text-decoration: none; } }
 """
 
@@ -87,6 +107,13 @@ def _h(text: object) -> str:
 
 def _t(text: str, style: str = "") -> Text:
     return Text(for_terminal(clip(text, TEXT_LIMIT)), style=style)
+
+
+def _verdict_cell(grade: StudentGrade, scenario: str) -> str:
+    verdict = grade.verdicts.get(scenario, NOT_RUN)
+    ticks = grade.scenario_ticks(scenario)
+    held = f"<br><small>{_h(ticks)}</small>" if ticks else ""
+    return f'<td class="v {_h(verdict.replace(" ", "-"))}">{_h(verdict)}{held}</td>'
 
 
 def class_html(
@@ -105,36 +132,58 @@ def class_html(
         links = " · ".join(
             f'<a href="{_h(quote(path))}">{_h(label)}</a>' for label, path in g.artifacts
         )
-        cells = "".join(
-            f'<td class="v {_h(v.replace(" ", "-"))}">{_h(v)}</td>'
-            for v in (g.verdicts.get(s, NOT_RUN) for s in scenarios)
-        )
+        cells = "".join(_verdict_cell(g, s) for s in scenarios)
+        node = g.node or g.kind
         rows.append(
-            f'<tr><td class="student">{_h(g.name)}<br><small>{_h(g.kind)}'
+            f'<tr><td class="student">{_h(g.name)}<br><small>{_h(node)}'
             f"{' · ' + links if links else ''}</small></td>{cells}"
-            f'<td class="v">{_h(g.score)}</td><td class="why">{_h(g.first_failure)}</td></tr>'
+            f'<td class="v">{_h(g.score)}<br><small>{_h(g.ticks_held)}</small></td>'
+            f'<td class="why">{_h(g.first_failure)}</td></tr>'
         )
     page = (
         "<!DOCTYPE html>\n"
         f'<html lang="en">\n<head>\n<meta charset="utf-8">\n<title>{_h(title)}</title>\n'
         f"<style>{_CSS}</style>\n</head>\n<body>\n<h1>{_h(title)}</h1>\n"
         f'<p class="meta">{" · ".join(_h(a) for a in about)}</p>\n'
-        f"<table>\n<thead><tr><th>student</th>{head}<th>passed</th><th>first failure</th></tr>"
+        f"<table>\n<thead><tr><th>student</th>{head}<th>passed<br><small>ticks held</small></th>"
+        "<th>first failure</th></tr>"
         "</thead>\n<tbody>\n" + "\n".join(rows) + "\n</tbody>\n</table>\n</body>\n</html>\n"
     )
     return page.encode("utf-8")
 
 
-def class_rich_table(grades: Sequence[StudentGrade], scenarios: Sequence[str]) -> Table:
-    """The same rows for the terminal, verdicts coloured, the failure folded to fit."""
+LETTERS = {PASS: "P", FAIL: "F", ERROR: "E", NOT_RUN: "-"}
+MAX_NAME = 20  # a student's name in the terminal table
+MIN_FAILURE = 20  # the first failure's least width there
+
+
+def class_rich_table(
+    grades: Sequence[StudentGrade], scenarios: Sequence[str], width: int = 100
+) -> Table:
+    """The same rows, one line each on a terminal `width` columns wide: a letter per
+    scenario (numbered as in `scenario_legend`), the partial score, and the first failure
+    cut to what is left of the line (the whole of it is in grades.html and the CSV)."""
+    names = min(MAX_NAME, max([len("student"), *(len(g.name) for g in grades)]))
+    passed = max([len("passed"), *(len(g.score) for g in grades)])
+    held = max([len("ticks held"), *(len(g.ticks_held) for g in grades)])
+    numbers = sum(len(str(i)) for i in range(1, len(scenarios) + 1))
+    gaps = 2 * (len(scenarios) + 3)  # two spaces between columns
+    room = max(MIN_FAILURE, width - names - numbers - passed - held - gaps)
     table = Table(box=None, pad_edge=False)
-    table.add_column("student", overflow="fold")
-    for s in scenarios:
-        table.add_column(_t(s), overflow="fold")
-    table.add_column("passed", justify="right")
-    table.add_column("first failure", overflow="fold", ratio=1)
+    table.add_column("student", no_wrap=True, overflow="ellipsis", max_width=MAX_NAME)
+    for number in range(1, len(scenarios) + 1):
+        table.add_column(str(number), justify="center", no_wrap=True)
+    table.add_column("passed", justify="right", no_wrap=True)
+    table.add_column("ticks held", justify="right", no_wrap=True)
+    table.add_column("first failure", no_wrap=True, overflow="ellipsis", max_width=room)
     for g in grades:
         verdicts = [g.verdicts.get(s, NOT_RUN) for s in scenarios]
-        cells = [_t(v, VERDICT_STYLE.get(v, "")) for v in verdicts]
-        table.add_row(_t(g.name), *cells, g.score, _t(g.first_failure))
+        cells = [_t(LETTERS.get(v, "?"), VERDICT_STYLE.get(v, "")) for v in verdicts]
+        table.add_row(_t(g.name), *cells, g.score, g.ticks_held, _t(g.first_failure))
     return table
+
+
+def scenario_legend(scenarios: Sequence[str]) -> str:
+    """What the terminal table's numbered columns and letters mean."""
+    numbered = ", ".join(f"{i} {s}" for i, s in enumerate(scenarios, 1))
+    return f"scenarios: {numbered}; P pass, F fail, E error, - not run"

@@ -39,7 +39,12 @@ __all__ = ["GradeConfig", "grade_class", "grade_student"]
 MAX_RUN_LOG_BYTES = 20 * 1024 * 1024
 WORKER_RETRIES = 1  # a student is graded again once if their worker died under them
 STOP_WAIT_S = TERM_GRACE_S + 15.0  # on Ctrl-C: for running students to stop their children
-ARTIFACTS = (("build log", "build.log"), ("run log", "run.log"), ("JUnit", "junit.xml"))
+ARTIFACTS = (
+    ("report", "report/index.html"),
+    ("build log", "build.log"),
+    ("run log", "run.log"),
+    ("JUnit", "junit.xml"),
+)
 
 
 @dataclass(frozen=True)
@@ -130,6 +135,30 @@ def verdicts_from(
     return verdicts, first
 
 
+def ticks_from(data: dict[str, Any], config: GradeConfig) -> dict[str, tuple[int, int]]:
+    """(ticks held, ticks judged) of each scenario the worker judged."""
+    held: dict[str, tuple[int, int]] = {}
+    for entry in data.get("results", []):
+        if not isinstance(entry, dict) or entry.get("scenario") not in config.scenarios:
+            continue
+        try:
+            judged, failed = int(entry.get("ticks", 0)), int(entry.get("failed_ticks", 0))
+        except (TypeError, ValueError):
+            continue
+        if judged > 0:
+            held[str(entry["scenario"])] = (max(0, judged - failed), judged)
+    return held
+
+
+def node_of(student: Student, config: GradeConfig) -> str:
+    """The node this student's suite ran, in words."""
+    if student.kind == "script" and student.script is not None:
+        return f"{student.script.name} (script)"
+    if student.kind in ("package", "workspace"):
+        return f"{config.options.package}/{config.options.executable} ({student.kind})"
+    return "none"
+
+
 def _artifacts(folder: Path) -> tuple[tuple[str, str], ...]:
     """(label, path relative to the class table) of the student's files that exist."""
     return tuple(
@@ -156,11 +185,15 @@ def _grade(student: Student, config: GradeConfig, cancel: StopFlag) -> StudentGr
         (label, f"students/{student.slug}/{name}")
         for label, name in ARTIFACTS
         if name != "build.log" or student.kind in ("package", "workspace")
+        if label != "report"  # only a suite that ran has one
     )
+    node = node_of(student, config)
 
     def without_run(reason: str, build_s: float | None = None) -> StudentGrade:
         _placeholder_junit(config, folder, reason)
-        return StudentGrade(student.name, student.kind, not_run, reason, artifacts, build_s=build_s)
+        return StudentGrade(
+            student.name, student.kind, not_run, reason, artifacts, build_s=build_s, node=node
+        )
 
     if student.problem is not None:
         return without_run(student.problem)
@@ -189,6 +222,7 @@ def _grade(student: Student, config: GradeConfig, cancel: StopFlag) -> StudentGr
         settings=config.settings,
         results=folder / "results.json",
         junit=folder / "junit.xml",
+        report=folder / "report",
     )
     finished = run_bounded(
         [sys.executable, "-m", "harness.grading.worker", str(job)],
@@ -203,7 +237,15 @@ def _grade(student: Student, config: GradeConfig, cancel: StopFlag) -> StudentGr
     if not (folder / "junit.xml").exists():
         _placeholder_junit(config, folder, first or "no results")
     return StudentGrade(
-        student.name, student.kind, verdicts, first, _artifacts(folder), build_s, finished.wall_s
+        student.name,
+        student.kind,
+        verdicts,
+        first,
+        _artifacts(folder),
+        build_s,
+        finished.wall_s,
+        ticks=ticks_from(data, config),
+        node=node,
     )
 
 

@@ -3,10 +3,12 @@
 A student's node can crash, hang or flood its output; running their suite
 here means that can only ever end this process, never the grader. JOB is a
 JSON file (written by ``grade``) naming the scenarios, the link, the
-LinkOptions and RunSettings fields, and where to write ``results.json`` and
-the JUnit XML. ``results.json`` is rewritten (atomically) after every
-scenario, so a run stopped at its time limit still tells what it judged.
-The human-readable report goes to stdout, as ``fossbot-hil run`` prints it.
+LinkOptions and RunSettings fields, and where to write ``results.json``, the
+JUnit XML and the report folder (what ``fossbot-hil run --out`` writes:
+index.html, plots, recordings). ``results.json`` is rewritten (atomically)
+after every scenario and the report gets each scenario as it ends, so a run
+stopped at its time limit still tells what it judged. The human-readable
+account goes to stdout (run.log), as ``fossbot-hil run`` prints it.
 """
 
 from __future__ import annotations
@@ -14,6 +16,7 @@ from __future__ import annotations
 import json
 import signal
 import sys
+import time
 from dataclasses import asdict, fields
 from pathlib import Path
 from typing import Any
@@ -51,6 +54,7 @@ def write_job(
     settings: Any,
     results: Path,
     junit: Path,
+    report: Path | None = None,
 ) -> Path:
     """Write a job file for this worker: LinkOptions and RunSettings as their fields."""
     job = {
@@ -60,6 +64,7 @@ def write_job(
         "settings": asdict(settings),
         "results": str(results),
         "junit": str(junit),
+        "report": None if report is None else str(report),
     }
     return write_atomically(path, json.dumps(job, indent=2).encode())
 
@@ -87,45 +92,70 @@ def _settings(data: dict[str, Any]) -> Any:
 
 def run_job(job: dict[str, Any]) -> int:
     """Run the job's suite; results.json tells the outcome, the exit code only if it broke."""
-    from rich.console import Console
+    from harness.report.outputs import ReportFolder
 
-    from harness.report.junit import write_junit
-    from harness.report.terminal import print_results
-    from harness.runner.suite import run_suite
-    from harness.scenario.files import resolve_scenario
-
-    results_path = Path(job["results"])
-    entries: list[dict[str, Any]] = []
-    results: list[RunResult] = []
-
-    def keep(result: RunResult) -> None:
-        results.append(result)
-        entries.append(result_entry(result))
-        _write_results(results_path, entries, finished=False, error=None)
-        write_junit(job["junit"], results)  # so a run stopped later still has a report
-        print(f"{result.scenario}: {verdict_of(result)}", flush=True)
-
+    report = ReportFolder(job["report"]) if job.get("report") else None
+    suite = _Suite(job, report)
+    started = time.monotonic()
     try:
-        scenarios = [resolve_scenario(ref) for ref in job["scenarios"]]
-        run_suite(
-            scenarios,
-            job["link"],
-            _options(job["options"]),
-            _settings(job["settings"]),
-            on_result=keep,
-        )
-    except ConfigError as err:  # e.g. the node command cannot be resolved
-        _write_results(results_path, entries, finished=False, error=str(err))
-        print(f"error: {err}", flush=True)
+        return suite.run()
+    finally:
+        if report is not None:
+            report.finish(time.monotonic() - started)  # index.html of what was judged
+
+
+class _Suite:
+    """One student's suite: each result kept (results.json, JUnit, report) as it ends."""
+
+    def __init__(self, job: dict[str, Any], report: Any) -> None:
+        self.job = job
+        self.report = report
+        self.results_path = Path(job["results"])
+        self.entries: list[dict[str, Any]] = []
+        self.results: list[RunResult] = []
+        self.scenarios: dict[str, Any] = {}
+
+    def keep(self, result: RunResult) -> None:
+        from harness.report.junit import write_junit
+
+        self.results.append(result)
+        self.entries.append(result_entry(result))
+        _write_results(self.results_path, self.entries, finished=False, error=None)
+        write_junit(self.job["junit"], self.results)  # a run stopped later keeps its report
+        if self.report is not None:
+            self.report.add(result, self.scenarios.get(result.scenario))
+        print(f"{result.scenario}: judged ({len(result.records)} ticks)", flush=True)
+
+    def run(self) -> int:
+        from rich.console import Console
+
+        from harness.report.terminal import print_results
+        from harness.runner.suite import run_suite
+        from harness.scenario.files import resolve_scenario
+
+        job = self.job
+        try:
+            chosen = [resolve_scenario(ref) for ref in job["scenarios"]]
+            self.scenarios.update((s.name, s) for s in chosen)
+            run_suite(
+                chosen,
+                job["link"],
+                _options(job["options"]),
+                _settings(job["settings"]),
+                on_result=self.keep,
+            )
+        except ConfigError as err:  # e.g. the node command cannot be resolved
+            _write_results(self.results_path, self.entries, finished=False, error=str(err))
+            print(f"error: {err}", flush=True)
+            return 0
+        except KeyboardInterrupt:  # SIGTERM from the grader: links are closed, nodes stopped
+            _write_results(self.results_path, self.entries, finished=False, error="stopped")
+            return 1
+        _write_results(self.results_path, self.entries, finished=True, error=None)
+        print(flush=True)
+        console = Console(highlight=False, width=160, force_terminal=False)
+        print_results(console, self.results)  # the verdicts, once, with the failures explained
         return 0
-    except KeyboardInterrupt:  # SIGTERM from the grader: links are closed, nodes stopped
-        _write_results(results_path, entries, finished=False, error="stopped")
-        return 1
-    _write_results(results_path, entries, finished=True, error=None)
-    print(flush=True)
-    console = Console(highlight=False, width=160, force_terminal=False)
-    print_results(console, results)
-    return 0
 
 
 def _interrupt_on_sigterm() -> None:

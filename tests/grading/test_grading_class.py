@@ -146,16 +146,48 @@ def test_html_page_has_the_same_rows(graded: Graded) -> None:
     parser = _Table()
     parser.feed((graded.out / "grades.html").read_text(encoding="utf-8"))
     header, *rows = parser.rows
-    assert header == ["student", *LAB_SCENARIOS, "passed", "first failure"]
+    assert header == ["student", *LAB_SCENARIOS, "passed ticks held", "first failure"]
     by_name = {row[0].split()[0]: row for row in rows}
     assert sorted(by_name) == ["alice", "bob", "carol", "dave"]
     print(graded.done.stdout)  # shown with -s, for timing notes
     for name, csv_row in graded.rows.items():
         assert by_name[name][1:] == [
-            *(csv_row[s] for s in LAB_SCENARIOS),
-            csv_row["passed"],
+            *(f"{csv_row[s]} {csv_row[s + ' ticks']}".strip() for s in LAB_SCENARIOS),
+            f"{csv_row['passed']} {csv_row['ticks_held']}".strip(),
             csv_row["first_failure"],
         ]
+        assert csv_row["node"] in by_name[name][0]  # the node each student ran
+
+
+def test_each_student_has_a_partial_score_and_the_node_they_ran(graded: Graded) -> None:
+    """Ticks held of ticks judged, per scenario and overall, beside PASS/FAIL."""
+    alice, bob, dave = (graded.rows[n] for n in ("alice", "bob", "dave"))
+    assert alice["node"] == "fossbot_lidar_processing/fossbot_lidar_node (workspace)"
+    assert dave["node"] == "lidar_node.py (script)"
+    assert graded.rows["carol"]["ticks_held"] == "" and graded.rows["carol"]["node"]
+    held, judged = (int(n) for n in bob["out_of_range ticks"].split("/"))
+    assert 0 <= held < judged, bob
+    whole = alice["approach_wall ticks"].split("/")
+    assert whole[0] == whole[1] and alice["ticks_held"].endswith("(100%)"), alice
+    assert bob["ticks_held"].split(" ")[1] not in ("(100%)", "(0%)"), bob
+
+
+def test_each_graded_student_has_a_linked_report(graded: Graded) -> None:
+    """What `run --out` writes, per student, linked from grades.html; none for carol."""
+    page = (graded.out / "grades.html").read_text(encoding="utf-8")
+    for name in ("alice", "bob", "dave"):
+        report = graded.out / "students" / name / "report"
+        assert (report / "index.html").is_file() and (report / "summary.json").is_file()
+        assert list((report / "scenarios").glob("*.png")), name
+        assert f'href="students/{name}/report/index.html"' in page
+    assert not (graded.out / "students" / "carol" / "report").exists()
+    assert 'href="students/carol/report' not in page
+
+
+def test_run_log_lists_the_verdicts_once(graded: Graded) -> None:
+    log = (graded.out / "students" / "bob" / "run.log").read_text(encoding="utf-8")
+    assert "out_of_range: judged (" in log
+    assert sum(line.split()[:1] == ["out_of_range"] for line in log.splitlines()) == 1, log
 
 
 def test_each_student_has_a_junit_report(graded: Graded) -> None:
