@@ -19,9 +19,6 @@ from __future__ import annotations
 
 import argparse
 import contextlib
-import os
-import signal
-import socket
 import subprocess
 import sys
 import tempfile
@@ -30,55 +27,21 @@ from collections.abc import Iterator
 from pathlib import Path
 
 REPO = Path(__file__).resolve().parents[1]
+sys.path[:0] = [str(REPO / "tests"), str(REPO / "tests" / "grading")]  # the tests' helpers
 FAULTS = "clean,noisy,dropouts_nan,driver_rplidar_ros"
 COMMAND = [sys.executable, "-m", "harness.cli"]
-
-
-def _free_port() -> int:
-    with socket.socket() as probe:
-        probe.bind(("127.0.0.1", 0))
-        return int(probe.getsockname()[1])
 
 
 @contextlib.contextmanager
 def external_cluster(workers: int) -> Iterator[str]:
     """`dask scheduler` and `workers` one-thread `dask worker`s, ready, stopped afterwards."""
+    from dask_cluster import GRADING_ENV, dask_cluster
     from distributed import Client
 
-    address = f"tcp://127.0.0.1:{_free_port()}"
-    env = {
-        **os.environ,
-        "DASK_DISTRIBUTED__SCHEDULER__ALLOWED_FAILURES": "1",
-        "DASK_DISTRIBUTED__SCHEDULER__WORKER_SATURATION": "1.0",
-    }
-    quiet = {"stdout": subprocess.DEVNULL, "stderr": subprocess.DEVNULL, "env": env}
-    port = address.rsplit(":", 1)[1]
-    processes = [
-        subprocess.Popen(
-            [sys.executable, "-m", "distributed.cli.dask_scheduler", "--host", "127.0.0.1"]
-            + ["--port", port, "--dashboard-address", ":0"],
-            **quiet,
-        )
-    ]
-    processes += [
-        subprocess.Popen(
-            [sys.executable, "-m", "distributed.cli.dask_worker", address, "--nthreads", "1"],
-            **quiet,
-        )
-        for _ in range(workers)
-    ]
-    try:
+    with dask_cluster(workers, nanny=True, env=GRADING_ENV) as (address, _):
         with Client(address, timeout=30) as client:
             client.wait_for_workers(workers, timeout=60)
         yield address
-    finally:
-        for process in processes:
-            process.send_signal(signal.SIGTERM)
-        for process in processes:
-            try:
-                process.wait(timeout=30)
-            except subprocess.TimeoutExpired:
-                process.kill()
 
 
 def make_class(folder: Path, students: int) -> None:
@@ -88,7 +51,6 @@ def make_class(folder: Path, students: int) -> None:
         students - 2: "hangs",
         students - 1: "kills_worker",
     }
-    sys.path.insert(0, str(REPO / "tests" / "grading"))
     from grading_class import HANGS, KILLS_ITS_WORKER, VARIANT
 
     for index in range(students):

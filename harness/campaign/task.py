@@ -12,20 +12,24 @@ from __future__ import annotations
 import os
 import socket
 import time
+from dataclasses import replace
 from typing import Any
 
 from harness.campaign.plan import SCENARIO_FAULTS, RunSpec
 from harness.links.base import LinkOptions
+from harness.runner.settings import RunSettings
 from harness.safe_text import clip, for_csv
 
 FAILURE_CHARS = 500  # of the first failure kept in the table
 
 
-def run_one(spec: RunSpec, link_name: str, options: LinkOptions) -> dict[str, Any]:
-    """Run `spec` through a fresh link and return its results row."""
+def run_one(
+    spec: RunSpec, link_name: str, options: LinkOptions, judged: RunSettings | None = None
+) -> dict[str, Any]:
+    """Run `spec` through a fresh link and return its results row; `judged` holds what
+    every run of the campaign is judged with (status regex, warning rule)."""
     from harness.faults.sensor import split_fault_text
     from harness.runner.scenario_run import run
-    from harness.runner.settings import RunSettings
     from harness.scenario.files import resolve_scenario
     from harness.scenario.variations import varied
 
@@ -33,7 +37,9 @@ def run_one(spec: RunSpec, link_name: str, options: LinkOptions) -> dict[str, An
     try:
         scenario = varied(resolve_scenario(spec.scenario), dict(spec.variation))
         faults = None if spec.faults == SCENARIO_FAULTS else split_fault_text(spec.faults)
-        settings = RunSettings(seed=spec.seed, threshold=spec.threshold, faults=faults)
+        settings = replace(
+            judged or RunSettings(), seed=spec.seed, threshold=spec.threshold, faults=faults
+        )
         result = run(scenario, link_name, options, settings)
     except Exception as err:  # a run that could not be made is a result, not a lost task
         verdict, ticks, failed, failure = "ERROR", 0, 0, f"{type(err).__name__}: {err}"

@@ -176,15 +176,19 @@ def judging_settings(args: argparse.Namespace) -> RunSettings:
     )
 
 
-def add_judging_options(parser: argparse.ArgumentParser, *, deadline: bool = True) -> None:
-    """How answers are judged and waited for: threshold, status regex, and (lockstep
-    commands, `deadline`) the per-scan timeout."""
-    parser.add_argument(
-        "--threshold",
-        type=positive("threshold"),
-        metavar="M",
-        help="the oracle's warning threshold in metres (default: the scenario's)",
-    )
+def add_judging_options(
+    parser: argparse.ArgumentParser, *, deadline: bool = True, threshold: bool = True
+) -> None:
+    """How answers are judged and waited for: threshold (unless a command has its own),
+    status regex, the warning rule, and (lockstep commands, `deadline`) the per-scan
+    timeout."""
+    if threshold:
+        parser.add_argument(
+            "--threshold",
+            type=positive("threshold"),
+            metavar="M",
+            help="the oracle's warning threshold in metres (default: the scenario's)",
+        )
     parser.add_argument(
         "--status-regex",
         metavar="REGEX",

@@ -11,9 +11,11 @@ from rich.console import Console
 
 from harness.atomic_write import write_atomically
 from harness.commands.arguments import (
+    add_judging_options,
     add_link_option,
     add_node_options,
     check_link_options,
+    check_status_regex,
     given,
     whole_number,
 )
@@ -25,6 +27,7 @@ if TYPE_CHECKING:
     from harness.campaign.plan import RunSpec, Variation
     from harness.campaign.results import ResultsTable
     from harness.links.base import LinkOptions
+    from harness.runner.settings import RunSettings
 
 NAME = "sweep"
 HELP = "run one node through every combination of scenarios, faults, seeds and thresholds"
@@ -108,6 +111,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "start_dx, start_dy (m), start_dyaw (rad), speed (x); docs/campaigns.md",
     )
     add_link_option(parser)
+    add_judging_options(parser, threshold=False)  # --thresholds is a factor here
     parser.add_argument(
         "--out",
         type=given("--out"),
@@ -133,6 +137,7 @@ def run(args: argparse.Namespace, console: Console) -> int:
     from harness.campaign.plan import plan
     from harness.campaign.results import ResultsTable, columns_for
     from harness.cluster.client import check_cluster_options
+    from harness.runner.settings import RunSettings
 
     check_cluster_options(args.scheduler, args.workers)
     if args.domain_id is not None:
@@ -140,6 +145,10 @@ def run(args: argparse.Namespace, console: Console) -> int:
     if args.parquet:
         check_parquet_available()
     options = check_link_options(args)
+    check_status_regex(args)
+    judged = RunSettings(
+        status_pattern=args.status_regex, warning_when_clear=args.warning_when_clear
+    )
     varied = _varied(args.vary)
     specs = plan(*_levels(args, varied))
     if len(specs) > MAX_RUNS:
@@ -154,7 +163,7 @@ def run(args: argparse.Namespace, console: Console) -> int:
         f"results in {out / 'results.csv'}",
     )
     if todo:
-        _run_all(console, todo, args, options, table)
+        _run_all(console, todo, args, options, judged, table)
     wanted = {spec.key for spec in specs}
     rows = [row for row in table.rows if row["key"] in wanted]
     lines = explain(rows, varied=list(varied))
@@ -211,6 +220,7 @@ def _run_all(
     todo: list[RunSpec],
     args: argparse.Namespace,
     options: LinkOptions,
+    judged: RunSettings,
     table: ResultsTable,
 ) -> None:
     """Submit every run, write each row as it finishes, show progress."""
@@ -231,7 +241,9 @@ def _run_all(
         link = dashboard(client)
         if link:
             say(console, f"Dask dashboard: {link}")
-        futures = client.map(run_one, todo, link_name=args.link, options=options, pure=False)
+        futures = client.map(
+            run_one, todo, link_name=args.link, options=options, judged=judged, pure=False
+        )
         failed = 0
         columns = (
             TextColumn("{task.description}"),

@@ -7,24 +7,19 @@ sweep of the same seeds gives.
 
 from __future__ import annotations
 
-import contextlib
 import csv
 import os
 import signal
-import socket
 import subprocess
-import sys
 import time
-from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
 from command_line import COMMAND, fossbot_hil
+from dask_cluster import dask_cluster
 
 pytestmark = [pytest.mark.ros, pytest.mark.slow, pytest.mark.timeout(300)]
 
-DASK = [sys.executable, "-m", "distributed.cli.dask_scheduler"]
-WORKER = [sys.executable, "-m", "distributed.cli.dask_worker"]
 SWEEP = [
     "sweep",
     "--scenario",
@@ -33,6 +28,8 @@ SWEEP = [
     "clean,noisy",
     "--seeds",
     "2",
+    "--timeout",
+    "5",  # a generous per-scan deadline: a busy machine must not turn into a late answer
 ]
 
 
@@ -45,40 +42,6 @@ def _verdicts(rows: list[dict[str, str]]) -> dict[str, tuple[str, str, str]]:
     return {r["key"]: (r["verdict"], r["ticks"], r["failed_ticks"]) for r in rows}
 
 
-def _free_port() -> int:
-    with socket.socket() as probe:
-        probe.bind(("127.0.0.1", 0))
-        return int(probe.getsockname()[1])
-
-
-@contextlib.contextmanager
-def _cluster(workers: int) -> Iterator[tuple[str, list[subprocess.Popen[bytes]]]]:
-    """A scheduler and `workers` single-threaded workers, without nannies (a killed
-    worker stays dead), all stopped afterwards."""
-    port = _free_port()
-    address = f"tcp://127.0.0.1:{port}"
-    quiet = {"stdout": subprocess.DEVNULL, "stderr": subprocess.DEVNULL}
-    scheduler = subprocess.Popen(
-        [*DASK, "--host", "127.0.0.1", "--port", str(port), "--dashboard-address", ":0"], **quiet
-    )
-    started = [
-        subprocess.Popen([*WORKER, address, "--nthreads", "1", "--no-nanny"], **quiet)
-        for _ in range(workers)
-    ]
-    try:
-        yield address, started
-    finally:
-        for process in [*started, scheduler]:
-            if process.poll() is None:
-                process.send_signal(signal.SIGTERM)
-        for process in [*started, scheduler]:
-            try:
-                process.wait(timeout=20)
-            except subprocess.TimeoutExpired:
-                process.kill()
-                process.wait(timeout=10)
-
-
 def test_an_external_cluster_loses_nothing_when_a_worker_is_killed(tmp_path: Path) -> None:
     one_machine = tmp_path / "one"
     done = fossbot_hil(*SWEEP, "--workers", "1", "--out", str(one_machine), timeout=240)
@@ -87,7 +50,7 @@ def test_an_external_cluster_loses_nothing_when_a_worker_is_killed(tmp_path: Pat
     assert len(expected) == 8
 
     out = tmp_path / "cluster"
-    with _cluster(workers=2) as (address, workers):
+    with dask_cluster(2, nanny=False) as (address, workers):
         sweep = subprocess.Popen(
             [*COMMAND, *SWEEP, "--scheduler", address, "--out", str(out)],
             stdout=subprocess.PIPE,
@@ -157,6 +120,8 @@ def test_generated_variations_are_factors_with_a_column_each(tmp_path: Path) -> 
         "wall_distance=0.4,1.5",
         "--workers",
         "1",
+        "--timeout",
+        "5",
         "--parquet",
         "--out",
         str(out),
