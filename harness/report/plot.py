@@ -23,7 +23,8 @@ from harness.safe_text import visible
 
 __all__ = ["AS_WRITTEN", "PlotSeries", "draw_text", "plot_series", "render_plot", "write_plot"]
 
-WIDTH_IN, HEIGHT_IN, DPI = 8.0, 5.0, 90  # about 720 x 450 px: a few tens of kB
+WIDTH_IN, HEIGHT_IN, DPI = 8.0, 6.0, 90  # about 720 x 540 px: a few tens of kB
+ANGLE_REACH = 2 * math.pi + 0.1  # the oracle accepts angles in [-2 pi, 2 pi]; beyond: off scale
 FAILED_COLOUR = "#f2b8b8"
 # matplotlib text properties for text from outside (a scenario name, a node's status):
 # mathtext off, so a "$" in it is a dollar sign, never a formula matplotlib fails to parse.
@@ -47,6 +48,9 @@ class PlotSeries:
     nearest: np.ndarray  # min valid range of the scan the node saw (NaN: no valid reading)
     claimed: np.ndarray  # the node's distance (NaN: none given, or not finite)
     claimed_nonfinite: np.ndarray  # bool: the status gave inf or nan as the distance
+    angle_expected: np.ndarray  # rad, in [-pi, pi) (NaN: no obstacle)
+    angle_claimed: np.ndarray  # the node's angle on the expected one's turn (NaN: none)
+    angle_off: np.ndarray  # bool: the node's angle is beyond +-2 pi (degrees?) or not finite
     warning_expected: np.ndarray  # 1 True, 0 False, NaN either (within the band)
     warning_got: np.ndarray  # 1 True, 0 False, NaN no Bool
     failed: np.ndarray  # bool
@@ -65,9 +69,28 @@ def _flag(value: bool | None) -> float:
     return math.nan if value is None else float(value)
 
 
+def _wrap(angle: float) -> float:
+    """`angle` folded into [-pi, pi)."""
+    return (angle + math.pi) % (2 * math.pi) - math.pi
+
+
+def _angles(expected: float | None, claimed: float | None) -> tuple[float, float, bool]:
+    """(expected, claimed, off the scale): the claim is drawn on the expected angle's turn,
+    so a node answering in [0, 2 pi) lies on the line when it is right; a claim the oracle
+    never reads as radians (beyond +-2 pi, degrees most likely) is drawn off the scale."""
+    want = math.nan if expected is None else _wrap(expected)
+    if claimed is None:
+        return want, math.nan, False
+    if not math.isfinite(claimed) or abs(claimed) > ANGLE_REACH:
+        return want, math.nan, True
+    base = want if math.isfinite(want) else 0.0
+    return want, base + _wrap(claimed - base), False
+
+
 def plot_series(result: RunResult) -> PlotSeries:
     """The arrays a plot of `result` shows (the scan judged is the one the node saw)."""
     nearest, claimed, odd = [], [], []
+    angles: list[tuple[float, float, bool]] = []
     # In time order: a reordered scan was judged after the next one.
     records = sorted(result.records, key=lambda r: r.t)
     for r in records:
@@ -78,6 +101,8 @@ def plot_series(result: RunResult) -> PlotSeries:
         finite = d is not None and math.isfinite(d)
         claimed.append(d if finite else math.nan)
         odd.append(d is not None and not finite)
+        told = claim.angle if claim is not None and claim.obstacle else None
+        angles.append(_angles(r.verdict.expected.angle, told))
     failed = len(result.failed_ticks)
     counted = f"{failed} of {len(records)} ticks failed" if failed else f"{len(records)} ticks"
     title = f"{visible(result.scenario)} · {result.link} · {verdict_of(result)} ({counted})"
@@ -88,6 +113,9 @@ def plot_series(result: RunResult) -> PlotSeries:
         nearest=np.array(nearest, dtype=float),
         claimed=np.array(claimed, dtype=float),
         claimed_nonfinite=np.array(odd, dtype=bool),
+        angle_expected=np.array([a[0] for a in angles], dtype=float),
+        angle_claimed=np.array([a[1] for a in angles], dtype=float),
+        angle_off=np.array([a[2] for a in angles], dtype=bool),
         warning_expected=np.array([_flag(r.verdict.expected.warning) for r in records]),
         warning_got=np.array([_flag(r.verdict.warning_got) for r in records]),
         failed=np.array([not r.verdict.ok for r in records], dtype=bool),
@@ -110,19 +138,25 @@ def _spans(t: np.ndarray, mask: np.ndarray) -> list[tuple[float, float]]:
     return [(t[a] - step / 2, t[b] - t[a] + step) for a, b in _runs(mask)]
 
 
+def _unwrapped_gaps(t: np.ndarray, angle: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The line broken where it wraps from pi to -pi, instead of a vertical stroke."""
+    jumps = np.flatnonzero(np.abs(np.diff(angle)) > math.pi) + 1
+    return np.insert(t, jumps, np.nan), np.insert(angle, jumps, np.nan)
+
+
 def render_plot(series: PlotSeries) -> bytes:
     """The PNG bytes (deterministic: no software or date in the metadata)."""
     from matplotlib.figure import Figure  # lazy: matplotlib takes a while to import
 
     fig = Figure(figsize=(WIDTH_IN, HEIGHT_IN), dpi=DPI, layout="constrained")
-    top, bottom = fig.subplots(
-        2, 1, sharex=True, gridspec_kw={"height_ratios": [3, 1]}, squeeze=True
+    top, middle, bottom = fig.subplots(
+        3, 1, sharex=True, gridspec_kw={"height_ratios": [3, 2, 1]}, squeeze=True
     )
     fig.suptitle(series.title, fontsize=10, **AS_WRITTEN)  # a name may hold "$"
     t = series.t
     failed_spans = _spans(t, series.failed)
     band_spans = _spans(t, np.isnan(series.warning_expected))
-    for ax in (top, bottom):
+    for ax in (top, middle, bottom):
         if failed_spans:
             ax.broken_barh(
                 failed_spans, (0, 1), transform=ax.get_xaxis_transform(), color=FAILED_COLOUR, lw=0
@@ -164,6 +198,26 @@ def render_plot(series: PlotSeries) -> bytes:
         top.plot([], [], "s", color=FAILED_COLOUR, label="failed tick")
     top.set_ylabel("range, m", fontsize=8)
 
+    # Middle: the angle of the nearest return.
+    middle.plot(
+        *_unwrapped_gaps(t, series.angle_expected), color="#1f5fa8", lw=1.4, label="expected angle"
+    )
+    middle.plot(t, series.angle_claimed, "o", ms=2.5, color="#e07b00", label="node's angle")
+    off = series.angle_off
+    if off.any():
+        middle.plot(
+            t[off],
+            np.full(int(off.sum()), 3.9),
+            "^",
+            ms=4,
+            color="#e07b00",
+            clip_on=False,
+            label="node's angle beyond 2 pi (degrees?) or inf/nan",
+        )
+    middle.set_ylim(-4.0, 4.0)
+    middle.set_yticks([-math.pi, 0, math.pi], ["-pi", "0", "pi"])
+    middle.set_ylabel("angle, rad", fontsize=8)
+
     # Bottom: the warning Bool.
     for x, width in band_spans:
         bottom.axvspan(x, x + width, color="#dddddd", lw=0)
@@ -177,10 +231,11 @@ def render_plot(series: PlotSeries) -> bytes:
     bottom.set_ylabel("warning", fontsize=8)
     bottom.set_xlabel("simulated time, s", fontsize=8)
     handles, labels = top.get_legend_handles_labels()
+    turned, turned_labels = middle.get_legend_handles_labels()
     more, more_labels = bottom.get_legend_handles_labels()
     fig.legend(
-        handles + more,
-        labels + [f"warning {x}" for x in more_labels],
+        handles + turned + more,
+        labels + turned_labels + [f"warning {x}" for x in more_labels],
         loc="outside lower center",
         ncols=4,
         fontsize=7,

@@ -117,3 +117,23 @@ def test_a_scenario_name_is_drawn_as_text_never_as_markup(tmp_path) -> None:
     path = write_plot(tmp_path / "plot.png", result)
     assert path.read_bytes().startswith(b"\x89PNG")
     assert "\\x1b" in plot_series(result).title
+
+
+def test_the_angle_panel_shows_a_degrees_node_off_the_scale() -> None:
+    """Expected and reported angles: right ones on the line whatever their wrap, degrees
+    drawn off the scale (the gap an angle failure is about)."""
+    scan = _scan([3.0, 0.5, 3.0, 3.0])  # nearest at beam 1: -pi/2
+    result = RunResult("s", "ros2", 0, 0.3, "clean")
+    result.records += [
+        _tick(0, scan, None, "Obstacle at 0.500 m, angle -1.571 rad", False),
+        _tick(1, scan, None, "Obstacle at 0.500 m, angle 4.712 rad", False),  # [0, 2 pi)
+        _tick(2, scan, None, "Obstacle at 0.500 m, angle -90.0", False),  # degrees
+        _tick(3, scan, None, "no obstacle", False),
+    ]
+    s = plot_series(result)
+    assert np.allclose(s.angle_expected, -math.pi / 2)
+    assert np.allclose(s.angle_claimed[:2], -math.pi / 2, atol=1e-3)
+    assert math.isnan(s.angle_claimed[2]) and s.angle_off.tolist() == [False, False, True, False]
+    assert math.isnan(s.angle_claimed[3])
+    png = render_plot(s)
+    assert png[:8] == b"\x89PNG\r\n\x1a\n"
