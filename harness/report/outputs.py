@@ -30,6 +30,7 @@ from harness.atomic_write import fill_atomically, relative_path, write_atomicall
 from harness.errors import ConfigError
 from harness.judge.records import RunResult
 from harness.report.folder_lock import lock_folder
+from harness.report.previous_run import clear_previous_run
 from harness.report.summary import json_bytes, run_summary, scenario_details, scenario_entry
 from harness.safe_text import DIAGNOSTICS_LIMIT, for_storage
 
@@ -186,6 +187,7 @@ class ReportFolder:
     def __init__(self, root: str | Path, writers: Sequence[Writer] | None = None) -> None:
         self.root = prepare_folder(root)
         self._lock = lock_folder(self.root, root)
+        self.cleared = clear_previous_run(self.root)  # an earlier run's files, once locked
         self.writers = list(writers) if writers is not None else artifact_writers()
         self.scenarios: list[ScenarioFiles] = []
         self._stems: set[str] = set()

@@ -185,3 +185,22 @@ def test_folder_that_cannot_be_made_is_a_config_error(tmp_path: Path) -> None:
     with pytest.raises(ConfigError, match="is a file, not a folder|Not a directory"):
         ReportFolder(afile / "sub")
     assert afile.read_text() == "not a folder"
+
+
+def test_a_reused_folder_keeps_no_scenario_of_an_earlier_run(
+    tmp_path: Path, passing: RunResult, failing: RunResult
+) -> None:
+    """The earlier run's files (as its summary.json lists them) go; the user's stay, and a
+    summary naming files outside scenarios/ deletes nothing there."""
+    write_report(tmp_path, [passing, failing])
+    before = {p.name for p in (tmp_path / "scenarios").iterdir()}
+    (tmp_path / "scenarios" / "notes.txt").write_text("mine")
+    (tmp_path / "keep.json").write_text("{}")
+    write_report(tmp_path, [passing])
+    after = {p.name for p in (tmp_path / "scenarios").iterdir()}
+    assert after == {n for n in before if n.startswith(passing.scenario)} | {"notes.txt"}
+    summary = json.loads((tmp_path / "summary.json").read_text())
+    summary["scenarios"][0]["files"]["plot"] = "keep.json"  # tampered: outside scenarios/
+    (tmp_path / "summary.json").write_text(json.dumps(summary))
+    write_report(tmp_path, [failing])
+    assert (tmp_path / "keep.json").exists() and (tmp_path / "scenarios" / "notes.txt").exists()
