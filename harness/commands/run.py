@@ -25,6 +25,7 @@ from harness.errors import ConfigError, Interrupted
 
 if TYPE_CHECKING:  # the rest is imported when a run starts (the parser is built for any command)
     from harness.judge.records import RunResult
+    from harness.report.baseline import Baseline, Comparison
     from harness.report.outputs import ReportFolder
     from harness.runner.settings import RunSettings
     from harness.scenario.schema import Scenario
@@ -33,6 +34,7 @@ T = TypeVar("T")
 
 NAME = "run"
 HELP = "run scenarios and judge the node's answers"
+FAIL_ON = ("failure", "regression")
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -62,8 +64,42 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="with --out: also an animated top-down view of each scenario, "
         "scenarios/<name>.gif (a few seconds per scenario)",
     )
+    parser.add_argument(
+        "--baseline",
+        type=given("--baseline"),
+        metavar="FILE",
+        help="summary.json of an earlier run (or its --out folder): say what regressed, "
+        "what was fixed and what still fails (see docs/ci.md)",
+    )
+    parser.add_argument(
+        "--fail-on",
+        choices=FAIL_ON,
+        default="failure",
+        help="exit 1 on any failed expectation (failure, the default), or only on a failure "
+        "the --baseline does not know (regression: known failures are tolerated)",
+    )
     add_node_options(parser)
     add_device_options(parser)
+
+
+def check_baseline(args: argparse.Namespace) -> Baseline | None:
+    """The `--baseline` summary, read now so a bad file fails before anything runs."""
+    if args.baseline is None:
+        if args.fail_on == "regression":
+            raise ConfigError("--fail-on regression needs --baseline FILE (a run to compare with)")
+        return None
+    from harness.report.baseline import load_baseline
+
+    return load_baseline(args.baseline)
+
+
+def compared(results: Sequence[RunResult], baseline: Baseline) -> Comparison:
+    """This run's verdicts against the baseline's, as summary.json would hold them."""
+    from harness.report.baseline import compare
+    from harness.report.outputs import stored
+    from harness.report.summary import scenario_entry
+
+    return compare(baseline, [scenario_entry(stored(r), {}) for r in results])
 
 
 def selected(names: Sequence[str]) -> list[Scenario]:
@@ -120,12 +156,13 @@ def run(args: argparse.Namespace, console: Console) -> int:
     from harness.nodes.forkserver import scope
 
     check_animate(args)  # before a node or a fork server starts
+    baseline = check_baseline(args)
 
     with scope():  # whatever prepare() starts stops with the command
-        return _run(args, console)
+        return _run(args, console, baseline)
 
 
-def _run(args: argparse.Namespace, console: Console) -> int:
+def _run(args: argparse.Namespace, console: Console, baseline: Baseline | None) -> int:
     from harness.links.base import link_class
 
     # First what takes a while in another process (the node's fork server),
@@ -168,8 +205,13 @@ def _run(args: argparse.Namespace, console: Console) -> int:
             interrupted, results = stop, stop.results
     wall_s = command_seconds()
     print_results(console, results, wall_s=wall_s)
+    comparison = compared(results, baseline) if baseline is not None else None
+    if comparison is not None:
+        from harness.report.terminal import print_comparison
+
+        print_comparison(console, comparison)
     if report is not None:
-        index = _write(f"--out {args.out}", report.finish, wall_s)
+        index = _write(f"--out {args.out}", report.finish, wall_s, baseline=baseline)
         console.print(f"report: {index}", highlight=False, markup=False, soft_wrap=True)
     if args.junit_xml:
         from harness.report.junit import write_junit
@@ -186,6 +228,8 @@ def _run(args: argparse.Namespace, console: Console) -> int:
         judged = sum(1 for r in results if not r.not_run)
         summary = f"{judged} of {len(scenarios)} scenarios judged, the last one in part"
         raise Interrupted(interrupted.signum, results, summary)
+    if args.fail_on == "regression" and comparison is not None:
+        return 0 if comparison.ok else 1  # known failures tolerated
     return 0 if all(r.ok for r in results) else 1
 
 

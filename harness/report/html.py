@@ -20,6 +20,7 @@ from harness.safe_text import DIAGNOSTICS_LIMIT, TEXT_LIMIT, clip, for_html, vis
 __all__ = ["index_html"]
 
 DIAGNOSTIC_LINES = 15
+CHANGE_HEAD = ["change", "scenario", "faults", "then", "now", "why"]
 
 _STYLE = """
 body { font: 14px/1.4 system-ui, sans-serif; margin: 1.5em auto; max-width: 60em; color: #222; }
@@ -29,6 +30,9 @@ td.n { text-align: right; font-variant-numeric: tabular-nums; }
 .PASS { color: #1a7f37; font-weight: bold; }
 .FAIL, .ERROR { color: #c62828; font-weight: bold; }
 .NOT_RUN { color: #9a6700; font-weight: bold; }
+.regressed { color: #c62828; font-weight: bold; }
+.fixed { color: #1a7f37; font-weight: bold; }
+.still_failing, .new, .not_compared, .missing, p.note { color: #9a6700; }
 p.failure { color: #c62828; font-family: monospace; white-space: pre-wrap; }
 pre { background: #f6f6f6; padding: 0.5em; overflow-x: auto; }
 img { max-width: 100%; border: 1px solid #ddd; }
@@ -51,13 +55,19 @@ def _file_links(files: Mapping[str, str | None]) -> str:
     return " ".join(f'<a href="{_href(p)}">{_text(n)}</a>' for n, p in files.items() if p)
 
 
+def _change(kind: str) -> str:
+    return f'<span class="{kind.replace(" ", "_")}">{_text(kind)}</span>'
+
+
 def _row(i: int, e: Mapping[str, Any]) -> str:
+    change = [_change(e["change"])] if "change" in e else []
     cells = [
         f'<a href="#scenario-{i}">{_text(e["scenario"])}</a>',
         _text(e["link"]),
         f'<td class="n">{e["ticks"]}',
         f'<td class="n">{e["failed"]}',
         _verdict(e["verdict"]),
+        *change,
         f'<td class="n">{e["total_s"]:.2f}',
         f'<td class="n">{_text(e["seed"])}',
         f'<td class="n">{_text(e["threshold"])}',
@@ -96,11 +106,39 @@ def _image(path: str, alt: str) -> str:
     return f'<p><a href="{href}"><img src="{href}" alt="{_text(alt)}" loading="lazy"></a></p>'
 
 
+def _baseline(comparison: Mapping[str, Any]) -> list[str]:
+    """The comparison with `--baseline`: notes, every change but "still passing", counts."""
+    out = [
+        "<h2>Compared with the baseline</h2>",
+        f"<p>{_text(comparison['file'])} (fossbot-hil {_text(comparison['harness'])})</p>",
+        *(f'<p class="note">note: {_text(note)}</p>' for note in comparison["notes"]),
+    ]
+    rows = [c for c in comparison["changes"] if c["change"] != "still passing"]
+    if rows:
+        out.append("<table>")
+        out.append("<tr>" + "".join(f"<th>{h}" for h in CHANGE_HEAD) + "</tr>")
+        for c in rows:
+            cells = [c["scenario"], c["faults"], c["then"] or "-", c["now"] or "-"]
+            out.append(
+                f"<tr><td>{_change(c['change'])}"
+                + "".join(f"<td>{_text(x)}" for x in cells)
+                + f"<td>{_text(c['reason'] or '')}</tr>"
+            )
+        out.append("</table>")
+    counts = ", ".join(f"{n} {k.replace('_', ' ')}" for k, n in comparison["counts"].items() if n)
+    verdict = "no regression" if comparison["ok"] else "failing, and not known from the baseline"
+    out.append(f"<p>{_text(counts)}: <strong>{_text(verdict)}</strong>.</p>")
+    return out
+
+
 def index_html(summary: Mapping[str, Any], *, diagnostics: Sequence[str] = ()) -> bytes:
-    """The page for a run summary (see harness.report.summary.run_summary)."""
+    """The page for a run summary (see harness.report.summary.run_summary), with the
+    comparison harness.report.baseline.with_comparison added, when there is one."""
     entries = summary["scenarios"]
     headline = f"{summary['passed']} of {summary['total']} scenarios passed"
     head = ["scenario", "link", "ticks", "failed", "verdict", "time s", "seed", "threshold"]
+    if "baseline" in summary:
+        head.insert(5, "vs baseline")
     lines = [
         "<!DOCTYPE html>",
         '<html lang="en">',
@@ -116,6 +154,8 @@ def index_html(summary: Mapping[str, Any], *, diagnostics: Sequence[str] = ()) -
         *(_row(i, e) for i, e in enumerate(entries)),
         "</table>",
     ]
+    if "baseline" in summary:
+        lines.extend(_baseline(summary["baseline"]))
     for i, e in enumerate(entries):
         lines.extend(_section(i, e, diagnostics[i] if i < len(diagnostics) else ""))
     lines += ["</body>", "</html>", ""]

@@ -8,18 +8,24 @@ rich markup, with every non-printable character shown as its escape
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import TYPE_CHECKING
 
 from rich.console import Console
 from rich.table import Table
 from rich.text import Text
 
 from harness.judge.records import RunResult
+from harness.report.baseline import KINDS
 from harness.report.summary import verdict_of
 from harness.safe_text import DIAGNOSTICS_LIMIT, TEXT_LIMIT, clip, for_terminal
 from harness.scenario.schema import Scenario
 
+if TYPE_CHECKING:
+    from harness.report.baseline import Comparison
+
 DIAGNOSTIC_LINES = 15
 VERDICT_STYLES = {"PASS": "green", "FAIL": "red", "ERROR": "red", "NOT RUN": "yellow"}
+CHANGE_STYLES = {"regressed": "bold red", "fixed": "green", "still failing": "yellow"}
 
 
 def _plain(text: object, style: str = "") -> Text:
@@ -119,3 +125,38 @@ def print_results(
     passed = total - len(failed)
     console.print()
     console.print(f"{passed} of {total} scenarios passed", highlight=False)
+
+
+def print_comparison(console: Console, comparison: Comparison) -> None:
+    """`run --baseline`: what differs from the baseline as a whole, then one row per
+    scenario whose verdict is not a plain "still passing", then the counts."""
+    console.print()
+    print_safe(
+        console,
+        f"compared with the baseline {comparison.baseline} (fossbot-hil {comparison.harness})",
+        style="bold",
+    )
+    for note in comparison.notes:
+        print_safe(console, f"  note: {note}", style="yellow")
+    rows = [c for c in comparison.changes if c.kind != "still passing"]
+    if rows:
+        table = Table(box=None, pad_edge=False)
+        for column in ("change", "scenario", "faults", "then", "now", "why"):
+            table.add_column(column, overflow="fold")
+        for c in sorted(rows, key=lambda c: KINDS.index(c.kind)):
+            table.add_row(
+                Text(c.kind, style=CHANGE_STYLES.get(c.kind, "")),
+                _plain(c.scenario),
+                _plain(c.faults),
+                c.then or "-",
+                c.now or "-",
+                _plain(c.reason),
+            )
+        console.print(table)
+    console.print(comparison.headline(), highlight=False)
+    unknown = comparison.unknown_failures
+    if unknown:
+        named = ", ".join(f"{c.scenario} [{c.faults}] ({c.kind})" for c in unknown)
+        print_safe(console, f"failing, and not known from the baseline: {named}", style="bold red")
+    else:
+        console.print("no regression: every failure is known from the baseline", highlight=False)
