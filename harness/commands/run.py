@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 from collections.abc import Callable, Sequence
+from dataclasses import replace
 from typing import TYPE_CHECKING, Any, TypeVar
 
 from rich.console import Console
@@ -17,8 +18,8 @@ from harness.commands.arguments import (
     check_link_options,
     check_output_file,
     check_status_regex,
-    fault_list,
     given,
+    judging_settings,
     unchecked_link_options,
 )
 from harness.errors import ConfigError, Interrupted
@@ -111,16 +112,7 @@ def selected(names: Sequence[str]) -> list[Scenario]:
 
 def settings_from(args: argparse.Namespace) -> RunSettings:
     """The per-run overrides given on the command line."""
-    from harness.runner.settings import RunSettings
-
-    return RunSettings(
-        seed=args.seed,
-        threshold=args.threshold,
-        faults=fault_list(args.faults),
-        status_pattern=args.status_regex,
-        warning_when_clear=args.warning_when_clear,
-        gui=args.gui,
-    )
+    return replace(judging_settings(args), gui=args.gui)
 
 
 def open_report(out: str | None, *, animate: bool = False) -> ReportFolder | None:

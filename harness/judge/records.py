@@ -36,6 +36,7 @@ class RunResult:
     threshold: float
     faults: str
     noise_sigma: float = 0.0  # the fault profile's noise, which widens the oracle's band
+    warning_rule: str = "optional"  # "required": warning False was due on every clear scan
     records: list[TickRecord] = field(default_factory=list)
     error: str | None = None
     diagnostics: str = ""  # e.g. the node's last stderr lines, shown on failure

@@ -53,6 +53,7 @@ KINDS = (
     "still passing",
 )  # the order the terminal and the page list them in
 JUDGED_ALIKE = ("link", "threshold", "seed")  # what must match for two verdicts to compare
+WARNING_RULE = "warning_when_clear"  # must match too; absent (older summaries): "optional"
 _FIELDS: dict[str, type | tuple[type, ...]] = {
     "scenario": str,
     "verdict": str,
@@ -216,6 +217,9 @@ def _judged_otherwise(then: Mapping[str, Any], now: Mapping[str, Any]) -> str:
         for field in JUDGED_ALIKE
         if not _same(field, then[field], now[field])
     ]
+    rule_then, rule_now = (e.get(WARNING_RULE, "optional") for e in (then, now))
+    if rule_then != rule_now:  # a summary older than the rule judged it "optional"
+        differ.append(f"{WARNING_RULE} {rule_then} in the baseline, {rule_now} now")
     return "; ".join(differ)
 
 

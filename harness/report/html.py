@@ -15,6 +15,7 @@ from html import escape
 from typing import Any
 from urllib.parse import quote
 
+from harness.report.summary import passed_line
 from harness.safe_text import DIAGNOSTICS_LIMIT, TEXT_LIMIT, clip, for_html, visible
 
 __all__ = ["index_html"]
@@ -71,6 +72,7 @@ def _row(i: int, e: Mapping[str, Any]) -> str:
         f'<td class="n">{e["total_s"]:.2f}',
         f'<td class="n">{_text(e["seed"])}',
         f'<td class="n">{_text(e["threshold"])}',
+        _text(e.get("warning_when_clear", "optional")),
         _text(e["faults"]),
         _file_links(e["files"]),
     ]
@@ -135,8 +137,9 @@ def index_html(summary: Mapping[str, Any], *, diagnostics: Sequence[str] = ()) -
     """The page for a run summary (see harness.report.summary.run_summary), with the
     comparison harness.report.baseline.with_comparison added, when there is one."""
     entries = summary["scenarios"]
-    headline = f"{summary['passed']} of {summary['total']} scenarios passed"
+    headline = passed_line(summary["passed"], summary["total"])
     head = ["scenario", "link", "ticks", "failed", "verdict", "time s", "seed", "threshold"]
+    head.append("warning when clear")  # "optional", or "required" (--warning-when-clear)
     if "baseline" in summary:
         head.insert(5, "vs baseline")
     lines = [

@@ -59,6 +59,7 @@ def scenario_entry(result: RunResult, files: Mapping[str, str | None]) -> dict[s
         "link": result.link,
         "seed": result.seed,
         "threshold": _number(result.threshold),
+        "warning_when_clear": result.warning_rule,
         "faults": result.faults,
         "ticks": len(result.records),
         "failed": len(failed),
@@ -122,6 +123,11 @@ def scenario_details(result: RunResult, files: Mapping[str, str | None]) -> dict
         "diagnostics": result.diagnostics,
         "records": [tick_entry(r) for r in result.records],
     }
+
+
+def passed_line(passed: int, total: int) -> str:
+    """'6 of 7 scenarios passed', '0 of 1 scenario passed'."""
+    return f"{passed} of {total} scenario{'s' if total != 1 else ''} passed"
 
 
 def run_summary(entries: Sequence[dict[str, Any]], wall_s: float | None = None) -> dict[str, Any]:

@@ -16,7 +16,7 @@ from rich.text import Text
 
 from harness.judge.records import RunResult
 from harness.report.baseline import KINDS
-from harness.report.summary import verdict_of
+from harness.report.summary import passed_line, verdict_of
 from harness.safe_text import DIAGNOSTICS_LIMIT, TEXT_LIMIT, clip, for_terminal
 from harness.scenario.schema import Scenario
 
@@ -124,7 +124,13 @@ def print_results(
     total = len(results)
     passed = total - len(failed)
     console.print()
-    console.print(f"{passed} of {total} scenarios passed", highlight=False)
+    console.print(passed_line(passed, total), highlight=False)
+    if any(r.warning_rule == "required" for r in results):
+        console.print(
+            "judged with --warning-when-clear required: warning False was due on every scan "
+            "with nothing within the threshold",
+            highlight=False,
+        )
 
 
 def print_comparison(console: Console, comparison: Comparison) -> None:

@@ -90,13 +90,16 @@ def replay(
 
     def body(link: Link) -> RunResult:
         started = time.perf_counter()
+        rule = warning_when_clear or "optional"
         oracle = Oracle(
             threshold,
             noise_sigma=noise_sigma,
             status_pattern=status_pattern,
-            warning_required_when_clear=warning_when_clear == "required",
+            warning_required_when_clear=rule == "required",
         )
-        replayed = RunResult(name, link.name, seed, threshold, faults, noise_sigma)
+        replayed = RunResult(
+            name, link.name, seed, threshold, faults, noise_sigma, warning_rule=rule
+        )
         check_link_faults(link_faults, link)
         judge_frames(
             frames(recording), link, oracle, replayed, on_tick=on_tick, link_faults=link_faults

@@ -36,11 +36,12 @@ def judging(
 ) -> tuple[Oracle, RunResult]:
     """The oracle for one run of `scenario`, and the empty result its verdicts go into."""
     threshold = effective_threshold(scenario, settings)
+    rule = warning_rule(scenario, settings)
     oracle = Oracle(
         threshold,
         noise_sigma=profile.noise_sigma,
         status_pattern=settings.status_pattern,
-        warning_required_when_clear=warning_rule(scenario, settings) == "required",
+        warning_required_when_clear=rule == "required",
     )
     result = RunResult(
         scenario=scenario.name,
@@ -49,6 +50,7 @@ def judging(
         threshold=threshold,
         faults=profile.name,
         noise_sigma=profile.noise_sigma,
+        warning_rule=rule,
     )
     return oracle, result
 

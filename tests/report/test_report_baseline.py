@@ -93,6 +93,16 @@ def test_judged_otherwise_is_named_not_compared(field: str, value: object, reaso
     assert comparison.notes == (f"1 judged with another {field} in the baseline, so not compared",)
 
 
+def test_another_warning_rule_is_not_compared_and_older_summaries_are_optional() -> None:
+    """A summary written before the rule existed was judged 'optional'."""
+    base = baseline(entry("a"), entry("b", warning_when_clear="optional"))
+    now = [entry("a", "FAIL", warning_when_clear="required"), entry("b")]
+    first, second = compare(base, now).changes
+    assert first.kind == "not compared"
+    assert first.reason == "warning_when_clear optional in the baseline, required now"
+    assert second.kind == "still passing"
+
+
 def test_threshold_compared_as_a_number() -> None:
     """0.5 written as 0.5000000000000001 by arithmetic is the same threshold."""
     assert kinds(entry("a", threshold=0.1 + 0.4), base=baseline(entry("a"))) == ["still passing"]

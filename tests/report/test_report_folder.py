@@ -73,6 +73,7 @@ def test_layout_and_summary_match_the_run(
         assert entry["scenario"] == result.scenario and entry["link"] == "inprocess"
         assert entry["verdict"] == ("PASS" if result.ok else "FAIL")
         assert entry["ticks"] == len(result.records)
+        assert entry["warning_when_clear"] == "optional"
         assert entry["failed_ticks"] == [r.tick for r in result.failed_ticks]
         assert entry["failed"] == len(result.failed_ticks)
         assert entry["first_failure"] == result.first_failure

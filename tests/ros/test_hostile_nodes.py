@@ -255,7 +255,7 @@ def test_a_node_waiting_for_clock_before_it_subscribes_starts_and_passes(pids: P
     """The harness publishes /clock (time 0) while it waits for the node to come up."""
     done = hostile_cli("waits_for_clock", pids)
     assert done.returncode == 0, explanation(done)
-    says(done, "1 of 1 scenarios passed")
+    says(done, "1 of 1 scenario passed")
     assert survivors(pids) == []
 
 

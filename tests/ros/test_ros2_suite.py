@@ -196,3 +196,5 @@ def test_the_strict_warning_rule_fails_a_bool_only_when_close() -> None:
     strict = fossbot_hil("run", "approach_wall", "--node", node, "--warning-when-clear", "required")
     assert strict.returncode == 1, strict.stdout + strict.stderr
     assert "expected warning False; got no Bool" in strict.stdout
+    assert "judged with --warning-when-clear required" in strict.stdout
+    assert "judged with --warning-when-clear" not in lenient.stdout

@@ -108,7 +108,7 @@ def test_a_second_run_on_the_same_domain_id_exits_2_naming_the_first(held_runs) 
     holder = f"pid {first.popen.pid} (fossbot-hil run approach_wall --node "
     assert f"ROS domain {domain_id} is in use by {holder}" in line, line
     code, output = first.finish()
-    assert code == 0 and "1 of 1 scenarios passed" in output, output
+    assert code == 0 and "1 of 1 scenario passed" in output, output
 
 
 def test_a_second_run_into_the_same_out_folder_exits_2_and_leaves_it_alone(

@@ -133,7 +133,7 @@ def test_run_against_a_board_on_a_serial_port(board: Board, tmp_path: Path) -> N
     board.start_when_harness_listens(harness)
     out, err = harness.communicate(timeout=90)
     assert harness.returncode == 0, out + err
-    assert "1 of 1 scenarios passed" in out
+    assert "1 of 1 scenario passed" in out
 
 
 def test_unplugged_adapter_fails_the_run_promptly(board: Board, tmp_path: Path) -> None:
