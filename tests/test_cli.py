@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import pytest
@@ -83,3 +84,31 @@ def test_malformed_scenario_file_exits_2_naming_file_and_field(tmp_path: Path) -
         "Input should be a valid number, unable to parse string as a number"
     )
     assert "Traceback" not in done.stderr and done.stdout == ""
+
+
+def test_help_shows_the_topic_defaults(capsys: pytest.CaptureFixture[str]) -> None:
+    """--scan-topic, --status-topic and --warning-topic say their defaults in --help."""
+    with pytest.raises(SystemExit):
+        main(["run", "--help"])
+    help_text = " ".join(capsys.readouterr().out.split())  # argparse wraps lines
+    for default in ("(default /scan;", "(default /lidar_status)", "(default /obstacle_warning)"):
+        assert default in help_text
+
+
+def test_a_reused_out_folder_says_what_it_cleared_and_times_the_run(tmp_path: Path) -> None:
+    """summary.json's wall_s is the command's wall time (the terminal's total row), each
+    scenario's own time beside it; a second run into the folder says what it removed."""
+    out = tmp_path / "report"
+    scenarios = ("approach_wall", "out_of_range")
+    first = fossbot_hil("run", *scenarios, "--link", "inprocess", "--out", str(out))
+    assert first.returncode == 0, first.stdout + first.stderr
+    summary = json.loads((out / "summary.json").read_text())
+    total_row = next(line for line in first.stdout.splitlines() if line.startswith("total"))
+    assert float(total_row.split()[-1]) == pytest.approx(summary["wall_s"], abs=0.006)
+    assert summary["wall_s"] >= max(e["total_s"] for e in summary["scenarios"])
+    assert all(e["wall_s"] <= e["total_s"] for e in summary["scenarios"])
+    listed = sum(v is not None for e in summary["scenarios"] for v in e["files"].values())
+    second = fossbot_hil("run", "approach_wall", "--link", "inprocess", "--out", str(out))
+    assert second.returncode == 0, second.stdout + second.stderr
+    assert f"--out: removed {listed} scenario files of the run before" in second.stdout
+    assert not list((out / "scenarios").glob("out_of_range*"))

@@ -173,6 +173,13 @@ def _run(args: argparse.Namespace, console: Console, baseline: Baseline | None) 
 
     check_settings(scenarios, settings_from(args))
     report = open_report(args.out, animate=args.animate)
+    if report is not None and report.cleared:
+        console.print(
+            f"--out: removed {report.cleared} scenario files of the run before",
+            highlight=False,
+            markup=False,
+            soft_wrap=True,
+        )
     ran = scenario_of(scenarios)
 
     with RunProgress(console, [s.name for s in scenarios]) as progress:
