@@ -77,7 +77,7 @@ class RunResult:
         with what the whole run suggests about its cause."""
         failed = self.failed_ticks
         if failed:
-            hint = threshold_hint(self.records, self.threshold)
+            hint = threshold_hint([r.verdict for r in self.records], self.threshold)
             more = f" ({hint})" if hint else ""
             return f"{self.scenario}: {failed[0].verdict.explanation}{more}"
         if self.error is not None:

@@ -10,30 +10,28 @@ bracket excludes the threshold the harness passed, say so.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import TYPE_CHECKING
 
-if TYPE_CHECKING:
-    from harness.judge.records import TickRecord
+from harness.judge.oracle import Verdict
 
 WARNING_FAILURE = "expected warning"
 
 
-def _bounds(records: Sequence[TickRecord]) -> tuple[float | None, float | None]:
+def _bounds(verdicts: Sequence[Verdict]) -> tuple[float | None, float | None]:
     """(largest distance it warned at, smallest it published False at)."""
-    warned = [r.verdict.expected.distance for r in records if r.verdict.warning_got is True]
-    calm = [r.verdict.expected.distance for r in records if r.verdict.warning_got is False]
+    warned = [v.expected.distance for v in verdicts if v.warning_got is True]
+    calm = [v.expected.distance for v in verdicts if v.warning_got is False]
     warned_at = [d for d in warned if d is not None]
     calm_at = [d for d in calm if d is not None]
     return (max(warned_at) if warned_at else None, min(calm_at) if calm_at else None)
 
 
-def threshold_hint(records: Sequence[TickRecord], threshold: float) -> str | None:
+def threshold_hint(verdicts: Sequence[Verdict], threshold: float) -> str | None:
     """'the node warns as if its threshold were ...', when it both warned and did not,
     at distances that fit one other threshold and not this run's; None otherwise."""
-    failed = any(f.startswith(WARNING_FAILURE) for r in records for f in r.verdict.failures)
+    failed = any(f.startswith(WARNING_FAILURE) for v in verdicts for f in v.failures)
     if not failed:
         return None
-    low, high = _bounds(records)  # a threshold T warns below it: low < T <= high
+    low, high = _bounds(verdicts)  # a threshold T warns below it: low < T <= high
     if low is None or high is None:
         return None  # one-sided: an always-False Bool fits a small threshold, but says little
     if low >= high:
