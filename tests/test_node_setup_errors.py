@@ -25,7 +25,11 @@ STUDENT = Path(__file__).parent / "ros" / "student_node.py"
     [
         ("ModuleNotFoundError: No module named 'rclpy'", ["/usr/bin/python3", "n.py"], "rclpy"),
         ("ModuleNotFoundError: No module named 'std_msgs.msg'", ["python3"], "std_msgs"),
+        ("ModuleNotFoundError: No module named 'rcl_interfaces'", ["python3"], "rcl_interfaces"),
+        ("ModuleNotFoundError: No module named 'geometry_msgs.msg'", ["python3"], "geometry_msgs"),
+        ("ModuleNotFoundError: No module named 'std_srvs'", ["python3"], "std_srvs"),
         ("ModuleNotFoundError: No module named 'numpy'", ["python3", "n.py"], None),
+        ("ModuleNotFoundError: No module named 'my_msgs_helper'", ["python3", "n.py"], None),
         ("ZeroDivisionError: division by zero", ["python3", "n.py"], None),
     ],
 )

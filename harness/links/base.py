@@ -11,6 +11,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, ClassVar, TypeVar
 
 from harness.errors import ConfigError
+from harness.nodes.setup_problems import is_ros_module
 
 if TYPE_CHECKING:  # naming the links and their options needs none of these (nor numpy)
     from harness.faults.link import LineDamage
@@ -126,7 +127,6 @@ class Link(ABC):
 
 
 _REGISTRY: dict[str, type[Link]] = {}
-ROS_MODULES = {"rclpy", "sensor_msgs", "std_msgs", "rosgraph_msgs", "builtin_interfaces"}
 L = TypeVar("L", bound=type[Link])
 
 
@@ -175,7 +175,7 @@ def link_class(name: str) -> type[Link]:
             importlib.import_module(f"harness.links.{name}")
         except ImportError as err:
             hint = ""
-            if (err.name or "").split(".")[0] in ROS_MODULES:
+            if is_ros_module(err.name or ""):
                 hint = (
                     " (install the ROS 2 wheels: pip install 'fossbot-hil[ros]',"
                     " or source ROS 2 Jazzy)"

@@ -14,9 +14,18 @@ import sys
 from collections.abc import Sequence
 from pathlib import Path
 
-ROS_MODULES = ("rclpy", "sensor_msgs", "std_msgs", "rosgraph_msgs", "builtin_interfaces")
+# ROS 2's Python packages by their names: rclpy and its kin, message, service and
+# interface packages (rcl_interfaces is what lab nodes often import first), ament.
+ROS_MODULE = re.compile(
+    r"(rclpy|rcl_\w+|rosidl_\w+|ament_\w+|tf2_\w+|launch(_ros)?|\w+_(msgs|srvs|interfaces))$"
+)
 _MISSING = re.compile(r"ModuleNotFoundError: No module named '([A-Za-z_][\w.]*)'")
 PYTHON = re.compile(r"python(\d+(\.\d+)?)?$")
+
+
+def is_ros_module(name: str) -> bool:
+    """Is `name` (dotted or not) one of ROS 2's Python packages, by its top-level name?"""
+    return bool(ROS_MODULE.match(name.split(".")[0]))
 
 
 def is_python(program: str) -> bool:
@@ -28,7 +37,7 @@ def setup_problem(output: str, argv: Sequence[str]) -> str | None:
     """The setup mistake `output` (the node's last stderr lines, its exit summary) shows,
     in one line with the fix; None when the node failed for a reason of its own."""
     missing = _MISSING.search(output)
-    if missing is None or missing[1].split(".")[0] not in ROS_MODULES:
+    if missing is None or not is_ros_module(missing[1]):
         return None
     module = missing[1].split(".")[0]
     program = argv[0] if argv else "the node's interpreter"
