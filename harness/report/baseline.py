@@ -82,12 +82,14 @@ def load_baseline(path: str) -> Baseline:
     summary that `fossbot-hil run --out` writes.
     """
     file = Path(path)
-    if file.is_dir():
+    folder = file.is_dir()
+    if folder:
         file = file / SUMMARY
     try:
         text = file.read_text(encoding="utf-8")
     except FileNotFoundError:
-        raise ConfigError(f"--baseline {path}: no such file") from None
+        missing = f"a folder without {SUMMARY}" if folder else "no such file"
+        raise ConfigError(f"--baseline {path}: {missing}") from None
     except (OSError, UnicodeDecodeError) as err:
         reason = getattr(err, "strerror", None) or str(err).splitlines()[0]
         raise ConfigError(f"--baseline {path}: cannot read it: {reason}") from None
@@ -95,8 +97,15 @@ def load_baseline(path: str) -> Baseline:
         data = json.loads(text)
     except json.JSONDecodeError as err:
         raise ConfigError(f"--baseline {path}: not JSON ({err.msg}, line {err.lineno})") from None
+    except (ValueError, RecursionError) as err:  # a number too long, nesting too deep
+        reason = str(err).split(":")[0].splitlines()[0]
+        raise ConfigError(f"--baseline {path}: not JSON this harness reads ({reason})") from None
     entries = _checked(data, path)
-    return Baseline(path=path, harness=str(data.get("harness", "unknown")), entries=entries)
+    harness = data.get("harness", "unknown")
+    if not isinstance(harness, str):
+        what = f"--baseline {path}: not a fossbot-hil summary.json"
+        raise ConfigError(f"{what} (harness is malformed)")
+    return Baseline(path=path, harness=harness, entries=entries)
 
 
 def _checked(data: object, path: str) -> tuple[Mapping[str, Any], ...]:

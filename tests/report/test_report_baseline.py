@@ -153,6 +153,12 @@ def test_load_reads_a_summary_or_its_folder(tmp_path: Path) -> None:
         assert loaded.harness == "0.1.0" and [e["scenario"] for e in loaded.entries] == ["a"]
 
 
+def test_folder_without_summary_is_named(tmp_path: Path) -> None:
+    """A folder given as the baseline, but not a report folder: said so, on one line."""
+    with pytest.raises(ConfigError, match=r"^--baseline \S+: a folder without summary\.json$"):
+        load_baseline(str(tmp_path))
+
+
 @pytest.mark.parametrize(
     ("content", "message"),
     [
@@ -164,6 +170,9 @@ def test_load_reads_a_summary_or_its_folder(tmp_path: Path) -> None:
         ({"scenarios": [entry("a", seed=True)]}, r"scenarios\[0\]\.seed is missing or malformed"),
         ({"scenarios": [entry("a", verdict="MAYBE")]}, "verdict 'MAYBE' is unknown"),
         ("\xff\xfe", "cannot read it|not JSON"),
+        ("[" * 100_000 + "]" * 100_000, r"not JSON this harness reads \(maximum recursion"),
+        ('{"scenarios": [], "n": ' + "9" * 5000 + "}", r"not JSON this harness reads \(Exceeds"),
+        ({"harness": 1, "scenarios": []}, r"summary\.json \(harness is malformed\)"),
     ],
 )
 def test_bad_baseline_is_one_line(tmp_path: Path, content: object, message: str) -> None:
