@@ -63,6 +63,13 @@ def machine(tmp_path_factory: pytest.TempPathFactory) -> Machine:
     return Machine.create(tmp_path_factory.mktemp("ci-python") / "venv")
 
 
+def assert_full_report(report: Path) -> None:
+    """The artifact holds what docs/ci.md promises: the page, the plot, the MCAP recording."""
+    for name in ("index.html", "junit.xml", "scenarios/approach_wall.png"):
+        assert (report / name).is_file(), f"the report has no {name}"
+    assert (report / "scenarios" / "approach_wall.mcap").stat().st_size > 0
+
+
 def test_templates_parse_and_agree() -> None:
     """Every template is YAML (what the CI services read), names the same release of
     fossbot-hil and installs it with the same hash-checked lines."""
@@ -85,6 +92,7 @@ def test_github_student_workspace(tmp_path: Path, machine: Machine, harness: Pat
     summary = json.loads((repo / "report" / "summary.json").read_text())
     assert summary["ok"] and [e["scenario"] for e in summary["scenarios"]] == ["approach_wall"]
     assert (repo / "install" / "fossbot_lidar_processing").is_dir()  # colcon built it
+    assert_full_report(repo / "report")
 
 
 def test_gitlab_student_script(tmp_path: Path, machine: Machine, harness: Path) -> None:
@@ -95,6 +103,7 @@ def test_gitlab_student_script(tmp_path: Path, machine: Machine, harness: Path) 
     summary = json.loads((repo / "report" / "summary.json").read_text())
     assert summary["ok"] and summary["scenarios"][0]["link"] == "ros2"
     assert not (repo / "install").exists()  # a script is not built
+    assert_full_report(repo / "report")
 
 
 def test_github_course_grades_every_submission(
