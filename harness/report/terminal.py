@@ -164,5 +164,7 @@ def print_comparison(console: Console, comparison: Comparison) -> None:
     if unknown:
         named = ", ".join(f"{c.scenario} [{c.faults}] ({c.kind})" for c in unknown)
         print_safe(console, f"failing, and not known from the baseline: {named}", style="bold red")
-    else:
+    elif any(c.fails_now for c in comparison.changes):
         console.print("no regression: every failure is known from the baseline", highlight=False)
+    else:
+        console.print("no regression: nothing fails", highlight=False)

@@ -59,6 +59,17 @@ def test_known_failure_still_exits_1_by_default(tmp_path: Path) -> None:
     assert "no regression: every failure is known from the baseline" in done.stdout
 
 
+def test_a_run_with_no_failure_says_nothing_fails(tmp_path: Path) -> None:
+    """Against a baseline, a run where everything passed says so, not 'every failure is
+    known'."""
+    base = tmp_path / "base"
+    inprocess = ["approach_wall", "--link", "inprocess"]
+    assert fossbot_hil("run", *inprocess, "--out", str(base)).returncode == 0
+    done = fossbot_hil("run", *inprocess, "--baseline", str(base), "--fail-on", "regression")
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert "no regression: nothing fails" in done.stdout
+
+
 @pytest.mark.parametrize(
     ("args", "needle"),
     [
