@@ -21,6 +21,12 @@ VER_LEN = 0x2C  # top 3 bits reserved, low 5 bits: points per packet (12)
 POINTS_PER_PACKET = 12
 PACKET_LEN = 47
 BAUD = 230400
+# LDROBOT command frames: 0x54, a command, 0x04, a 4-byte payload, CRC-8 of
+# the first 7 bytes. Drivers written for the LD14P (lds2d 0.7.0, kaiaai/LDS)
+# send start/stop/speed frames to an LD06/LD19 too, which streams anyway.
+COMMAND_LEN = 8
+COMMAND_PAYLOAD_LEN = 4
+COMMAND_NAMES: dict[int, str] = {0xA0: "LD_START", 0xA1: "LD_STOP", 0xA2: "LD_SET_SPEED"}
 TIMESTAMP_WRAP_MS = 30000
 CRC_POLY = 0x4D
 MAX_DISTANCE_MM = 0xFFFF
@@ -135,6 +141,16 @@ def decode_packets(data: bytes) -> tuple[list[Sample], int]:
     return samples, bad
 
 
+def _is_command_frame(frame: bytes) -> bool:
+    """An LDROBOT command frame: 0x54, a command, length 4, its payload and CRC-8."""
+    return (
+        len(frame) == COMMAND_LEN
+        and frame[0] == HEADER
+        and frame[2] == COMMAND_PAYLOAD_LEN
+        and crc8(frame[:-1]) == frame[-1]
+    )
+
+
 class LdlidarDevice:
     """An LD06/LD19 streaming at a fixed rotation speed and sample rate."""
 
@@ -144,8 +160,11 @@ class LdlidarDevice:
         self.speed_deg_s = speed_deg_s
         self.samples_per_s = samples_per_s
         self._pending: list[tuple[Sample, float]] = []  # samples and their times (ms)
-        self.counters: dict[str, int] = {"ignored_host_bytes": 0}
+        # "requests": whole LDROBOT command frames (ignored, but not an error).
+        self.counters: dict[str, int] = {"requests": 0, "ignored_host_bytes": 0}
+        self.requests_by_command: dict[str, int] = {}
         self.listener: Listener | None = None  # told of host bytes, which it ignores
+        self._rx = bytearray()
 
     @property
     def samples_per_revolution(self) -> int:
@@ -182,11 +201,46 @@ class LdlidarDevice:
         return bytes(out)
 
     def receive(self, data: bytes) -> bytes:
-        """Host bytes: an LD06/LD19 takes no commands, so they are counted and ignored.
+        """Host bytes: an LD06/LD19 takes no commands, so it answers none.
 
-        Counted because they say something on a bench: a driver that sends
-        requests (0xA5 ...) is an RPLIDAR driver pointed at the wrong device.
+        Whole LDROBOT command frames (an LD14P driver's start/stop/speed)
+        are logged as requests the sensor ignores: harmless, it streams on.
+        Any other bytes are counted (``ignored_host_bytes``) because they say
+        something on a bench: requests starting 0xA5 come from an RPLIDAR
+        driver pointed at the wrong device.
         """
+        rx = self._rx
+        rx += data
+        while rx:
+            if rx[0] == HEADER:
+                if len(rx) < COMMAND_LEN:
+                    break  # perhaps a frame in pieces (drop_partial_request ends the wait)
+                frame = bytes(rx[:COMMAND_LEN])
+                if _is_command_frame(frame):
+                    del rx[:COMMAND_LEN]
+                    self._command(frame)
+                    continue
+            end = rx.find(HEADER, 1)
+            end = len(rx) if end < 0 else end
+            self._ignored(bytes(rx[:end]))
+            del rx[:end]
+        return b""
+
+    def drop_partial_request(self) -> None:
+        """The line went quiet inside what looked like a command frame: ignore its bytes."""
+        if self._rx:
+            self._ignored(bytes(self._rx))
+            self._rx.clear()
+
+    def _command(self, frame: bytes) -> None:
+        name = COMMAND_NAMES.get(frame[1], f"LD_0x{frame[1]:02X}")
+        self.counters["requests"] += 1
+        self.requests_by_command[name] = self.requests_by_command.get(name, 0) + 1
+        if self.listener is not None:
+            note = "ignored: an LD06/LD19 takes no commands and streams on (an LD14P-style frame)"
+            self.listener(DeviceEvent("request", frame, name, b"", note))
+
+    def _ignored(self, data: bytes) -> None:
         self.counters["ignored_host_bytes"] += len(data)
         if self.listener is not None:
             note = (
@@ -194,8 +248,7 @@ class LdlidarDevice:
                 if data[:1] == b"\xa5"
                 else ""
             )
-            self.listener(DeviceEvent("ignored_host_bytes", bytes(data), note=note))
-        return b""
+            self.listener(DeviceEvent("ignored_host_bytes", data, note=note))
 
     def reset(self) -> None:
         """Forget samples waiting for a packet (the stream was interrupted)."""

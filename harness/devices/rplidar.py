@@ -141,6 +141,16 @@ def _command_name(cmd: int) -> str:
     return COMMAND_NAMES.get(cmd, f"0x{cmd:02X}")
 
 
+def _garbage_note(data: bytes | bytearray) -> str:
+    """Name bytes that are another LIDAR's (else the generic hint applies)."""
+    if len(data) >= 3 and data[0] == 0x54 and data[2] == 0x04:  # 0x54 cmd 0x04 ...: LDROBOT
+        return (
+            "an LDROBOT command frame (54 ...): an LD06/LD19 driver on an RPLIDAR; "
+            "use its own device type (emulate ldlidar, --link ldlidar)"
+        )
+    return ""
+
+
 def _xor_all(data: bytes | bytearray) -> int:
     return reduce(xor, data, 0)
 
@@ -484,7 +494,7 @@ class RplidarDevice:
             if rx[0] != SYNC:
                 skip = rx.find(SYNC)
                 skip = len(rx) if skip < 0 else skip
-                self._error("garbage_bytes", bytes(rx[:skip]), skip)
+                self._error("garbage_bytes", bytes(rx[:skip]), skip, note=_garbage_note(rx[:skip]))
                 del rx[:skip]
                 continue
             if len(rx) < 2:

@@ -141,7 +141,22 @@ class BoardLink(Ros2Link):
             f"({self.profile.description})"
         )
         graph = self.observer.graph_summary() if self.observer is not None else ""
-        return f"{ready}: on the line {self.line_report()}" + (f" ({graph})" if graph else "")
+        line = self.line_report()
+        if "; likely cause: " not in line:
+            # Nothing wrong on the line (an LD06/LD19's line cannot tell: its driver
+            # sends nothing back): what was missing is on the board's ROS 2 side.
+            quiet = (
+                "an LD06/LD19 driver sends nothing back, so the line cannot tell"
+                if self.profile.streams_unasked
+                else "the line looks right"
+            )
+            domain = self.domain.domain_id if self.domain is not None else "?"
+            line += (
+                f"; likely cause: {quiet}; the board's nodes were not ready in ROS domain "
+                f"{domain}: check that it is the board's ROS_DOMAIN_ID, --ros-network (the "
+                "board is another machine), and that its LIDAR driver and node run"
+            )
+        return f"{ready}: on the line {line}" + (f" ({graph})" if graph else "")
 
     def line_report(self) -> str:
         """The serial line's story: sent, came back, likely cause (for errors)."""

@@ -142,6 +142,15 @@ class _Log:
             self.line(f"{event.text()} [first of its kind; -v logs every one]")
 
 
+# The device's mode as the status line says it.
+_STATES = {
+    "idle": "idle",
+    "scan": "scanning (standard)",  # SCAN or FORCE_SCAN
+    "express": "scanning (express)",
+    "streaming": "streaming",
+}
+
+
 def status_line(stats: Any) -> str:
     """One line on the state of the line: the client, scanning or idle, what was served."""
     if stats.peer_present is None:
@@ -153,8 +162,8 @@ def status_line(stats: Any) -> str:
         client = f"client: connected{baud}"
     else:
         client = "client: none" + (" (one came and went)" if stats.peer_seen else "")
-    mode = stats.device_mode or "streaming"
-    state = "idle" if mode == "idle" else f"scanning ({mode})" if mode != "streaming" else mode
+    mode = stats.device_mode or "streaming"  # a device without modes streams unasked
+    state = _STATES.get(mode, f"scanning ({mode})")
     errors = sum(stats.device_errors.values()) + stats.wrong_baud + stats.motor_off_revolutions
     return (
         f"{client} | {state} | {stats.revolutions_sent} revolutions, "

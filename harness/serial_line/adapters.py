@@ -13,6 +13,9 @@ import grp
 import os
 import pwd
 import re
+import stat
+
+_GROUP_RW = stat.S_IRGRP | stat.S_IWGRP
 
 # USB ids of the common USB-UART chips (vendor:product, as pyserial prints them).
 KNOWN_ADAPTERS: dict[str, str] = {
@@ -61,6 +64,12 @@ def access_problem(device: str) -> str | None:
         user = pwd.getpwuid(os.getuid())
     except KeyError:
         return "no read/write permission (owner or group unknown to this system)"
+    if st.st_mode & _GROUP_RW != _GROUP_RW:
+        # Joining its group would not help: the group may not read and write it either.
+        return (
+            f"mode {stat.S_IMODE(st.st_mode):04o}, group {group.gr_name}: no group may open it; "
+            'a udev rule with GROUP="dialout", MODE="0660" (docs/hil.md), then replug'
+        )
     if user.pw_gid == group.gr_gid or user.pw_name in group.gr_mem:
         return (
             f"you are in group {group.gr_name}, this login session is not yet: "

@@ -17,6 +17,11 @@ from harness.serial_line.server import ServerStats
 SCAN_REQUESTS = ("SCAN", "FORCE_SCAN", "EXPRESS_SCAN")
 # Requests that ask for something the emulated device may not have.
 _LACKS = ("unknown_command", "unknown_conf", "unsupported_mode")
+# A client at the other emulated LIDAR's rate most likely is that LIDAR's driver.
+_OTHER_DEVICE_AT: dict[int | None, tuple[str, str]] = {
+    230400: ("an LD06/LD19", "emulate ldlidar, --link ldlidar"),
+    115200: ("an RPLIDAR A1", "emulate rplidar, --link rplidar"),
+}
 
 
 @dataclass(frozen=True)
@@ -63,8 +68,16 @@ def _likely(stats: ServerStats, port: str, baudrate: int, streams_unasked: bool)
     if stats.peer_seen is False:
         return f"nothing opened {port}: point the driver (or client) at {port} and start it"
     if stats.wrong_baud:
+        rate = stats.host_baud or stats.wrong_baud_rate
+        other = _OTHER_DEVICE_AT.get(rate) if rate != baudrate else None
+        if other is not None:
+            return (
+                f"the client's line is at {rate} baud, the device's at {baudrate}; {rate} is "
+                f"{other[0]}'s rate: a driver for {other[0]}? use its own device type "
+                f"({other[1]}), or set the driver's baud rate to {baudrate}"
+            )
         return (
-            f"the client's line is at {stats.host_baud or 'another'} baud, the device's at "
+            f"the client's line is at {rate or 'another'} baud, the device's at "
             f"{baudrate}: set the driver's baud rate to {baudrate}"
         )
     if errors.get("ignored_host_bytes"):

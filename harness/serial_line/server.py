@@ -125,6 +125,7 @@ class ServerStats:
     peer_present: bool | None
     peer_seen: bool | None  # a client ever had the port open (None: cannot be seen)
     host_baud: int | None  # the client's baud rate where it can be seen (a pty)
+    wrong_baud_rate: int | None  # the last wrong rate a client set (kept after it closed)
     dtr: bool | None
     device_mode: str | None
     pacing: PacingReport | None
@@ -247,6 +248,7 @@ class DeviceServer:
         self._peer_seen: bool | None = None if port.peer_present() is None else False
         self._peer_since = 0.0
         self._host_baud: int | None = None
+        self._wrong_baud_rate: int | None = None
         self._motor_off_streak = False
         self._stalled = False
         self._session = getattr(device, "session", None)
@@ -377,6 +379,7 @@ class DeviceServer:
             peer_present=peer,
             peer_seen=self._peer_seen,
             host_baud=self._host_baud,
+            wrong_baud_rate=self._wrong_baud_rate,
             dtr=self._dtr,
             device_mode=mode if isinstance(mode, str) else None,
             pacing=pacing,
@@ -573,6 +576,7 @@ class DeviceServer:
         self._host_baud = baud
         if baud != self.baudrate:
             self._n["wrong_baud"] += 1
+            self._wrong_baud_rate = baud
             self._tell(
                 LineEvent(
                     "wrong_baud",

@@ -138,3 +138,41 @@ def test_device_rejects_nonsense_rates() -> None:
     with pytest.raises(ValueError):
         ld.encode_packet(uniform(11), speed_deg_s=3600, timestamp_ms=0)
     assert struct.calcsize("<BBHH") + 12 * 3 + 5 == ld.PACKET_LEN
+
+
+def command_frame(cmd: int, payload: bytes = bytes(4)) -> bytes:
+    """An LDROBOT command frame as LD14P drivers (lds2d 0.7.0, kaiaai/LDS) send it."""
+    body = bytes((ld.HEADER, cmd, len(payload))) + payload
+    return body + bytes((ld.crc8(body),))
+
+
+def test_ld14p_command_frames_are_requests_it_ignores_not_errors() -> None:
+    """lds2d's LD06/LD19 driver sends start/stop frames: logged as ignored requests."""
+    assert command_frame(0xA0) == bytes.fromhex("54 A0 04 00 00 00 00 5E")  # what lds2d sends
+    device = ld.LdlidarDevice()
+    events = []
+    device.listener = events.append
+    start = command_frame(0xA0)
+    assert device.receive(start[:3]) == b"" and not events  # a frame in pieces waits
+    assert device.receive(start[3:] + command_frame(0xA1)) == b""
+    assert [(e.kind, e.command) for e in events] == [
+        ("request", "LD_START"),
+        ("request", "LD_STOP"),
+    ]
+    assert "takes no commands and streams on" in events[0].text()
+    assert device.counters == {"requests": 2, "ignored_host_bytes": 0}
+    assert device.requests_by_command == {"LD_START": 1, "LD_STOP": 1}
+
+
+def test_other_host_bytes_are_counted_and_an_rplidar_request_is_named() -> None:
+    device = ld.LdlidarDevice()
+    events = []
+    device.listener = events.append
+    bad_crc = bytearray(command_frame(0xA2, b"\x10\x0e\x00\x00"))
+    bad_crc[-1] ^= 0xFF
+    device.receive(bytes.fromhex("A5 50") + bytes(bad_crc) + b"\x54\x2c")
+    device.drop_partial_request()  # the line went quiet inside "54 2C"
+    assert [e.data for e in events] == [b"\xa5\x50", bytes(bad_crc), b"\x54\x2c"]
+    assert all(e.kind == "ignored_host_bytes" for e in events)
+    assert "RPLIDAR driver" in events[0].text()
+    assert device.counters == {"requests": 0, "ignored_host_bytes": 2 + 8 + 2}
