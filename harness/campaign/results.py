@@ -53,6 +53,23 @@ def read_rows(path: Path) -> list[dict[str, str]]:
     return [row for row in rows if row.get("key") and row.get("verdict")]
 
 
+def check_columns(path: Path, columns: Sequence[str]) -> None:
+    """Resuming needs the table's own columns (the same generated variations)."""
+    if read_header(path) != tuple(columns):
+        raise ConfigError(
+            f"--resume: {path} has the columns {', '.join(read_header(path))[:300]}; "
+            f"this sweep writes {', '.join(columns)} (another --vary? use another --out)"
+        )
+
+
+def done_keys(path: Path, columns: Sequence[str] = COLUMNS) -> set[str]:
+    """The keys of the runs a table to resume holds (none when there is no table yet)."""
+    if not path.exists():
+        return set()
+    check_columns(path, columns)
+    return {row["key"] for row in read_rows(path)}
+
+
 class ResultsTable:
     """Appends rows to ``path``; `done` holds the keys of every run already there.
 
@@ -64,11 +81,8 @@ class ResultsTable:
         self.path = path
         self.columns = tuple(columns)
         resuming = resume and path.exists()
-        if resuming and read_header(path) != self.columns:
-            raise ConfigError(
-                f"--resume: {path} has the columns {', '.join(read_header(path))[:300]}; "
-                f"this sweep writes {', '.join(self.columns)} (another --vary? use another --out)"
-            )
+        if resuming:
+            check_columns(path, self.columns)
         rows = read_rows(path) if resuming else []
         self.done = {row["key"] for row in rows}
         self.rows = rows

@@ -10,6 +10,7 @@ from typing import Any
 from harness.errors import ConfigError
 
 CONNECT_TIMEOUT_S = 10  # for an external scheduler to answer
+WORKER_WAIT_S = 30  # for an external cluster without workers to get one
 # Our tasks are long (a run, a student): a worker holds only the one it runs, so
 # the next goes to whichever worker frees first, and a worker that dies takes no
 # queued task down with it (Dask counts those as suspects, and gives up on a
@@ -43,11 +44,13 @@ def open_client(
 
     check_cluster_options(scheduler, workers)
     if scheduler is not None:
+        check_scheduler(scheduler)
         try:
             client = Client(scheduler, timeout=CONNECT_TIMEOUT_S)
-        except (OSError, TimeoutError, ValueError) as err:
-            raise ConfigError(f"--scheduler {scheduler}: cannot connect: {err}") from None
+        except Exception as err:  # noqa: BLE001 - anything here is the address's fault
+            raise ConfigError(f"--scheduler {scheduler}: cannot connect: {_said(err)}") from None
         with client:
+            _wait_for_a_worker(client, scheduler)
             yield client
         return
     count = workers if workers is not None else default_workers()
@@ -64,6 +67,54 @@ def open_client(
         )
     with cluster, Client(cluster) as client:
         yield client
+
+
+def check_scheduler(address: str) -> None:
+    """Ask `address` who it is, within CONNECT_TIMEOUT_S: a Dask scheduler, or a ConfigError.
+
+    A Client alone waits for ever on a port that answers in another protocol
+    (the dashboard's HTTP port, say), or reads its bytes as a huge frame.
+    """
+    import asyncio
+
+    from distributed.core import rpc
+
+    async def identity() -> Any:
+        async with rpc(address, timeout=CONNECT_TIMEOUT_S) as scheduler:
+            return await scheduler.identity()
+
+    try:
+        info = asyncio.run(asyncio.wait_for(identity(), CONNECT_TIMEOUT_S))
+    except (TimeoutError, asyncio.TimeoutError):
+        raise ConfigError(
+            f"--scheduler {address}: cannot connect: "
+            f"no Dask scheduler answered within {CONNECT_TIMEOUT_S} s"
+        ) from None
+    except Exception as err:  # noqa: BLE001 - a bad address, a refusal, another protocol
+        raise ConfigError(f"--scheduler {address}: cannot connect: {_said(err)}") from None
+    if not isinstance(info, dict) or info.get("type") != "Scheduler":
+        raise ConfigError(f"--scheduler {address}: answers, but not as a Dask scheduler")
+
+
+def _wait_for_a_worker(client: Any, address: str) -> None:
+    """A cluster without workers would wait for ever: give it WORKER_WAIT_S to get one."""
+    if client.nthreads():
+        return
+    try:
+        client.wait_for_workers(1, timeout=WORKER_WAIT_S)
+    except (TimeoutError, OSError):
+        raise ConfigError(
+            f"--scheduler {address}: no worker joined within {WORKER_WAIT_S} s "
+            f"(start one: dask worker {address} --nthreads 1)"
+        ) from None
+
+
+def _said(err: BaseException) -> str:
+    """An error in one short line."""
+    text = " ".join(str(err).split()) or type(err).__name__
+    if isinstance(err, MemoryError):
+        text = "its answer is not Dask's protocol (is this the scheduler's port?)"
+    return text[:200]
 
 
 def dashboard(client: Any) -> str | None:

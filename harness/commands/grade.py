@@ -169,7 +169,8 @@ def prepare_out(out: Path) -> HolderLock:
     return lock
 
 
-def _progress(console: Console, student: Student, grade: object) -> None:
+def _graded_line(student: Student, grade: object) -> str:
+    """One line per student as their row comes in."""
     from harness.grading.class_table import StudentGrade
     from harness.safe_text import for_terminal
 
@@ -184,7 +185,14 @@ def _progress(console: Console, student: Student, grade: object) -> None:
     else:
         parts.append("not run")
     name = for_terminal(student.name)  # a folder name is the student's choice
-    console.print(f"  {name}: {', '.join(parts)}", markup=False, highlight=False)
+    return f"  {name}: {', '.join(parts)}"
+
+
+def _all_passed(grade: object) -> bool:
+    from harness.grading.class_table import PASS, StudentGrade
+
+    assert isinstance(grade, StudentGrade)
+    return bool(grade.verdicts) and all(v == PASS for v in grade.verdicts.values())
 
 
 def _show_dashboard(console: Console, link: str | None) -> None:
@@ -195,6 +203,7 @@ def _show_dashboard(console: Console, link: str | None) -> None:
 def run(args: argparse.Namespace, console: Console) -> int:
     from harness.atomic_write import write_atomically
     from harness.cluster.client import check_cluster_options, dashboard, open_client
+    from harness.cluster.progress import add_task, task_progress
     from harness.grading.build import colcon_executable
     from harness.grading.class_table import (
         class_csv,
@@ -249,12 +258,17 @@ def run(args: argparse.Namespace, console: Console) -> int:
         )
         _show_dashboard(console, dashboard(client))
         started = time.monotonic()
-        grades = grade_class(
-            found.students,
-            config,
-            client,
-            on_graded=lambda student, grade: _progress(console, student, grade),
-        )
+        with task_progress(console, "students") as progress:
+            bar = add_task(progress, "students", count)
+            failed = 0
+
+            def graded(student: Student, grade: object, running: int) -> None:
+                nonlocal failed
+                failed += not _all_passed(grade)
+                progress.console.print(_graded_line(student, grade), markup=False, highlight=False)
+                progress.update(bar, advance=1, running=running, failed=failed)
+
+            grades = grade_class(found.students, config, client, on_graded=graded)
         wall_s = time.monotonic() - started
         meta = [
             ("scenarios", ", ".join(names)),

@@ -19,7 +19,7 @@ from harness.commands.arguments import (
     given,
     whole_number,
 )
-from harness.commands.cluster_options import add_cluster_options
+from harness.commands.cluster_options import add_cluster_options, describe_cluster
 from harness.errors import ConfigError
 from harness.report.terminal import print_safe as say
 
@@ -135,7 +135,7 @@ def run(args: argparse.Namespace, console: Console) -> int:
     from harness.campaign.factors import explain
     from harness.campaign.parquet import check_parquet_available, write_parquet
     from harness.campaign.plan import plan
-    from harness.campaign.results import ResultsTable, columns_for
+    from harness.campaign.results import columns_for, done_keys, read_rows
     from harness.cluster.client import check_cluster_options
     from harness.runner.settings import RunSettings
 
@@ -154,22 +154,26 @@ def run(args: argparse.Namespace, console: Console) -> int:
     if len(specs) > MAX_RUNS:
         raise ConfigError(f"{len(specs)} runs; at most {MAX_RUNS} in one sweep")
     out = Path(args.out)
-    table = ResultsTable(out / "results.csv", resume=args.resume, columns=columns_for(list(varied)))
-    todo = [spec for spec in specs if spec.key not in table.done]
+    path, columns = out / "results.csv", columns_for(list(varied))
+    done = done_keys(path, columns) if args.resume else set()
+    todo = [spec for spec in specs if spec.key not in done]
     say(
         console,
         f"sweep: {len(specs)} run{'s' if len(specs) != 1 else ''} "
-        f"({len(specs) - len(todo)} done already), "
-        f"results in {out / 'results.csv'}",
+        f"({len(specs) - len(todo)} done already) "
+        f"{describe_cluster(args.scheduler, args.workers)}, results in {path}",
     )
     if todo:
-        _run_all(console, todo, args, options, judged, table)
+        table = _run_all(console, todo, args, options, judged, path, columns)
+        kept = table.rows
+    else:
+        kept = read_rows(path)
     wanted = {spec.key for spec in specs}
-    rows = [row for row in table.rows if row["key"] in wanted]
+    rows = [row for row in kept if row["key"] in wanted]
     lines = explain(rows, varied=list(varied))
     write_atomically(out / "summary.txt", ("\n".join(lines) + "\n").encode())
     if args.parquet:
-        say(console, f"wrote {write_parquet(out / 'results.parquet', rows, table.columns)}")
+        say(console, f"wrote {write_parquet(out / 'results.parquet', rows, columns)}")
     for line in lines:
         say(console, line)
     failed = sum(row["verdict"] != "PASS" for row in rows)
@@ -221,42 +225,69 @@ def _run_all(
     args: argparse.Namespace,
     options: LinkOptions,
     judged: RunSettings,
-    table: ResultsTable,
-) -> None:
-    """Submit every run, write each row as it finishes, show progress."""
-    from distributed import as_completed
-    from rich.progress import (
-        BarColumn,
-        MofNCompleteColumn,
-        Progress,
-        TextColumn,
-        TimeElapsedColumn,
-        TimeRemainingColumn,
-    )
+    path: Path,
+    columns: tuple[str, ...],
+) -> ResultsTable:
+    """Run every spec on the cluster, write each row as it finishes, show progress.
 
+    The table is opened (a fresh one emptied) only once the cluster answers,
+    so a mistyped --scheduler costs no earlier results.
+    """
+    from harness.campaign.results import ResultsTable
     from harness.campaign.task import run_one
     from harness.cluster.client import dashboard, open_client
+    from harness.cluster.progress import add_task, task_progress
+    from harness.cluster.window import Window
 
     with open_client(args.scheduler, args.workers) as client:
+        table = ResultsTable(path, resume=args.resume, columns=columns)
         link = dashboard(client)
         if link:
             say(console, f"Dask dashboard: {link}")
-        futures = client.map(
-            run_one, todo, link_name=args.link, options=options, judged=judged, pure=False
-        )
+
+        def submit(spec: RunSpec) -> Any:
+            return client.submit(
+                run_one, spec, link_name=args.link, options=options, judged=judged, pure=False
+            )
+
+        window = Window(client, todo, submit)
         failed = 0
-        columns = (
-            TextColumn("{task.description}"),
-            BarColumn(),
-            MofNCompleteColumn(),
-            TextColumn("{task.fields[failed]} failed"),
-            TimeElapsedColumn(),
-            TimeRemainingColumn(),
-        )
-        with Progress(*columns, console=console, transient=False) as progress:
-            task = progress.add_task("runs", total=len(todo), failed=0)
-            for future in as_completed(futures):
-                row = future.result()
+        with task_progress(console, "runs") as progress:
+            bar = add_task(progress, "runs", len(todo))
+            for index, future in window:
+                row = _row_of(future, todo[index])
                 table.add(row)
                 failed += row["verdict"] != "PASS"
-                progress.update(task, advance=1, failed=failed)
+                progress.update(bar, advance=1, failed=failed, running=len(window.running))
+    return table
+
+
+def _row_of(future: Any, spec: RunSpec) -> dict[str, Any]:
+    """The run's row; a run Dask gave up on (it killed its worker every time) is a row too.
+
+    Any other loss (the scheduler went away) ends the sweep: the run is not
+    done, and --resume runs it.
+    """
+    from distributed import KilledWorker
+
+    from harness.errors import HarnessError
+
+    try:
+        return dict(future.result())
+    except KilledWorker:
+        failure = "could not run: the worker running it died every time it was tried"
+    except Exception as err:  # noqa: BLE001 - lost to the cluster, not to the node
+        raise HarnessError(
+            f"sweep stopped: run {spec.key} was lost to the Dask cluster "
+            f"({type(err).__name__}: {' '.join(str(err).split())[:200]}); "
+            "--resume runs what is missing"
+        ) from None
+    return {
+        **spec.as_row(),
+        "verdict": "ERROR",
+        "ticks": 0,
+        "failed_ticks": 0,
+        "first_failure": failure,
+        "wall_s": 0.0,
+        "worker": "",
+    }

@@ -271,35 +271,39 @@ def grade_class(
     config: GradeConfig,
     client: Any,
     *,
-    on_graded: Callable[[Student, StudentGrade], None] | None = None,
+    on_graded: Callable[[Student, StudentGrade, int], None] | None = None,
 ) -> list[StudentGrade]:
     """Every student's row, in the order given, each graded as a task on `client`'s cluster.
 
-    Open the client with ``retries=WORKER_RETRIES``: a student whose grading
-    kills its worker is then run once more elsewhere (a worker can die for
-    reasons of its own) before their row says so. On Ctrl-C (or SIGTERM)
-    the running builds and suites are stopped, each within its bounded
-    grace, before KeyboardInterrupt goes on up.
+    Students go to the cluster only as workers free up (harness.cluster.window),
+    so a worker holds only the student it grades. Open the client with
+    ``retries=WORKER_RETRIES``: a student whose grading kills its worker is
+    then run once more elsewhere (a worker can die for reasons of its own)
+    before their row says so. `on_graded` gets each row as it comes, with
+    how many students are being graded then. On Ctrl-C (or SIGTERM) the
+    running builds and suites are stopped, each within its bounded grace,
+    before KeyboardInterrupt goes on up.
     """
-    from distributed import as_completed
-
     from harness.cluster.flag import ClusterFlag
+    from harness.cluster.window import Window
 
     grades: dict[int, StudentGrade] = {}
     stop = ClusterFlag()
-    futures = {
-        client.submit(grade_student, s, config, stop, key=_task_key(s), pure=False): i
-        for i, s in enumerate(students)
-    }
+
+    def submit(student: Student) -> Any:
+        return client.submit(
+            grade_student, student, config, stop, key=_task_key(student), pure=False
+        )
+
+    window = Window(client, students, submit)
     try:
-        for future in as_completed(futures):
-            index = futures[future]
+        for index, future in window:
             grades[index] = _outcome(future, students[index], config)
             if on_graded is not None:
-                on_graded(students[index], grades[index])
+                on_graded(students[index], grades[index], len(window.running))
     except BaseException:
         stop.set()
-        _wait_for_running(futures, client)
+        _wait_for_running(list(window.running), client)
         raise
     return [grades[i] for i in range(len(students))]
 
@@ -329,11 +333,12 @@ def _outcome(future: Any, student: Student, config: GradeConfig) -> StudentGrade
     return StudentGrade(student.name, student.kind, not_run, reason)
 
 
-def _wait_for_running(futures: dict[Any, int], client: Any) -> None:
-    """Let running tasks stop their children (bounded), drop the ones not started."""
+def _wait_for_running(futures: list[Any], client: Any) -> None:
+    """Let the students on the cluster stop their children (each sees the stop flag within
+    its bounded grace), then drop whatever is left."""
     from distributed import wait as wait_for
 
-    pending = [f for f in futures if not f.done()]
-    client.cancel([f for f in pending if f.status == "pending"], reason="interrupted")
     with contextlib.suppress(Exception):
-        wait_for(pending, timeout=STOP_WAIT_S)
+        wait_for(futures, timeout=STOP_WAIT_S)
+    with contextlib.suppress(Exception):
+        client.cancel([f for f in futures if not f.done()], reason="interrupted")
