@@ -11,14 +11,17 @@ degrees, one hangs, one kills its worker) on every shipped scenario.
 would, configured as docs/grading.md advises) and passes `--scheduler`;
 otherwise the command's embedded cluster gets `--workers N`. `overhead`:
 Dask's own cost per task, from trivial tasks on an embedded cluster.
-Prints one line: runs, wall seconds, runs per second. Speed is measured
+Prints one line: runs, wall seconds, runs per second, and how many rows the
+results hold by verdict (sweep) or by score (grade). Speed is measured
 here, never asserted in tests (docs/benchmarks.md).
 """
 
 from __future__ import annotations
 
 import argparse
+import collections
 import contextlib
+import csv
 import subprocess
 import sys
 import tempfile
@@ -71,6 +74,17 @@ def timed(argv: list[str]) -> float:
     return wall
 
 
+def counted(out: Path, what: str) -> str:
+    """The rows the command wrote, by verdict (sweep) or by passed scenarios (grade)."""
+    name, column = ("results.csv", "verdict") if what == "sweep" else ("grades.csv", "passed")
+    with open(out / name, encoding="utf-8", newline="") as handle:
+        rows = list(csv.DictReader(handle))
+    counts = collections.Counter(row[column] for row in rows)
+    keys = {row.get("key") or row.get("student") for row in rows}
+    parts = ", ".join(f"{k} {v}" for k, v in sorted(counts.items()))
+    return f"{len(rows)} rows ({len(keys)} distinct): {parts}"
+
+
 def overhead(workers: int, tasks: int) -> None:
     from distributed import Client, LocalCluster
 
@@ -118,7 +132,7 @@ def main() -> None:
         unit = "runs" if args.what == "sweep" else "students"
         print(
             f"{args.what}: {runs} {unit} on {args.workers} {kind} workers: "
-            f"{wall:.1f} s, {runs / wall:.3f} {unit}/s"
+            f"{wall:.1f} s, {runs / wall:.3f} {unit}/s; {counted(out, args.what)}"
         )
 
 

@@ -16,12 +16,19 @@ from __future__ import annotations
 from collections.abc import Callable, Iterator, Sequence
 from typing import Any, Generic, TypeVar
 
+from harness.errors import HarnessError
+
 Item = TypeVar("Item")
 
 
 def cluster_threads(client: Any) -> int:
     """Worker threads the cluster has now (at least 1, so a cluster between workers waits)."""
-    return max(1, sum(client.nthreads().values()))
+    try:
+        threads = client.nthreads()
+    except Exception as err:  # noqa: BLE001 - the scheduler went away
+        said = " ".join(str(err).split())[:200] or type(err).__name__
+        raise HarnessError(f"lost the Dask scheduler: {said}") from None
+    return max(1, sum(threads.values()))
 
 
 class Window(Generic[Item]):

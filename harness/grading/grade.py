@@ -302,8 +302,9 @@ def grade_class(
             if on_graded is not None:
                 on_graded(students[index], grades[index], len(window.running))
     except BaseException:
-        stop.set()
-        _wait_for_running(list(window.running), client)
+        with contextlib.suppress(Exception):  # the scheduler may be what went away
+            stop.set()
+            _wait_for_running(list(window.running), client)
         raise
     return [grades[i] for i in range(len(students))]
 
