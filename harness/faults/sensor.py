@@ -264,18 +264,7 @@ class FaultProfile:
         intensities = np.where((cls == _VALID) | (cls == _GHOST), RETURN_INTENSITY, 0.0).astype(
             np.float32
         )
-        return Scan(
-            angle_min=spec.angle_min,
-            angle_max=spec.angle_max,
-            angle_increment=spec.angle_increment,
-            time_increment=spec.time_increment,
-            scan_time=spec.scan_time,
-            range_min=spec.range_min,
-            range_max=spec.range_max,
-            ranges=v32,
-            intensities=intensities,
-            stamp=float(stamp),
-        )
+        return spec.scan(v32, intensities=intensities, stamp=float(stamp))
 
 
 def _named(description: str, *items: _Item) -> tuple[str, tuple[_Item, ...]]:

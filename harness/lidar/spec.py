@@ -9,8 +9,14 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
+from typing import TYPE_CHECKING, Any
 
 from harness.errors import ConfigError
+
+if TYPE_CHECKING:
+    import numpy as np
+
+    from harness.lidar.scan import Scan
 
 # rad: how far a layout may pass one turn (or +-2 pi) by rounding: an
 # angle_increment taken from a float32 LaserScan, times 16383 beams, is off by
@@ -41,6 +47,22 @@ class LidarSpec:
     @property
     def time_increment(self) -> float:
         return self.scan_time / self.samples
+
+    def scan(self, ranges: np.ndarray, **fields: Any) -> Scan:
+        """A scan of this layout holding `ranges` (and `fields`: intensities, stamp, ...)."""
+        from harness.lidar.scan import Scan  # numpy: not for those who only read presets
+
+        return Scan(
+            angle_min=self.angle_min,
+            angle_max=self.angle_max,
+            angle_increment=self.angle_increment,
+            time_increment=self.time_increment,
+            scan_time=self.scan_time,
+            range_min=self.range_min,
+            range_max=self.range_max,
+            ranges=ranges,
+            **fields,
+        )
 
     def with_overrides(self, **changes: float | int | None) -> LidarSpec:
         """A copy with the given fields replaced (None means keep)."""

@@ -25,16 +25,7 @@ def scan_from(preset: str, seed: int = 7) -> Scan:
     """A revolution of the preset with a return on every beam (distinct distances)."""
     spec = PRESETS[preset]
     ranges = np.random.default_rng(seed).uniform(0.2, 11.0, spec.samples).astype(np.float32)
-    return Scan(
-        angle_min=spec.angle_min,
-        angle_max=spec.angle_max,
-        angle_increment=spec.angle_increment,
-        time_increment=spec.time_increment,
-        scan_time=spec.scan_time,
-        range_min=spec.range_min,
-        range_max=spec.range_max,
-        ranges=ranges,
-    )
+    return spec.scan(ranges)
 
 
 def decoded_standard(scan: Scan, rate_hz: float) -> list[tuple[float, float]]:
