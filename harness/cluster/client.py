@@ -10,7 +10,7 @@ from typing import Any
 from harness.errors import ConfigError
 
 CONNECT_TIMEOUT_S = 10  # for an external scheduler to answer
-WORKER_WAIT_S = 30  # for an external cluster without workers to get one
+WORKER_WAIT_S = 30.0  # for an external cluster without workers to get one (--worker-wait)
 # Our tasks are long (a run, a student): a worker holds only the one it runs, so
 # the next goes to whichever worker frees first, and a worker that dies takes no
 # queued task down with it (Dask counts those as suspects, and gives up on a
@@ -31,13 +31,18 @@ def check_cluster_options(scheduler: str | None, workers: int | None) -> None:
 
 @contextlib.contextmanager
 def open_client(
-    scheduler: str | None = None, workers: int | None = None, *, retries: int | None = None
+    scheduler: str | None = None,
+    workers: int | None = None,
+    *,
+    retries: int | None = None,
+    worker_wait: float = WORKER_WAIT_S,
 ) -> Iterator[Any]:
     """A Client on `scheduler`, or on a LocalCluster of `workers` processes that ends with it.
 
     `retries`: how often the embedded cluster runs a task again after its
     worker died under it (Dask's ``allowed-failures``, 3 by default); an
-    external scheduler keeps its own setting.
+    external scheduler keeps its own setting. `worker_wait`: seconds an
+    external cluster may take to offer its first worker.
     """
     import dask
     from distributed import Client, LocalCluster
@@ -50,7 +55,7 @@ def open_client(
         except Exception as err:  # noqa: BLE001 - anything here is the address's fault
             raise ConfigError(f"--scheduler {scheduler}: cannot connect: {_said(err)}") from None
         with client:
-            _wait_for_a_worker(client, scheduler)
+            _wait_for_a_worker(client, scheduler, worker_wait)
             yield client
         return
     count = workers if workers is not None else default_workers()
@@ -96,15 +101,15 @@ def check_scheduler(address: str) -> None:
         raise ConfigError(f"--scheduler {address}: answers, but not as a Dask scheduler")
 
 
-def _wait_for_a_worker(client: Any, address: str) -> None:
-    """A cluster without workers would wait for ever: give it WORKER_WAIT_S to get one."""
+def _wait_for_a_worker(client: Any, address: str, wait_s: float) -> None:
+    """A cluster without workers would wait for ever: give it `wait_s` to get one."""
     if client.nthreads():
         return
     try:
-        client.wait_for_workers(1, timeout=WORKER_WAIT_S)
+        client.wait_for_workers(1, timeout=wait_s)
     except (TimeoutError, OSError):
         raise ConfigError(
-            f"--scheduler {address}: no worker joined within {WORKER_WAIT_S} s "
+            f"--scheduler {address}: no worker joined within {wait_s:g} s "
             f"(start one: dask worker {address} --nthreads 1)"
         ) from None
 

@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import argparse
 
-from harness.commands.arguments import given, whole_number
+from harness.cluster.client import WORKER_WAIT_S
+from harness.commands.arguments import given, positive, whole_number
 
 workers = whole_number("workers", 1, 1_000)
 
@@ -23,6 +24,14 @@ def add_cluster_options(parser: argparse.ArgumentParser, *, unit: str = "runs") 
         type=workers,
         metavar="N",
         help=f"worker processes of the embedded cluster, {unit} at once (default: one per core)",
+    )
+    group.add_argument(
+        "--worker-wait",
+        type=positive("--worker-wait", 86_400),
+        default=WORKER_WAIT_S,
+        metavar="S",
+        help="seconds the --scheduler cluster may take to offer its first worker, e.g. while "
+        f"a batch queue starts one (default {WORKER_WAIT_S:g})",
     )
 
 

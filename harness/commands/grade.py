@@ -232,7 +232,9 @@ def run(args: argparse.Namespace, console: Console) -> int:
             "grading needs rclpy: pip install 'fossbot-hil[ros]' (or source ROS 2 Jazzy)"
         )
     with (
-        open_client(args.scheduler, args.workers, retries=WORKER_RETRIES) as client,
+        open_client(
+            args.scheduler, args.workers, retries=WORKER_RETRIES, worker_wait=args.worker_wait
+        ) as client,
         prepare_out(out),  # the folder is this grade's until it is done
     ):
         names = tuple(s.name for s in scenarios)

@@ -239,7 +239,7 @@ def _run_all(
     from harness.cluster.progress import add_task, task_progress
     from harness.cluster.window import Window
 
-    with open_client(args.scheduler, args.workers) as client:
+    with open_client(args.scheduler, args.workers, worker_wait=args.worker_wait) as client:
         table = ResultsTable(path, resume=args.resume, columns=columns)
         link = dashboard(client)
         if link:

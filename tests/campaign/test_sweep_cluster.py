@@ -197,10 +197,11 @@ def test_a_port_that_is_no_scheduler_is_refused_in_bounded_time(
 
 def test_a_cluster_without_workers_is_refused_in_bounded_time(tmp_path: Path) -> None:
     with dask_cluster(0, nanny=False) as (address, _):
-        done = fossbot_hil("sweep", "--out", str(tmp_path / "s"), "--scheduler", address)
+        out = ["--out", str(tmp_path / "s")]
+        done = fossbot_hil("sweep", *out, "--scheduler", address, "--worker-wait", "2")
     assert done.returncode == 2, done.stdout + done.stderr
     lines = done.stderr.strip().splitlines()
-    assert len(lines) == 1 and "no worker joined within" in lines[0], done.stderr
+    assert len(lines) == 1 and "no worker joined within 2 s" in lines[0], done.stderr
 
 
 @pytest.mark.parametrize(
@@ -214,6 +215,7 @@ def test_a_cluster_without_workers_is_refused_in_bounded_time(tmp_path: Path) ->
         (["--workers", "2", "--scheduler", "tcp://127.0.0.1:1"], "--workers"),
         (["--scheduler", "notanaddress"], "--scheduler notanaddress: cannot connect"),
         (["--seeds", "ten"], "--seeds"),
+        (["--worker-wait", "0"], "--worker-wait must be a positive number"),
         (["--vary", "spd=1"], "NAME one of start_dx, start_dy"),
         (["--vary", "speed=0"], "speed: a level is a number > 0"),
         (["--vary", "speed=1", "--vary", "speed=2"], "--vary speed: given twice"),
