@@ -35,7 +35,7 @@ from mcap_ros2.decoder import DecoderFactory
 from harness.atomic_write import TEMPORARY_NAME
 from harness.report.folder_lock import LOCK_NAME
 
-pytestmark = pytest.mark.timeout(300)
+pytestmark = [pytest.mark.timeout(300), pytest.mark.slow]
 
 EXAMPLES = 550
 TINY = """\

@@ -28,7 +28,7 @@ from mcap_ros2.decoder import DecoderFactory
 from harness.atomic_write import TEMPORARY_NAME
 from harness.safe_text import TEXT_LIMIT
 
-pytestmark = pytest.mark.timeout(600)
+pytestmark = [pytest.mark.timeout(600), pytest.mark.slow]
 
 EXAMPLES = 120  # each writes a whole report folder (a plot, a recording); 500+ at the
 # writers alone: tests/report/test_report_text_safety.py

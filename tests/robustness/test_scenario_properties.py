@@ -502,6 +502,7 @@ def outcome(path: Path, stats: Counter[str]) -> int | None:
 
 
 @pytest.mark.timeout(300)
+@pytest.mark.slow
 def test_generated_scenarios_run_or_are_refused(
     tmp_path: Path, record_property: Any, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -535,6 +536,7 @@ def test_generated_scenarios_run_or_are_refused(
 
 
 @pytest.mark.timeout(300)
+@pytest.mark.slow
 def test_generated_scenarios_through_the_command(
     tmp_path: Path, record_property: Any, capsys: pytest.CaptureFixture[str]
 ) -> None:
