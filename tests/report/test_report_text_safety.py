@@ -26,6 +26,7 @@ import pytest
 from command_line import COMMAND, fossbot_hil
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from property_depth import examples
 from rich.console import Console
 
 from harness.cli import _print_error
@@ -184,7 +185,7 @@ def _result(status: str, diagnostics: str, error: str, scenario: str) -> RunResu
     )
 
 
-@settings(max_examples=500, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=examples(300), deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(status=LONG_TEXTS, diagnostics=LONG_TEXTS, error=LONG_TEXTS, scenario=TEXTS)
 def test_any_text_makes_valid_bounded_reports(
     status: str, diagnostics: str, error: str, scenario: str

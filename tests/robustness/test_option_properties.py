@@ -31,13 +31,14 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from mcap.reader import make_reader
 from mcap_ros2.decoder import DecoderFactory
+from property_depth import examples
 
 from harness.atomic_write import TEMPORARY_NAME
 from harness.report.folder_lock import LOCK_NAME
 
 pytestmark = [pytest.mark.timeout(300), pytest.mark.slow]
 
-EXAMPLES = 550
+EXAMPLES = examples(330)
 TINY = """\
 description: Three ticks beside a wall.
 obstacles:

@@ -24,13 +24,14 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from mcap.reader import make_reader
 from mcap_ros2.decoder import DecoderFactory
+from property_depth import examples
 
 from harness.atomic_write import TEMPORARY_NAME
 from harness.safe_text import TEXT_LIMIT
 
 pytestmark = [pytest.mark.timeout(600), pytest.mark.slow]
 
-EXAMPLES = 120  # each writes a whole report folder (a plot, a recording); 500+ at the
+EXAMPLES = examples(70)  # each writes a whole report folder (a plot, a recording); 300+ at the
 # writers alone: tests/report/test_report_text_safety.py
 ONE_TICK = """\
 description: One tick beside a wall.
