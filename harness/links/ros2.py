@@ -286,6 +286,9 @@ class Ros2Link(Link):
                 break
             if outcome != "timeout":  # it names the node (or the driver, or the line) already
                 raise LinkError(self.node_gone("while warming up") or outcome)
+            # Ready may have counted a publisher the node has since replaced (a reliable
+            # one swapped for best-effort, say): what can never be heard is said now.
+            self._check_types()
             if time.perf_counter() >= deadline:
                 raise LinkError(
                     f"node {self.command.description} never answered a scan within "
