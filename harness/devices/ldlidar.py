@@ -141,13 +141,15 @@ def decode_packets(data: bytes) -> tuple[list[Sample], int]:
     return samples, bad
 
 
+def starts_like_command(data: bytes | bytearray) -> bool:
+    """Do these bytes begin as an LDROBOT command frame does (0x54, a command, length 4)?"""
+    return len(data) >= 3 and data[0] == HEADER and data[2] == COMMAND_PAYLOAD_LEN
+
+
 def _is_command_frame(frame: bytes) -> bool:
-    """An LDROBOT command frame: 0x54, a command, length 4, its payload and CRC-8."""
+    """A whole LDROBOT command frame: its start, a 4-byte payload and its CRC-8."""
     return (
-        len(frame) == COMMAND_LEN
-        and frame[0] == HEADER
-        and frame[2] == COMMAND_PAYLOAD_LEN
-        and crc8(frame[:-1]) == frame[-1]
+        len(frame) == COMMAND_LEN and starts_like_command(frame) and crc8(frame[:-1]) == frame[-1]
     )
 
 

@@ -20,6 +20,7 @@ from functools import reduce
 from operator import xor
 
 from harness.devices.events import DeviceEvent, Listener
+from harness.devices.ldlidar import starts_like_command
 from harness.devices.revolution import DEFAULT_QUALITY, Sample
 
 # -- wire constants (Slamtec protocol v2.x, sl_lidar_cmd.h) --------------------
@@ -143,7 +144,7 @@ def _command_name(cmd: int) -> str:
 
 def _garbage_note(data: bytes | bytearray) -> str:
     """Name bytes that are another LIDAR's (else the generic hint applies)."""
-    if len(data) >= 3 and data[0] == 0x54 and data[2] == 0x04:  # 0x54 cmd 0x04 ...: LDROBOT
+    if starts_like_command(data):
         return (
             "an LDROBOT command frame (54 ...): an LD06/LD19 driver on an RPLIDAR; "
             "use its own device type (emulate ldlidar, --link ldlidar)"

@@ -19,7 +19,7 @@ import os
 import sys
 import time
 from dataclasses import replace
-from typing import Any, ClassVar
+from typing import TYPE_CHECKING, Any, ClassVar
 
 from harness.devices.profiles import DeviceProfile
 from harness.errors import ConfigError, LinkError
@@ -31,6 +31,9 @@ from harness.links.ros2 import CATCH_UP_S, POLL_S, Ros2Link
 from harness.nodes.command import NodeCommand, ros_arguments
 from harness.nodes.process import NodeProcess, prepare_start
 from harness.ros.observer import Heard
+
+if TYPE_CHECKING:
+    from harness.serial_line.diagnosis import LineReport
 
 SCAN_CATCH_UP_S = 0.05  # a driver scan published before its answer reaches us within this
 LATE_SCAN_WAIT_S = 0.2  # after a lost revolution: how long a second driver scan may follow
@@ -141,8 +144,8 @@ class BoardLink(Ros2Link):
             f"({self.profile.description})"
         )
         graph = self.observer.graph_summary() if self.observer is not None else ""
-        line = self.line_report()
-        if "; likely cause: " not in line:
+        report = self.line_diagnosis()
+        if not report.likely:
             # Nothing wrong on the line (an LD06/LD19's line cannot tell: its driver
             # sends nothing back): what was missing is on the board's ROS 2 side.
             quiet = (
@@ -151,15 +154,21 @@ class BoardLink(Ros2Link):
                 else "the line looks right"
             )
             domain = self.domain.domain_id if self.domain is not None else "?"
-            line += (
-                f"; likely cause: {quiet}; the board's nodes were not ready in ROS domain "
-                f"{domain}: check that it is the board's ROS_DOMAIN_ID, --ros-network (the "
-                "board is another machine), and that its LIDAR driver and node run"
+            report = replace(
+                report,
+                likely=f"{quiet}; the board's nodes were not ready in ROS domain {domain}: "
+                "check that it is the board's ROS_DOMAIN_ID, --ros-network (the board is "
+                "another machine), and that its LIDAR driver and node run",
             )
+        line = report.text()
         return f"{ready}: on the line {line}" + (f" ({graph})" if graph else "")
 
     def line_report(self) -> str:
         """The serial line's story: sent, came back, likely cause (for errors)."""
+        return self.line_diagnosis().text()
+
+    def line_diagnosis(self) -> LineReport:
+        """The serial line's story in its three parts."""
         from harness.serial_line.diagnosis import diagnose
 
         assert self.server is not None and self.port is not None
@@ -168,7 +177,7 @@ class BoardLink(Ros2Link):
             port=f"--port {self.port.name}" if self.physical else self.port.name,
             baudrate=self.profile.baudrate,
             streams_unasked=self.profile.streams_unasked,
-        ).text()
+        )
 
     def node_gone(self, when: str = "") -> str | None:
         if self.server is not None and self.server.error is not None:
