@@ -10,6 +10,12 @@ from __future__ import annotations
 import signal
 
 
+def one_line(err: BaseException, limit: int = 200) -> str:
+    """Another library's error as one short line for a message (its type when it says
+    nothing)."""
+    return " ".join(str(err).split())[:limit] or type(err).__name__
+
+
 class HarnessError(Exception):
     """Base class of every error the harness raises deliberately."""
 

@@ -62,12 +62,12 @@ def check_columns(path: Path, columns: Sequence[str]) -> None:
         )
 
 
-def done_keys(path: Path, columns: Sequence[str] = COLUMNS) -> set[str]:
-    """The keys of the runs a table to resume holds (none when there is no table yet)."""
+def rows_to_resume(path: Path, columns: Sequence[str] = COLUMNS) -> list[dict[str, str]]:
+    """The finished rows of a table to resume (none when there is no table yet)."""
     if not path.exists():
-        return set()
+        return []
     check_columns(path, columns)
-    return {row["key"] for row in read_rows(path)}
+    return read_rows(path)
 
 
 class ResultsTable:

@@ -7,7 +7,7 @@ import os
 from collections.abc import Iterator
 from typing import Any
 
-from harness.errors import ConfigError
+from harness.errors import ConfigError, one_line
 
 CONNECT_TIMEOUT_S = 10  # for an external scheduler to answer
 WORKER_WAIT_S = 30.0  # for an external cluster without workers to get one (--worker-wait)
@@ -116,10 +116,9 @@ def _wait_for_a_worker(client: Any, address: str, wait_s: float) -> None:
 
 def _said(err: BaseException) -> str:
     """An error in one short line."""
-    text = " ".join(str(err).split()) or type(err).__name__
     if isinstance(err, MemoryError):
-        text = "its answer is not Dask's protocol (is this the scheduler's port?)"
-    return text[:200]
+        return "its answer is not Dask's protocol (is this the scheduler's port?)"
+    return one_line(err)
 
 
 def dashboard(client: Any) -> str | None:

@@ -16,7 +16,7 @@ from __future__ import annotations
 from collections.abc import Callable, Iterator, Sequence
 from typing import Any, Generic, TypeVar
 
-from harness.errors import HarnessError
+from harness.errors import HarnessError, one_line
 
 Item = TypeVar("Item")
 
@@ -26,8 +26,7 @@ def cluster_threads(client: Any) -> int:
     try:
         threads = client.nthreads()
     except Exception as err:  # noqa: BLE001 - the scheduler went away
-        said = " ".join(str(err).split())[:200] or type(err).__name__
-        raise HarnessError(f"lost the Dask scheduler: {said}") from None
+        raise HarnessError(f"lost the Dask scheduler: {one_line(err)}") from None
     return max(1, sum(threads.values()))
 
 

@@ -135,7 +135,7 @@ def run(args: argparse.Namespace, console: Console) -> int:
     from harness.campaign.factors import explain
     from harness.campaign.parquet import check_parquet_available, write_parquet
     from harness.campaign.plan import plan
-    from harness.campaign.results import columns_for, done_keys, read_rows
+    from harness.campaign.results import columns_for, rows_to_resume
     from harness.cluster.client import check_cluster_options
     from harness.runner.settings import RunSettings
 
@@ -155,7 +155,8 @@ def run(args: argparse.Namespace, console: Console) -> int:
         raise ConfigError(f"{len(specs)} runs; at most {MAX_RUNS} in one sweep")
     out = Path(args.out)
     path, columns = out / "results.csv", columns_for(list(varied))
-    done = done_keys(path, columns) if args.resume else set()
+    kept = rows_to_resume(path, columns) if args.resume else []
+    done = {row["key"] for row in kept}
     todo = [spec for spec in specs if spec.key not in done]
     say(
         console,
@@ -164,10 +165,7 @@ def run(args: argparse.Namespace, console: Console) -> int:
         f"{describe_cluster(args.scheduler, args.workers)}, results in {path}",
     )
     if todo:
-        table = _run_all(console, todo, args, options, judged, path, columns)
-        kept = table.rows
-    else:
-        kept = read_rows(path)
+        kept = _run_all(console, todo, args, options, judged, path, columns).rows
     wanted = {spec.key for spec in specs}
     rows = [row for row in kept if row["key"] in wanted]
     lines = explain(rows, varied=list(varied))
@@ -270,7 +268,7 @@ def _row_of(future: Any, spec: RunSpec) -> dict[str, Any]:
     """
     from distributed import KilledWorker
 
-    from harness.errors import HarnessError
+    from harness.errors import HarnessError, one_line
 
     try:
         return dict(future.result())
@@ -279,7 +277,7 @@ def _row_of(future: Any, spec: RunSpec) -> dict[str, Any]:
     except Exception as err:  # noqa: BLE001 - lost to the cluster, not to the node
         raise HarnessError(
             f"sweep stopped: run {spec.key} was lost to the Dask cluster "
-            f"({type(err).__name__}: {' '.join(str(err).split())[:200]}); "
+            f"({type(err).__name__}: {one_line(err)}); "
             "--resume runs what is missing"
         ) from None
     return {

@@ -13,7 +13,7 @@ from pydantic import (
     ValidationError,
 )
 
-from harness.errors import ConfigError
+from harness.errors import ConfigError, one_line
 from harness.faults.sensor import build_profile
 from harness.safe_text import shown
 from harness.scenario.checks import (
@@ -112,7 +112,7 @@ def load_scenario_file(path: str | Path) -> Scenario:
     except RecursionError:
         raise ConfigError(f"{name}: YAML error: nested too deeply") from None
     except ValueError as err:  # e.g. an integer with more digits than Python converts
-        raise ConfigError(f"{name}: YAML error: {' '.join(str(err).split())[:200]}") from None
+        raise ConfigError(f"{name}: YAML error: {one_line(err)}") from None
     return checked_scenario(data, source=str(path))
 
 

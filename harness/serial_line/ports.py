@@ -19,7 +19,7 @@ from abc import ABC, abstractmethod
 from dataclasses import dataclass
 from typing import Literal
 
-from harness.errors import ConfigError, LinkError
+from harness.errors import ConfigError, LinkError, one_line
 from harness.serial_line.port_lock import DEFAULT_WAIT_S, PortLock, hold_port
 
 _NO_PEER_STEP_S = 0.01  # how often a pty without a reader is re-checked
@@ -36,7 +36,7 @@ def _one_line(err: BaseException) -> str:
     code = getattr(err, "errno", None)
     if isinstance(code, int) and code > 0:
         return f"[Errno {code}] {os.strerror(code)}"
-    return " ".join(str(err).split()) or type(err).__name__
+    return one_line(err, limit=1000)
 
 
 class DevicePort(ABC):
