@@ -30,7 +30,7 @@ from collections.abc import Iterator
 from pathlib import Path
 
 REPO = Path(__file__).resolve().parents[1]
-sys.path[:0] = [str(REPO / "tests"), str(REPO / "tests" / "grading")]  # the tests' helpers
+sys.path[:0] = [str(REPO / "tests")]  # the tests' helpers
 FAULTS = "clean,noisy,dropouts_nan,driver_rplidar_ros"
 COMMAND = [sys.executable, "-m", "harness.cli"]
 
@@ -54,7 +54,7 @@ def make_class(folder: Path, students: int) -> None:
         students - 2: "hangs",
         students - 1: "kills_worker",
     }
-    from grading_class import HANGS, KILLS_ITS_WORKER, VARIANT
+    from cluster_nodes import HANGS, KILLS_ITS_WORKER, VARIANT
 
     for index in range(students):
         kind = special.get(index, "correct")

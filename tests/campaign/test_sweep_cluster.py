@@ -20,11 +20,9 @@ from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
+from cluster_nodes import HANGS, KILLS_ITS_WORKER
 from command_line import COMMAND, fossbot_hil
 from dask_cluster import children, dask_cluster
-
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "grading"))
-from grading_class import HANGS, KILLS_ITS_WORKER  # noqa: E402 - the cluster class's nodes
 
 pytestmark = [pytest.mark.ros, pytest.mark.slow, pytest.mark.timeout(300)]
 

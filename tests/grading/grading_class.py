@@ -69,33 +69,3 @@ def snapshot(folder: Path) -> dict[str, tuple[int, int]]:
         str(p.relative_to(folder)): (p.stat().st_size, p.stat().st_mtime_ns)
         for p in sorted(folder.rglob("*"))
     }
-
-
-# Single-file students for grading on a cluster (tests/grading/test_grading_cluster.py,
-# benchmarks/cluster_throughput.py): VARIANT.format(variant=...) runs a student_node variant.
-VARIANT = (
-    "import runpy\nimport sys\n\n"
-    'sys.argv[1:1] = ["{variant}"]\n'
-    f'runpy.run_path({str(STUDENT_NODE)!r}, run_name="__main__")\n'
-)
-HANGS = (
-    "import signal\nimport time\n\n"
-    "signal.signal(signal.SIGTERM, signal.SIG_IGN)  # and never comes up\n"
-    "while True:\n    time.sleep(1)\n"
-)
-# Walks up its ancestors to the Dask worker process (a nanny's spawned child, or a
-# `dask worker --no-nanny`) and kills it, as a node gone badly wrong might.
-KILLS_ITS_WORKER = """\
-import os
-import signal
-
-pid = os.getppid()
-while pid > 1:
-    with open(f"/proc/{pid}/cmdline", "rb") as handle:
-        command = handle.read().replace(b"\\0", b" ")
-    if b"spawn_main" in command or b"dask_worker" in command:
-        os.kill(pid, signal.SIGKILL)
-        break
-    with open(f"/proc/{pid}/stat", "rb") as handle:
-        pid = int(handle.read().rsplit(b")", 1)[1].split()[1])
-"""

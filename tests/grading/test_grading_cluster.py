@@ -18,9 +18,9 @@ import time
 from pathlib import Path
 
 import pytest
+from cluster_nodes import HANGS, KILLS_ITS_WORKER, VARIANT
 from command_line import COMMAND
 from dask_cluster import GRADING_ENV, children, dask_cluster
-from grading_class import HANGS, KILLS_ITS_WORKER, VARIANT
 
 pytestmark = [pytest.mark.ros, pytest.mark.slow, pytest.mark.timeout(300)]
 
