@@ -1,0 +1,82 @@
+"""How a LIDAR device sits on the robot: where its own zero points, which way it counts.
+
+A ``Scan`` is in the robot's scan frame (REP-103: radians, counter-clockwise,
+0 = straight ahead). A spinning LIDAR reports its own angles: degrees,
+clockwise seen from above (the RPLIDAR A1 and the LD06/LD19 both), from its
+own zero, which need not point forward. On the FOSSBot v2 the A1's zero
+points to the robot's right (``yaw_deg = -90``): the v2 bridge turns it back
+with ``invert: true, angle_offset_deg: -90``. A device mounted upside down
+counts the other way round seen from above (``mirrored``).
+
+A board driver that maps device angle ``theta`` to
+``a = (-theta if invert else theta) + angle_offset_deg`` (the v2 bridge, the
+bundled driver) shows the scan frame exactly when ``invert = not mirrored``
+and ``angle_offset_deg = yaw_deg`` (``driver_settings``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from harness.errors import ConfigError
+
+__all__ = ["FORWARD", "LidarMount", "parse_mount"]
+
+FORWARD_WORDS = ("forward", "generic")
+MODEL_WORD = "model"
+
+
+@dataclass(frozen=True)
+class LidarMount:
+    """The device's zero and sense of rotation in the robot's scan frame."""
+
+    yaw_deg: float = 0.0  # where the device's 0 degrees points: CCW from forward, degrees
+    mirrored: bool = False  # True: device angles run counter-clockwise seen from above
+
+    def device_angle_deg(self, scan_deg: float) -> float:
+        """The device angle (degrees, [0, 360)) of a beam at `scan_deg` (CCW, scan frame)."""
+        turn = scan_deg - self.yaw_deg if self.mirrored else self.yaw_deg - scan_deg
+        angle = turn % 360.0
+        return 0.0 if angle >= 360.0 else angle + 0.0
+
+    def driver_settings(self) -> tuple[bool, float]:
+        """(invert, angle_offset_deg) that turn this device's angles back into the scan frame."""
+        return (not self.mirrored, self.yaw_deg)
+
+    def describe(self) -> str:
+        """For messages: 'zero at -90 deg (to the right), clockwise'."""
+        where = {0.0: "straight ahead", 90.0: "to the left", -90.0: "to the right"}
+        yaw = ((self.yaw_deg + 180.0) % 360.0) - 180.0
+        side = where.get(yaw, "")
+        sense = "counter-clockwise (mirrored)" if self.mirrored else "clockwise"
+        return f"zero at {yaw:g} deg{f' ({side})' if side else ''}, {sense}"
+
+    def option_text(self) -> str:
+        """The `--lidar-mount` value that gives this mount."""
+        return f"{self.yaw_deg:g}" + (",mirrored" if self.mirrored else "")
+
+
+FORWARD = LidarMount()  # a generic mount: zero straight ahead, clockwise
+
+
+def parse_mount(text: str) -> LidarMount | None:
+    """`--lidar-mount`: 'model' (None: what the robot model says), 'forward', or
+    'DEG[,mirrored]' (the device's zero, CCW from forward). ConfigError when neither."""
+    value = text.strip().lower()
+    if value == MODEL_WORD:
+        return None
+    if value in FORWARD_WORDS:
+        return FORWARD
+    yaw_text, _, flag = value.partition(",")
+    if flag not in ("", "mirrored"):
+        raise ConfigError(f"--lidar-mount {text[:40]!r}: after the angle only ',mirrored' may follow")
+    try:
+        yaw = float(yaw_text)
+    except ValueError:
+        yaw = float("nan")
+    if not -360.0 <= yaw <= 360.0:  # also refuses nan and inf
+        raise ConfigError(
+            f"--lidar-mount {text[:40]!r}: give model, forward, or the angle of the device's zero "
+            "in degrees (-360..360, counter-clockwise from forward), e.g. -90 or 180,mirrored"
+        )
+    return LidarMount(yaw_deg=yaw + 0.0, mirrored=flag == "mirrored")
