@@ -46,6 +46,21 @@ and the same policy applies when it comes. Express scans get no marker:
 their capsules carry no start flag and the encoder holds back a capsule
 until the next one starts, so in lockstep the end of each express
 revolution waits for the next push (use standard scans, or realtime).
+
+A device that never falls silent (``continuous``)
+-------------------------------------------------
+A real device streams from its SCAN request until its STOP, whatever the
+host does; a driver may wait for bytes with no timeout (rplidar-roboticia
+does). With ``continuous`` the server does the same for a whole run of
+scenarios: in realtime, when the next revolution is late at its slot, the
+start marker goes out as above and, if nothing came within half a period,
+the last revolution goes out again (a *repeat*), and so on each period; in
+lockstep, revolutions go out as pushed while a scenario runs, and between
+scenarios (``stream_idle``, until the next push or ``end_idle``) the last
+revolution goes out again every period. ``stream_idle(samples)`` also sets
+what to stream before anything was pushed (an empty room, say). Repeats
+are marked in ``deliveries()``; a pushed revolution's delivery is found by
+the id ``send_revolution`` returned (``delivery_of``).
 """
 
 from __future__ import annotations
@@ -82,6 +97,11 @@ class Delivery:
     tick: int
     started_at: float  # time.monotonic()
     finished_at: float
+    push_id: int | None = None  # send_revolution's id; None for a repeat
+    # System time (ns) just before the write that carried the revolution's last
+    # byte: every scan a driver made of it is published after this.
+    written_ns: int = 0
+    repeat: bool = False  # the device sent an earlier revolution again (continuous)
 
 
 @dataclass(frozen=True)
@@ -113,6 +133,7 @@ class ServerStats:
     revolutions_sent: int
     revolutions_dropped: int  # the device encoded nothing (not scanning)
     revolutions_superseded: int  # realtime: replaced by a newer one before their slot
+    revolutions_repeated: int  # continuous: the last revolution sent again (nothing new came)
     markers_sent: int
     stream_bytes_dropped: int  # unsent revolution bytes dropped when the device stopped
     overrun_bytes: int  # realtime: bytes the line "sent" that the port did not take
@@ -174,6 +195,7 @@ class DeviceServer:
         request_gap_s: float = 0.1,
         poll_s: float = 0.01,
         listener: Callable[[Any], None] | None = None,
+        continuous: bool = False,
     ) -> None:
         if mode not in ("lockstep", "realtime"):
             raise ValueError(f"mode must be lockstep or realtime, not {mode!r}")
@@ -196,6 +218,8 @@ class DeviceServer:
         self.request_gap_s = request_gap_s  # line quiet this long: a partial request is dropped
         self.poll_s = poll_s
         self._unit_override = unit_samples
+        # A whole run: never fall silent while the device scans (see the module docstring).
+        self.continuous = continuous
         self.damage: Any = None  # a harness.faults.link.LineDamage, set before the run starts
         # Told (on the server thread) of line events and, through the device, of
         # each request and protocol error: what `emulate -v` prints.
@@ -207,7 +231,8 @@ class DeviceServer:
         self.pacer = LinePacer(baudrate, bits_per_byte) if mode == "realtime" else None
 
         self._lock = threading.Lock()
-        self._inbox: deque[tuple[Sequence[Any], int, float]] = deque()  # samples, tick, period
+        # samples, tick, period, push id
+        self._inbox: deque[tuple[Sequence[Any], int, float, int]] = deque()
         self._idle = threading.Event()
         self._idle.set()
         self._changed = threading.Event()  # device state may have changed
@@ -232,13 +257,24 @@ class DeviceServer:
         self._reply = bytearray()
         self._stream = bytearray()
         self._rev_left = 0  # bytes of the current revolution (not its marker) still in _stream
-        self._current: tuple[int, float | None] | None = None  # tick, first write time
+        # The revolution being written: tick, first write time, push id, repeat?
+        self._current: tuple[int, float | None, int | None, bool] | None = None
+        self._write_ns = 0  # system time just before the last write to the port
         self._rev_lost = 0  # bytes of the current revolution the port did not take
         self._marker_sent = False  # a start marker stands in for the next revolution's start
         self._marker_size = 0  # samples in the last marker
         self._carry = 0  # samples a packetizing encoder holds for its next packet
         self._last_samples: Sequence[Any] | None = None
         self._last_tick = -1
+        self._last_period = revolution_period_s
+        self._marker_at = 0.0  # realtime: when the last underrun marker was queued
+        self._push_count = 0  # ids of pushed revolutions
+        # Continuous lockstep: between scenarios the last revolution streams every
+        # period (harness thread sets and clears it under the lock).
+        self._idling = False
+        self._idle_due = 0.0
+        self._idle_request: tuple[Sequence[Any], float] | None = None  # held samples, period
+        self._idle_quiet = threading.Event()  # the thread saw the idle stream end
         self._next_due: float | None = None  # realtime: nominal start of the next revolution
         self._was_streaming = self._streaming()
         self._dtr: bool | None = None
@@ -265,6 +301,7 @@ class DeviceServer:
                 "revolutions_sent",
                 "revolutions_dropped",
                 "revolutions_superseded",
+                "revolutions_repeated",
                 "markers_sent",
                 "stream_bytes_dropped",
                 "overrun_bytes",
@@ -311,11 +348,13 @@ class DeviceServer:
 
     def send_revolution(
         self, samples: Sequence[Any], tick: int, period_s: float | None = None
-    ) -> None:
-        """Queue one revolution; it goes out on the server thread.
+    ) -> int:
+        """Queue one revolution; it goes out on the server thread. Returns its id
+        (``delivery_of``).
 
         `period_s`: in real time, how long this revolution lasts before the
-        next is due (a drifting rate); default the server's period.
+        next is due (a drifting rate); default the server's period. In
+        continuous lockstep a push also ends the idle stream.
         """
         self._check()
         with self._lock:
@@ -324,9 +363,63 @@ class DeviceServer:
                 # waiting for its slot is replaced by the newer one.
                 self._inbox.popleft()
                 self._n["revolutions_superseded"] += 1
-            self._inbox.append((list(samples), tick, period_s or self.period_s))
+            self._push_count += 1
+            self._inbox.append((list(samples), tick, period_s or self.period_s, self._push_count))
+            self._idling = False
             self._idle.clear()
         self._wake()
+        return self._push_count
+
+    def stream_idle(
+        self, samples: Sequence[Any] | None = None, period_s: float | None = None
+    ) -> None:
+        """Continuous: between scenarios, keep the device streaming until the next push.
+
+        `samples` replaces the revolution to stream (default: the last one
+        sent); in realtime it streams anyway once nothing new comes, in
+        lockstep it goes out every `period_s` (default: the last period).
+        """
+        if not self.continuous:
+            raise RuntimeError("stream_idle needs a continuous server")
+        self._check()
+        with self._lock:
+            if samples is not None:
+                self._idle_request = (list(samples), period_s or self.period_s)
+            self._idling = self.mode == "lockstep"
+            self._idle_quiet.clear()
+        self._wake()
+
+    def end_idle(self, timeout: float) -> Delivery | None:
+        """Continuous lockstep: stop the idle stream before the next push; wait (at most
+        `timeout` s) until the revolution it was writing is out. Returns the last
+        repeat written since the last push (its driver scan comes before the
+        push's), or None."""
+        self._check()
+        with self._lock:
+            was = self._idling
+            self._idling = False
+        if self.mode != "lockstep":
+            return None
+        if was:
+            self._wake()
+            self._idle_quiet.wait(max(0.0, timeout))
+            self._check()
+        with self._lock:
+            for delivery in reversed(self._deliveries):
+                if not delivery.repeat:
+                    return None
+                return delivery
+        return None
+
+    def delivery_of(self, push_id: int) -> Delivery | None:
+        """When the pushed revolution `push_id` went out whole, or None (not yet, or never)."""
+        with self._lock:
+            for delivery in reversed(self._deliveries):
+                if delivery.push_id == push_id:
+                    return delivery
+                if delivery.push_id is not None and delivery.push_id < push_id:
+                    return None
+        return None
 
     def wait_idle(self, timeout: float) -> bool:
         """Wait (at most `timeout` s) until everything queued was written; False on timeout."""
@@ -480,6 +573,8 @@ class DeviceServer:
 
     def _step(self) -> None:
         now = time.monotonic()
+        if not self._idling and not (self._current is not None and self._current[3]):
+            self._idle_quiet.set()  # end_idle: no repeat in flight
         self._poll_dtr(now)
         self._housekeeping(now)
         self._next_revolution(now)
@@ -507,6 +602,10 @@ class DeviceServer:
             underrun_due = self._last_samples is not None and not self._marker_sent
             if self._inbox or underrun_due:
                 return min(self.poll_s, max(0.0, self._next_due - now))
+            if self.continuous and self._last_samples is not None:
+                return min(self.poll_s, max(0.0, self._repeat_due() - now))
+        if self._idling:
+            return min(self.poll_s, max(0.0, self._idle_due - now))
         return self.poll_s
 
     def _housekeeping(self, now: float) -> None:
@@ -532,8 +631,8 @@ class DeviceServer:
         if self.listener is not None:
             self.listener(event)
 
-    def _poll_dtr(self, now: float) -> None:
-        if now - self._dtr_polled < _DTR_POLL_S:
+    def _poll_dtr(self, now: float, *, force: bool = False) -> None:
+        if not force and now - self._dtr_polled < _DTR_POLL_S:
             return
         self._dtr_polled = now
         self._poll_peer(now)
@@ -589,7 +688,9 @@ class DeviceServer:
             self._tell(LineEvent("baud_ok", f"the client's line is at {baud} baud"))
 
     def _on_host_bytes(self, data: bytes) -> None:
-        self._poll_peer(time.monotonic())  # so "a client opened" comes before its requests
+        # A modem line set before these bytes were written (setDTR, then a
+        # request) is seen first, as on a wire; so is "a client opened".
+        self._poll_dtr(time.monotonic(), force=True)
         self._n["host_bytes"] += len(data)
         self._n["host_reads"] += 1
         receive = getattr(self.device, "receive", None)
@@ -626,19 +727,64 @@ class DeviceServer:
         with self._lock:
             due = self.mode == "lockstep" or self._next_due is None or now >= self._next_due
             item = self._inbox.popleft() if self._inbox and due else None
+            request, self._idle_request = self._idle_request, None
+            idling = self._idling
+        if request is not None:  # the revolution to stream while nothing new comes
+            self._last_samples, self._last_period = request
+            if idling:
+                self._idle_due = now
         if item is not None:
-            self._begin(*item, now)
-        elif (
-            self.mode == "realtime"
-            and due
-            and self._last_samples is not None
-            and not self._marker_sent
-            and self._next_due is not None
-        ):
+            samples, tick, period, push_id = item
+            self._begin(samples, tick, period, now, push_id=push_id)
+        elif self.mode == "realtime":
+            if due:
+                self._realtime_gap(now)
+        elif idling and now >= self._idle_due:
+            self._idle_due = now + self._last_period
+            self._repeat(now)
+
+    def _realtime_gap(self, now: float) -> None:
+        """Realtime, a slot with nothing new: close the last revolution (its start
+        marker); continuous, if still nothing after half a period, send it again."""
+        if self._last_samples is None:
+            return
+        if self._next_due is None:  # a fresh scan: no revolution of it to close yet
+            if self.continuous:
+                self._repeat(now)
+            return
+        if not self._marker_sent:
             self._n["underruns"] += 1
             self._append_marker(self._last_samples, self._last_tick + 1, now)
+            self._marker_at = now
+        elif self.continuous and now >= self._repeat_due():
+            self._repeat(now)
 
-    def _begin(self, samples: Sequence[Any], tick: int, period: float, now: float) -> None:
+    def _repeat_due(self) -> float:
+        """Continuous realtime: when the last revolution goes out again, nothing new having
+        come (half a period after the marker that closed it; at once after a fresh SCAN)."""
+        if self._next_due is None:
+            return 0.0
+        if not self._marker_sent:
+            return self._next_due
+        return self._marker_at + self._last_period / 2
+
+    def _repeat(self, now: float) -> None:
+        """Send the last revolution again (the device keeps scanning the same world)."""
+        if self._last_samples is None or not self._streaming():
+            return
+        self._n["revolutions_repeated"] += 1
+        self._begin(self._last_samples, self._last_tick, self._last_period, now, repeat=True)
+
+    def _begin(
+        self,
+        samples: Sequence[Any],
+        tick: int,
+        period: float,
+        now: float,
+        *,
+        push_id: int | None = None,
+        repeat: bool = False,
+    ) -> None:
         ms = self._stamp_ms(tick, now)
         skip = self._marker_size if self._marker_sent and self.next_start == "replace" else 0
         if self._ld_style:
@@ -661,8 +807,8 @@ class DeviceServer:
         self._stream += data
         self._rev_left = len(data)
         self._rev_lost = 0
-        self._current = (tick, None)
-        self._last_samples, self._last_tick = samples, tick
+        self._current = (tick, None, push_id, repeat)
+        self._last_samples, self._last_tick, self._last_period = samples, tick, period
         self._n["revolutions_sent"] += 1
         if self.mode == "realtime":
             nominal = self._next_due if self._next_due is not None else now
@@ -722,6 +868,7 @@ class DeviceServer:
             while budget > 0 and (self._reply or self._stream):
                 buf = self._reply or self._stream
                 chunk = bytes(buf[: self._chunk])
+                self._write_ns = time.time_ns()
                 n = self.port.write(chunk, 0.0)
                 self._consumed(buf, n, n, time.monotonic())
                 budget -= len(chunk)
@@ -734,6 +881,7 @@ class DeviceServer:
             n = self.pacer.allowance(len(buf), now)
             if n == 0:
                 return
+            self._write_ns = time.time_ns()
             written = self.port.write(bytes(buf[:n]), 0.0)
             with self._lock:
                 if buf is self._stream and self._current is not None and self._current[1] is None:
@@ -753,16 +901,18 @@ class DeviceServer:
         self._n["bytes_written"] += written
         if buf is not self._stream or self._current is None:
             return
-        tick, started = self._current
+        tick, started, push_id, repeat = self._current
         if started is None:
             started = now
-            self._current = (tick, now)
+            self._current = (tick, now, push_id, repeat)
         self._rev_left -= n
         self._rev_lost += n - written
         if self._rev_left <= 0:
             if not self._rev_lost:
                 self._n["revolutions_whole"] += 1
             with self._lock:
-                self._deliveries.append(Delivery(tick, started, now))
+                self._deliveries.append(
+                    Delivery(tick, started, now, push_id, self._write_ns, repeat)
+                )
             self._current = None
             self._rev_left = 0

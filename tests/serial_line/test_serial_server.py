@@ -452,3 +452,94 @@ def test_realtime_server_thread_asks_for_sched_fifo(pty: PtyPort) -> None:
     with DeviceServer(StandIn(), pty, mode="lockstep") as server:
         pass
     assert server.realtime_priority is None  # lockstep has no line timing to protect
+
+
+# -- a device that never falls silent (continuous) ------------------------------
+
+
+def test_continuous_lockstep_streams_between_scenarios_until_the_next_push(
+    pty: PtyPort, board: Board
+) -> None:
+    """Before the first push and between scenarios the held revolution streams every
+    period; a push ends that, and in lockstep the line is quiet again until the next."""
+    period = 0.05
+    room, r1 = revolution(20, 0), revolution(20, 90)
+    with DeviceServer(
+        StandIn(), pty, next_start="replace", continuous=True, revolution_period_s=period
+    ) as server:
+        server.stream_idle(room)
+        start_scanning(server, board)
+        once = stand_in_bytes(room) + marker(room)
+        again = stand_in_bytes(room)[3:] + marker(room)  # its start is the marker already sent
+        assert board.read(len(once) + 2 * len(again)) == once + again + again
+        last = server.end_idle(1.0)
+        assert last is not None and last.repeat and last.push_id is None
+        board.read(1 << 16, 0.2)  # a repeat that was under way when the stream ended
+        assert board.quiet(3 * period)  # stopped: nothing until the harness pushes
+        push = server.send_revolution(r1, 0)
+        pushed = stand_in_bytes(r1)[3:] + marker(r1)
+        assert board.read(len(pushed)) == pushed
+        assert board.quiet(3 * period)  # lockstep again
+        delivery = server.delivery_of(push)
+        assert delivery is not None and delivery.tick == 0 and not delivery.repeat
+        assert delivery.written_ns >= last.written_ns
+        server.stream_idle()  # the scenario is over: r1 again, every period
+        assert board.read(2 * len(pushed)) == pushed + pushed
+        assert server.stats().revolutions_repeated >= 4
+
+
+def test_continuous_realtime_repeats_the_last_revolution_when_nothing_comes(
+    pty: PtyPort, board: Board
+) -> None:
+    """A real device never falls silent: the slot after the last revolution closes it
+    (the start marker) and, nothing new having come, it goes out again."""
+    period = 0.1
+    r0, r1 = revolution(20, 10), revolution(20, 50)
+    dev = StandIn()
+    dev.mode = "scan"
+    with DeviceServer(
+        dev,
+        pty,
+        mode="realtime",
+        revolution_period_s=period,
+        next_start="replace",
+        continuous=True,
+    ) as server:
+        push = server.send_revolution(r0, 0)
+        assert server.delivery_of(push) is None or server.delivery_of(push).tick == 0
+        again = stand_in_bytes(r0)[3:] + marker(r0)
+        want = stand_in_bytes(r0) + marker(r0) + again + again
+        assert board.read(len(want), timeout=5.0) == want  # never silent
+        delivery = server.delivery_of(push)
+        assert delivery is not None and delivery.written_ns > 0
+        server.send_revolution(r1, 1)
+        got = board.read(4 * len(again), timeout=2.0)
+        assert stand_in_bytes(r1)[3:] in got  # the next revolution replaces the repeats
+        stats = server.stats()
+    assert stats.revolutions_repeated >= 2
+
+
+def test_continuous_streams_again_after_the_driver_restarts_the_scan(
+    pty: PtyPort, board: Board
+) -> None:
+    """STOP, then SCAN again (a driver that reopens the device): the device streams the
+    last revolution at once, without the harness pushing anything."""
+    r0 = revolution(20, 10)
+    with DeviceServer(
+        StandIn(),
+        pty,
+        mode="realtime",
+        revolution_period_s=0.1,
+        next_start="replace",
+        continuous=True,
+    ) as server:
+        start_scanning(server, board)
+        server.send_revolution(r0, 0)
+        assert len(board.read(len(stand_in_bytes(r0)), timeout=2.0)) == len(stand_in_bytes(r0))
+        board.send(b"X")
+        assert server.wait_until(lambda d: d.mode == "idle", 2.0)
+        board.read(1 << 16, 0.3)  # whatever was on its way
+        assert board.quiet(0.3)  # stopped: a real device sends nothing
+        board.send(b"S")
+        assert board.read(2) == b"ok"
+        assert len(board.read(len(stand_in_bytes(r0)), timeout=2.0)) == len(stand_in_bytes(r0))
