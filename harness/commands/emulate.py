@@ -2,7 +2,9 @@
 
 Exit 0 when it ends (the scenario's end, Ctrl-C or SIGTERM) and a client
 read from the device; 1 when the scenario ran out and nothing ever read,
-so a script notices. The summary says which either way.
+so a script notices. The summary says which either way. On a pty, the
+second line gives the environment a pyserial client needs for its DTR/RTS
+calls to work there (docs/hil.md, "Modem lines on a pty").
 """
 
 from __future__ import annotations
@@ -25,7 +27,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--port",
         metavar="DEV",
-        help="serial port to serve on (default: a new pty; its path is printed)",
+        help="serial port to serve on (default: a new pty; its path is printed first, then "
+        "a 'modem lines: export ...' line: run a pyserial client in a shell with it, and "
+        "its DTR/RTS calls succeed and reach the emulator, the motor following DTR)",
     )
     parser.add_argument("--seed", type=seed, help="override the scenario's seed")
     parser.add_argument("--faults", metavar="NAME[,NAME]", help="fault profiles to apply")

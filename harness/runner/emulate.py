@@ -3,7 +3,9 @@
 For users testing their own drivers: the harness is the device, in real
 time, and nothing else runs. With no port named, a pty pair stands in for
 the cable and its path is printed first, so a script can read it and point
-its driver there. No ROS is needed.
+its driver there; the next line is the environment (``modem lines: export
+...``) under which a pyserial client's DTR/RTS calls on that pty succeed
+and reach the emulator, as over a wired adapter. No ROS is needed.
 
 It explains itself: with ``verbose`` every request, answer and protocol
 error is logged as it happens; otherwise a one-line status every few
@@ -30,6 +32,8 @@ from harness.scenario.schema import Scenario
 
 IDLE_WAIT_S = 5.0  # after the last revolution: let the line drain
 STATUS_EVERY_S = 5.0  # without verbose: one status line this often
+# The line after "port: ..." on a pty: what a client's shell needs for DTR/RTS.
+MODEM_LINES_PREFIX = "modem lines: "
 
 
 @dataclass(frozen=True)
@@ -142,6 +146,18 @@ class _Log:
             self.line(f"{event.text()} [first of its kind; -v logs every one]")
 
 
+def _rts_reporter(log: _Log) -> Callable[[str, bool], None]:
+    """The client's RTS changes as line events (its DTR is the server's: the motor)."""
+    from harness.serial_line.server import LineEvent
+
+    def told(line: str, asserted: bool) -> None:
+        if line == "rts":
+            state = "asserted" if asserted else "deasserted"
+            log.event(LineEvent("rts", f"the client's RTS {state}"))
+
+    return told
+
+
 # The device's mode as the status line says it.
 _STATES = {
     "idle": "idle",
@@ -221,6 +237,9 @@ def emulate(
     periods = scan_periods(drift, spec.rate_hz, seed) if drift is not None else None
     try:
         announce(f"port: {name}")  # from here on, a stop is a normal end
+        if isinstance(line, PtyPort):
+            announce(f"{MODEM_LINES_PREFIX}{line.client_exports()}")
+            line.on_modem_change = _rts_reporter(log)
         # The simulation first: building it silences stdout (fd 1) for a moment,
         # which would swallow what the server thread logs meanwhile.
         with Simulation(scenario) as sim, server:

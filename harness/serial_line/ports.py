@@ -16,10 +16,12 @@ import termios
 import time
 import tty
 from abc import ABC, abstractmethod
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Literal
 
 from harness.errors import ConfigError, LinkError, one_line
+from harness.serial_line.modem_lines import ModemLines, client_environment, shell_exports
 from harness.serial_line.port_lock import DEFAULT_WAIT_S, PortLock, hold_port
 
 _NO_PEER_STEP_S = 0.01  # how often a pty without a reader is re-checked
@@ -89,8 +91,17 @@ class PtyPort(DevicePort):
     while the master lives. Nobody having the slave open shows as POLLHUP on
     the master (reads give EIO): that is "no reader yet", not an error, and
     bytes written then would only greet the next opener as stale input, so
-    ``write`` accepts nothing while there is no reader. A pty has no modem
-    lines: ``dtr_asserted`` is None. Ptys ignore the baud rate entirely.
+    ``write`` accepts nothing while there is no reader. Ptys ignore the baud
+    rate entirely.
+
+    A pty has no modem lines; a client's pyserial run with
+    ``client_environment()`` (the modem shim, see ``modem_lines``) sends its
+    DTR and RTS changes to this port's ``modem`` instead. ``dtr_asserted``
+    is the DTR it last set: None until a client set it (a client without
+    the shim, e.g. a C++ driver: the emulated motor simply runs), and
+    deasserted once that client closed the port, as a tty drops DTR on
+    close. ``on_modem_change(line, asserted)``, if set, is told each change
+    ("dtr" or "rts") on the thread that asks for ``dtr_asserted``.
     """
 
     def __init__(self, *, symlink: str | None = None) -> None:
@@ -101,6 +112,15 @@ class PtyPort(DevicePort):
         finally:
             os.close(slave)
         fcntl.fcntl(master, fcntl.F_SETFL, fcntl.fcntl(master, fcntl.F_GETFL) | os.O_NONBLOCK)
+        try:
+            self.modem: ModemLines | None = ModemLines()
+        except OSError as err:
+            os.close(master)
+            raise ConfigError(
+                f"{self.slave_path}: cannot make the socket its modem lines arrive on: "
+                f"{_one_line(err)}"
+            ) from None
+        self.on_modem_change: Callable[[str, bool], None] | None = None
         self._fd: int | None = master
         self.symlink = symlink
         if symlink is not None:
@@ -187,8 +207,40 @@ class PtyPort(DevicePort):
             select.select([], [fd], [], left)
         return done
 
-    def dtr_asserted(self) -> None:
-        return None
+    def dtr_asserted(self) -> bool | None:
+        """The DTR the client last set through the modem shim; None until one did."""
+        self._poll_modem()
+        return self.modem.dtr if self.modem is not None else None
+
+    def rts_asserted(self) -> bool | None:
+        """The RTS the client last set through the modem shim; None until one did."""
+        self._poll_modem()
+        return self.modem.rts if self.modem is not None else None
+
+    def _poll_modem(self) -> None:
+        modem = self.modem
+        if modem is None:
+            return
+        changes = modem.poll()
+        if (modem.dtr is not None or modem.rts is not None) and not self.peer_present():
+            changes += modem.hang_up()
+        if self.on_modem_change is not None:
+            for line, asserted in changes:
+                self.on_modem_change(line, asserted)
+
+    def client_environment(self, environ: Mapping[str, str] | None = None) -> dict[str, str]:
+        """The variables a pyserial client needs for its DTR/RTS calls on ``slave_path``
+        to succeed and reach this port (merge them into its environment)."""
+        return client_environment(self.slave_path, self._channel(), environ)
+
+    def client_exports(self) -> str:
+        """``client_environment`` as a line for a user to paste into a POSIX shell."""
+        return shell_exports(self.slave_path, self._channel())
+
+    def _channel(self) -> str | None:
+        if self._fd is None or self.modem is None:
+            raise LinkError(f"{self.name}: pty is closed")
+        return self.modem.path
 
     def host_baud(self) -> int | None:
         """The rate the board's driver set on the slave (Linux shares a pty's termios).
@@ -207,6 +259,9 @@ class PtyPort(DevicePort):
         fd, self._fd = self._fd, None
         if fd is not None:
             os.close(fd)
+        modem, self.modem = self.modem, None
+        if modem is not None:
+            modem.close()
         if self.symlink is not None and os.path.islink(self.symlink):
             try:
                 if os.readlink(self.symlink) == self.slave_path:

@@ -1,7 +1,10 @@
-"""`fossbot-hil emulate` as a user runs it: its own process, its output read line by line."""
+"""`fossbot-hil emulate` as a user runs it: its own process, its output read line by line;
+and a LIDAR client run as a user runs one beside it, in a shell given the line it printed."""
 
 from __future__ import annotations
 
+import json
+import os
 import queue
 import re
 import signal
@@ -10,10 +13,15 @@ import sys
 import threading
 import time
 from pathlib import Path
+from typing import Any
+
+CLIENT = Path(__file__).with_name("lidar_client.py")
+CLIENT_TIMEOUT_S = 30.0
 
 
 class Emulator:
-    """`fossbot-hil emulate ...` on a new pty; `port` is the path it printed first."""
+    """`fossbot-hil emulate ...` on a new pty; `port` is the path it printed first, and
+    `modem_exports` (on a pty) the shell line of "modem lines: " it printed next."""
 
     def __init__(self, *args: str, cwd: Path | None = None) -> None:
         self.process = subprocess.Popen(
@@ -28,6 +36,43 @@ class Emulator:
         threading.Thread(target=self._read, daemon=True).start()
         first = self.wait_for(r"^port: ", 30)
         self.port = first.removeprefix("port: ").strip()
+        self.modem_exports = ""
+        if "--port" not in args:
+            second = self.wait_for(r"", 10)
+            assert second.startswith("modem lines: export "), "\n" + self.text()
+            self.modem_exports = second.removeprefix("modem lines: ")
+
+    def client_command(self, *args: str) -> list[str]:
+        """``lidar_client.py PORT-less args`` in a POSIX shell that first ran the
+        printed "modem lines" line: how a user runs a client in a second shell."""
+        assert self.modem_exports, "no modem lines: emulate was given --port"
+        script = f'{self.modem_exports}; exec "$@"'
+        return ["sh", "-c", script, "sh", sys.executable, str(CLIENT), *args]
+
+    def start_client(self, *args: str, env: dict[str, str] | None = None) -> subprocess.Popen:
+        """`lidar_client.py LIBRARY <port> args...` started beside the emulator."""
+        library, *rest = args
+        return subprocess.Popen(
+            self.client_command(library, self.port, *rest),
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
+            env={**os.environ, **(env or {})},
+        )
+
+    def run_client(
+        self, *args: str, env: dict[str, str] | None = None, timeout: float = CLIENT_TIMEOUT_S
+    ) -> dict[str, Any]:
+        """`start_client`, waited for (at most `timeout` s): the JSON it printed."""
+        client = self.start_client(*args, env=env)
+        try:
+            out, err = client.communicate(timeout=timeout)
+        except subprocess.TimeoutExpired:
+            client.kill()
+            out, err = client.communicate(timeout=10)
+            raise AssertionError(f"client still running after {timeout} s:\n{err}") from None
+        assert client.returncode == 0, f"client exit {client.returncode}:\n{err}\n" + self.text()
+        return json.loads(out)
 
     def _read(self) -> None:
         assert self.process.stdout is not None
@@ -69,6 +114,12 @@ class Emulator:
         return found[-1].removeprefix(f"  {name}: ")
 
     def close(self) -> None:
+        """End it if still running: SIGTERM (a normal end: it removes its pty's
+        modem-line socket), then SIGKILL after 10 s."""
         if self.process.poll() is None:
-            self.process.kill()
-            self.process.wait(timeout=10)
+            self.process.terminate()
+            try:
+                self.process.wait(timeout=10)
+            except subprocess.TimeoutExpired:
+                self.process.kill()
+                self.process.wait(timeout=10)

@@ -1,35 +1,16 @@
-"""Helpers for driving third-party LIDAR clients and board processes over ptys."""
+"""Helpers for driving board processes over ptys.
+
+A LIDAR client's DTR/RTS calls on a pty need no help here: run it with the
+port's client environment (``PtyPort.client_environment``, or the "modem
+lines" line ``fossbot-hil emulate`` prints), as docs/hil.md says.
+"""
 
 from __future__ import annotations
 
-import errno
 import os
 import select
 import threading
 import tty
-
-import serial.serialposix
-
-
-def tolerate_missing_dtr_on_pty() -> None:
-    """Let pyserial clients run on a pty: a pty has no DTR line (ENOTTY), a USB-UART does.
-
-    The RPLIDAR clients toggle DTR to drive the A1's motor. Only that one
-    error is ignored; everything else the client does is unchanged.
-    """
-    original = serial.serialposix.Serial._update_dtr_state
-    if getattr(original, "tolerant", False):
-        return
-
-    def update(self: serial.serialposix.Serial) -> None:
-        try:
-            original(self)
-        except OSError as err:
-            if err.errno != errno.ENOTTY:
-                raise
-
-    update.tolerant = True  # type: ignore[attr-defined]
-    serial.serialposix.Serial._update_dtr_state = update
 
 
 class NullModem:

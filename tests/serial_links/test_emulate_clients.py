@@ -1,20 +1,22 @@
 """`fossbot-hil emulate` read by independent RPLIDAR clients over a real pty.
 
-The `rplidar` package (what FOSSBot code uses) and Adafruit's client must get
-device info, health and scans whose angles and distances match the
-simulated beams within the A1's quantisation (1/64 degree, 1/4 mm): in
-standard mode each sample is reported at the angle its beam was cast.
+The `rplidar` package, Adafruit's client and rplidar-roboticia (what the
+FOSSBot v2 runs) must get device info, health and scans whose angles and
+distances match the simulated beams within the A1's quantisation (1/64
+degree, 1/4 mm): in standard mode each sample is reported at the angle its
+beam was cast. Each client runs unmodified in its own process, in a shell
+given the "modem lines" line emulate printed, so its DTR calls work on the
+pty and reach the emulator.
 """
 
 from __future__ import annotations
 
-import subprocess
-import sys
 from collections.abc import Iterator
 
 import numpy as np
 import pytest
-from pty_clients import tolerate_missing_dtr_on_pty
+from emulator_process import Emulator
+from third_party import roboticia_site
 
 from harness.devices.revolution import device_angle_deg, encode_distances_mm
 from harness.runner.settings import RunSettings, fault_profile
@@ -55,61 +57,47 @@ def matches(client_scan: list[tuple[float, float]], beams: np.ndarray) -> bool:
 
 
 @pytest.fixture
-def emulator() -> Iterator[str]:
-    """`fossbot-hil emulate rplidar` on a new pty; yields the port path it printed first."""
-    process = subprocess.Popen(
-        [sys.executable, "-m", "harness.cli", "emulate", "rplidar", "--scenario", SCENARIO],
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-    )
+def emulator() -> Iterator[Emulator]:
+    """`fossbot-hil emulate rplidar -v` on a new pty, as a user starts it."""
+    process = Emulator("rplidar", "--scenario", SCENARIO, "-v")
     try:
-        first = process.stdout.readline()  # bounded by pytest-timeout; printed at once
-        assert first.startswith("port: /dev/pts/"), first + process.stderr.read()
-        yield first.removeprefix("port: ").strip()
+        yield process
     finally:
-        process.terminate()
-        process.wait(timeout=10)
+        process.close()
 
 
-def first_scans(lidar, count: int = 5) -> list[list[tuple[float, float]]]:
-    """The first `count` scans a client yields, as (angle, distance) pairs; then stop."""
-    scans = []
-    for scan in lidar.iter_scans():
-        scans.append([(a, d) for _, a, d in scan])
-        if len(scans) == count:
-            break
-    lidar.stop()
-    return scans
+def as_pairs(scans: list[list[list[float]]]) -> list[list[tuple[float, float]]]:
+    return [[(angle, distance) for angle, distance in scan] for scan in scans]
 
 
-def read_with_rplidar_package(port: str) -> tuple[dict, tuple, list[list[tuple[float, float]]]]:
-    from rplidar import RPLidar
-
-    lidar = RPLidar(port, timeout=3)
-    try:
-        return lidar.get_info(), lidar.get_health(), first_scans(lidar)
-    finally:
-        lidar.disconnect()
-
-
-def read_with_adafruit(port: str) -> tuple[dict, tuple, list[list[tuple[float, float]]]]:
-    from adafruit_rplidar import RPLidar
-
-    lidar = RPLidar(None, port, timeout=3)
-    try:
-        return lidar.info, lidar.health, first_scans(lidar)
-    finally:
-        lidar.disconnect()
-
-
-@pytest.mark.parametrize("reader", [read_with_rplidar_package, read_with_adafruit])
-def test_client_reads_info_health_and_the_simulated_scans(emulator: str, reader) -> None:
+@pytest.mark.parametrize("library", ["rplidar", "adafruit"])
+def test_client_reads_info_health_and_the_simulated_scans(emulator: Emulator, library) -> None:
     """Info and health as an A1M8 answers them; every full scan is a simulated one."""
-    tolerate_missing_dtr_on_pty()
-    info, health, scans = reader(emulator)
-    assert info["model"] == 0x18 and info["firmware"] == (1, 29) and info["hardware"] == 7
+    read = emulator.run_client(library, "--ask", "info,health", "--scans", "5")
+    info, health, scans = read["info"], read["health"], as_pairs(read["scans"])
+    assert info["model"] == 0x18 and tuple(info["firmware"]) == (1, 29) and info["hardware"] == 7
     assert health[0] == "Good"
     expected = simulated_revolutions()
     full = scans[1:]  # clients also yield the part-turn before the first start flag
     assert full and all(any(matches(s, e) for e in expected) for s in full), full[0][:5]
+
+
+@pytest.mark.slow  # the agent's own waits (4.7 s with the library's), the emulator's start
+def test_the_fossbot_v2_agents_client_gets_scans_and_drives_the_motor(emulator) -> None:
+    """rplidar-roboticia 0.9.5 (the real robot's) makes the agent's calls, unmodified:
+    the emulator follows its DTR (motor off from its open, on when it scans) and the
+    client gets simulated scans."""
+    site = str(roboticia_site())  # first on the path: its rplidar, not the venv's 0.9.2
+    read = emulator.run_client(
+        "rplidar", "--scans", "3", "--fossbot-agent", env={"PYTHONPATH": site}
+    )
+    assert read["info"]["model"] == 0x18
+    expected = simulated_revolutions()
+    full = as_pairs(read["scans"])[1:]
+    assert full and all(any(matches(s, e) for e in expected) for s in full), full[0][:5]
+    emulator.wait_for(r"the client closed", 10)
+    log = emulator.text()
+    off = log.index("board's DTR asserted: motor off")
+    reset = log.index("request RESET")
+    on = log.index("board's DTR deasserted: motor on", reset)
+    assert off < reset < on < log.index("request SCAN"), log

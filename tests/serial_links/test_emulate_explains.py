@@ -10,14 +10,12 @@ says so instead of reading like success.
 from __future__ import annotations
 
 import signal
-import threading
 from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
 import serial
 from emulator_process import Emulator
-from pty_clients import tolerate_missing_dtr_on_pty
 
 from harness.devices import ldlidar as ld
 from harness.devices import rplidar as rp
@@ -52,21 +50,11 @@ def start(emulators: list[Emulator], *args: str, cwd: Path | None = None) -> Emu
 
 def test_sigint_mid_stream_ends_with_the_counts_the_client_saw(emulators) -> None:
     """The rplidar package reads 3 scans; -v names each request; SIGINT: exit 0, counts match."""
-    from rplidar import RPLidar
-
-    tolerate_missing_dtr_on_pty()
     emulator = start(emulators, "rplidar", "--scenario", "approach_wall", "-v")
-    lidar = RPLidar(emulator.port, timeout=3)
-    try:
-        assert lidar.get_info()["model"] == 0x18
-        scans = 0
-        for _scan in lidar.iter_scans():
-            scans += 1
-            if scans == 3:
-                break
-        lidar.stop()  # STOP while the 4th revolution streams: it is cut short
-    finally:
-        lidar.disconnect()
+    # info, 3 scans, then STOP while the 4th revolution streams: it is cut short
+    read = emulator.run_client("rplidar", "--ask", "info", "--scans", "3")
+    assert read["info"]["model"] == 0x18
+    scans = len(read["scans"])
     emulator.wait_for(r"request STOP  A5 25 .*scan stopped", 10)
     assert emulator.finish(signal.SIGINT) == 0, emulator.text()
     log = emulator.text()
@@ -93,18 +81,9 @@ def test_sigint_mid_stream_ends_with_the_counts_the_client_saw(emulators) -> Non
 
 def test_adafruit_client_requests_are_logged_and_sigterm_is_a_normal_end(emulators) -> None:
     """Adafruit's client: its requests show in -v; SIGTERM gives exit 0 and the summary."""
-    from adafruit_rplidar import RPLidar
-
-    tolerate_missing_dtr_on_pty()
     emulator = start(emulators, "rplidar", "--scenario", "approach_wall", "-v")
-    lidar = RPLidar(None, emulator.port, timeout=3)
-    try:
-        assert lidar.health[0] == "Good"
-        for _n, _scan in zip(range(2), lidar.iter_scans(), strict=False):
-            pass
-        lidar.stop()
-    finally:
-        lidar.disconnect()
+    read = emulator.run_client("adafruit", "--ask", "health", "--scans", "2")
+    assert read["health"][0] == "Good"
     emulator.wait_for(r"request STOP", 10)
     assert emulator.finish(signal.SIGTERM) == 0, emulator.text()
     log = emulator.text()
@@ -163,27 +142,13 @@ def test_sigint_without_a_client_is_a_normal_end_that_says_no_client(emulators) 
 
 def test_without_v_a_status_line_says_client_state_and_what_was_served(emulators) -> None:
     """No -v: no request lines, but a status line (connected, scanning, counts) every 5 s."""
-    from rplidar import RPLidar
-
-    tolerate_missing_dtr_on_pty()
     emulator = start(emulators, "rplidar", "--scenario", "approach_wall")
-    lidar = RPLidar(emulator.port, timeout=3)
-    done = threading.Event()
-
-    def read() -> None:  # keep reading, as a driver does, until the status line came
-        for _scan in lidar.iter_scans():
-            if done.is_set():
-                return
-
-    reader = threading.Thread(target=read, daemon=True)
+    client = emulator.start_client("rplidar", "--scans", "0")  # reads on, as a driver does
     try:
-        reader.start()
         line = emulator.wait_for(r"\| scanning \(standard\) \|", 20)
     finally:
-        done.set()
-        reader.join(10)
-        lidar.stop()
-        lidar.disconnect()
+        client.kill()
+        client.communicate(timeout=10)
     assert "client: connected at 115200 baud | scanning (standard) | " in line, line
     served = line.split(" | ")[2]
     assert int(served.split(" revolutions")[0]) > 0 and " 0 bytes" not in served, line
