@@ -36,6 +36,7 @@ T = TypeVar("T")
 NAME = "run"
 HELP = "run scenarios and judge the node's answers"
 FAIL_ON = ("failure", "regression")
+ALIGNMENT = ("warn", "fail")  # what a misaligned board's /scan does: reported, or exit 1
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -78,6 +79,16 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         default="failure",
         help="exit 1 on any failed expectation (failure, the default), or only on a failure "
         "the --baseline does not know (regression: known failures are tolerated)",
+    )
+    parser.add_argument(
+        "--alignment",
+        choices=ALIGNMENT,
+        default="warn",
+        help="on a serial link (rplidar, ldlidar), check whether the board's /scan is the "
+        "simulated scan turned or mirrored (its driver's invert / angle_offset_deg, or the "
+        "LIDAR's mount) and report it with the likely fix: warn (the default) only reports; "
+        "fail also exits 1 when it is. Accepted on links without a board scan (ros2, "
+        "inprocess), which report nothing",
     )
     add_node_options(parser)
     add_device_options(parser)
@@ -161,7 +172,9 @@ def _run(args: argparse.Namespace, console: Console, baseline: Baseline | None) 
     # then the checks and the rest of the imports.
     link_class(args.link).prepare(unchecked_link_options(args))
     options = check_link_options(args)  # all before the report folder exists
+    from harness.judge.alignment import run_alignment
     from harness.report.progress import RunProgress
+    from harness.report.summary import alignment_fails
     from harness.report.terminal import print_results
     from harness.report.wall_clock import command_seconds
 
@@ -203,14 +216,23 @@ def _run(args: argparse.Namespace, console: Console, baseline: Baseline | None) 
         except Interrupted as stop:  # Ctrl-C or SIGTERM: report what was judged, then stop
             interrupted, results = stop, stop.results
     wall_s = command_seconds()
-    print_results(console, results, wall_s=wall_s)
+    alignment = run_alignment(results)
+    mode = args.alignment
+    print_results(console, results, wall_s=wall_s, alignment=alignment, alignment_mode=mode)
     comparison = compared(results, baseline) if baseline is not None else None
     if comparison is not None:
         from harness.report.terminal import print_comparison
 
         print_comparison(console, comparison)
     if report is not None:
-        index = _write(f"--out {args.out}", report.finish, wall_s, baseline=baseline)
+        index = _write(
+            f"--out {args.out}",
+            report.finish,
+            wall_s,
+            baseline=baseline,
+            alignment=alignment,
+            alignment_mode=mode,
+        )
         console.print(f"report: {index}", highlight=False, markup=False, soft_wrap=True)
     if args.junit_xml:
         from harness.report.junit import write_junit
@@ -227,6 +249,8 @@ def _run(args: argparse.Namespace, console: Console, baseline: Baseline | None) 
         judged = sum(1 for r in results if not r.not_run)
         summary = f"{judged} of {len(scenarios)} scenarios judged, the last one in part"
         raise Interrupted(interrupted.signum, results, summary)
+    if alignment_fails(alignment, mode):
+        return 1  # the reason is the terminal's alignment line
     if args.fail_on == "regression" and comparison is not None:
         return 0 if comparison.ok else 1  # known failures tolerated
     return 0 if all(r.ok for r in results) else 1

@@ -4,7 +4,9 @@
 - ``status``: reading the free-text status a student node publishes;
 - ``oracle``: per-tick expectations from the scan the node was sent, and
   the verdict with its explanation;
-- ``records``: what one run produced, tick by tick (``RunResult``).
+- ``records``: what one run produced, tick by tick (``RunResult``);
+- ``alignment``: whether the board's /scan is the truth turned or mirrored,
+  fitted over a run (``run_alignment``), and the likely fix.
 
 Pure: numpy only, no rclpy, no pybullet. Add a check to the ``Oracle``; teach
 ``status`` a new way students write their status.
@@ -21,6 +23,9 @@ _EXPORTS = {
     "Verdict": "oracle",
     "RunResult": "records",
     "TickRecord": "records",
+    "Alignment": "alignment",
+    "fit_alignment": "alignment",
+    "run_alignment": "alignment",
 }
 __all__ = sorted(_EXPORTS)
 __getattr__ = lazy_exports(__name__, _EXPORTS)

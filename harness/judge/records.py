@@ -8,6 +8,7 @@ from harness.faults.link import ON_TIME, Delivery
 from harness.judge.answers import Answers
 from harness.judge.oracle import Verdict
 from harness.judge.run_hints import threshold_hint
+from harness.lidar.mount import LidarMount
 from harness.lidar.scan import Scan
 
 
@@ -45,6 +46,10 @@ class RunResult:
     stop_s: float = 0.0  # waiting for it to stop, after the run (in series)
     not_started: bool = False  # the software under test never came up
     not_run: bool = False  # skipped because it did not come up in an earlier scenario
+    lidar_mount: LidarMount | None = None  # the mount the device was emulated with (serial links)
+    # On a run-long device session: seconds between the previous scenario's last
+    # revolution and this scenario's first judged one (the device kept streaming).
+    gap_s: float | None = None
 
     @property
     def total_s(self) -> float:

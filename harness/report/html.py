@@ -35,6 +35,8 @@ td.n { text-align: right; font-variant-numeric: tabular-nums; }
 .fixed { color: #1a7f37; font-weight: bold; }
 .still_failing, .new, .not_compared, .missing, p.note { color: #9a6700; }
 p.failure { color: #c62828; font-family: monospace; white-space: pre-wrap; }
+p.misaligned { color: #9a6700; font-weight: bold; }
+p.misaligned.fails { color: #c62828; }
 pre { background: #f6f6f6; padding: 0.5em; overflow-x: auto; }
 img { max-width: 100%; border: 1px solid #ddd; }
 """
@@ -108,6 +110,19 @@ def _image(path: str, alt: str) -> str:
     return f'<p><a href="{href}"><img src="{href}" alt="{_text(alt)}" loading="lazy"></a></p>'
 
 
+def _alignment(alignment: Mapping[str, Any]) -> list[str]:
+    """The board's /scan against the truth (serial links): turned, mirrored, or as shown."""
+    kind = _text(alignment["status"])
+    fails = " fails" if alignment["fails_run"] else ""
+    lead = ""
+    if alignment["status"] == "misaligned":
+        lead = "FAILED (--alignment fail): " if fails else "WARNING: "
+    return [
+        "<h2>Alignment of the board's /scan</h2>",
+        f'<p class="{kind}{fails}">{_text(lead + alignment["text"])}</p>',
+    ]
+
+
 def _baseline(comparison: Mapping[str, Any]) -> list[str]:
     """The comparison with `--baseline`: notes, every change but "still passing", counts."""
     out = [
@@ -135,7 +150,8 @@ def _baseline(comparison: Mapping[str, Any]) -> list[str]:
 
 def index_html(summary: Mapping[str, Any], *, diagnostics: Sequence[str] = ()) -> bytes:
     """The page for a run summary (see harness.report.summary.run_summary), with the
-    comparison harness.report.baseline.with_comparison added, when there is one."""
+    comparison harness.report.baseline.with_comparison added, when there is one, and
+    the alignment of the board's /scan, when it has one."""
     entries = summary["scenarios"]
     headline = passed_line(summary["passed"], summary["total"])
     head = ["scenario", "link", "ticks", "failed", "verdict", "time s", "seed", "threshold"]
@@ -157,6 +173,8 @@ def index_html(summary: Mapping[str, Any], *, diagnostics: Sequence[str] = ()) -
         *(_row(i, e) for i, e in enumerate(entries)),
         "</table>",
     ]
+    if summary.get("alignment"):
+        lines.extend(_alignment(summary["alignment"]))
     if "baseline" in summary:
         lines.extend(_baseline(summary["baseline"]))
     for i, e in enumerate(entries):

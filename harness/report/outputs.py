@@ -35,6 +35,7 @@ from harness.report.summary import json_bytes, run_summary, scenario_details, sc
 from harness.safe_text import DIAGNOSTICS_LIMIT, for_storage
 
 if TYPE_CHECKING:  # pydantic only when a scenario is at hand
+    from harness.judge.alignment import Alignment
     from harness.report.baseline import Baseline
     from harness.scenario.schema import Scenario
 
@@ -232,16 +233,24 @@ class ReportFolder:
             names[name] = relative_path(path, relative_to)
         return names
 
-    def finish(self, wall_s: float | None = None, *, baseline: Baseline | None = None) -> Path:
+    def finish(
+        self,
+        wall_s: float | None = None,
+        *,
+        baseline: Baseline | None = None,
+        alignment: Alignment | None = None,
+        alignment_mode: str = "warn",
+    ) -> Path:
         """Write summary.json, junit.xml and index.html; return the index page.
         `wall_s`: the command's wall time, for the totals; `baseline`: an earlier
-        run to compare with (`--baseline`), in summary.json and on the page."""
+        run to compare with (`--baseline`), in summary.json and on the page;
+        `alignment`: the fit of the board's /scan (`run --alignment`, its mode)."""
         from harness.report.html import index_html
         from harness.report.junit import junit_xml
 
         done = self.scenarios
         entries = [scenario_entry(s.result, self._names(s, relative_to=self.root)) for s in done]
-        summary = run_summary(entries, wall_s)
+        summary = run_summary(entries, wall_s, alignment=alignment, alignment_mode=alignment_mode)
         if baseline is not None:
             from harness.report.baseline import compare, with_comparison
 

@@ -11,13 +11,19 @@ from __future__ import annotations
 import json
 import math
 from collections.abc import Mapping, Sequence
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from harness import __version__
 from harness.judge.records import RunResult, TickRecord
+from harness.safe_text import for_storage
+
+if TYPE_CHECKING:
+    from harness.judge.alignment import Alignment
 
 __all__ = [
     "FORMAT",
+    "alignment_entry",
+    "alignment_fails",
     "json_bytes",
     "run_summary",
     "scenario_details",
@@ -70,6 +76,7 @@ def scenario_entry(result: RunResult, files: Mapping[str, str | None]) -> dict[s
         "startup_s": round(result.startup_s, 3),  # waiting for the node to come up
         "stop_s": round(result.stop_s, 3),  # waiting for it to stop
         "total_s": round(result.total_s, 3),  # what the scenario cost the run
+        "gap_s": None if result.gap_s is None else _number(round(result.gap_s, 3)),
         "files": dict(files),
     }
 
@@ -130,21 +137,55 @@ def passed_line(passed: int, total: int) -> str:
     return f"{passed} of {total} scenario{'s' if total != 1 else ''} passed"
 
 
-def run_summary(entries: Sequence[dict[str, Any]], wall_s: float | None = None) -> dict[str, Any]:
+def alignment_fails(alignment: Alignment | None, mode: str = "warn") -> bool:
+    """`--alignment fail` and the board's /scan is the truth turned or mirrored."""
+    return mode == "fail" and alignment is not None and alignment.misaligned
+
+
+def alignment_entry(alignment: Alignment | None, mode: str = "warn") -> dict[str, Any] | None:
+    """summary.json's `alignment`: the fitted turn and mirror of the board's /scan
+    (None: no board scans on this link); `mode` is `--alignment`'s."""
+    if alignment is None:
+        return None
+    return {
+        "status": alignment.status,
+        "rotation_deg": _number(alignment.rotation_deg),
+        "mirrored": alignment.mirrored,
+        "ticks": alignment.ticks,
+        "agreement": _number(alignment.agreement),
+        "identity_agreement": _number(alignment.identity_agreement),
+        "fix": for_storage(alignment.fix),
+        "reason": for_storage(alignment.reason),
+        "text": for_storage(alignment.text()),
+        "mode": mode,
+        "fails_run": alignment_fails(alignment, mode),
+    }
+
+
+def run_summary(
+    entries: Sequence[dict[str, Any]],
+    wall_s: float | None = None,
+    *,
+    alignment: Alignment | None = None,
+    alignment_mode: str = "warn",
+) -> dict[str, Any]:
     """summary.json: totals first (what CI checks), then every scenario.
 
     `wall_s` is the command's wall time, when known; otherwise the sum of
-    what each scenario cost.
+    what each scenario cost. `alignment`, the fit of the board's /scan
+    against the truth (serial links); with `alignment_mode` "fail" a
+    misaligned one makes the run not `ok`, as it makes the exit code 1.
     """
     passed = sum(1 for e in entries if e["ok"])
     return {
         "format": FORMAT,
         "harness": __version__,
-        "ok": passed == len(entries),
+        "ok": passed == len(entries) and not alignment_fails(alignment, alignment_mode),
         "total": len(entries),
         "passed": passed,
         "failed": len(entries) - passed,
         "wall_s": round(wall_s if wall_s is not None else sum(e["total_s"] for e in entries), 3),
+        "alignment": alignment_entry(alignment, alignment_mode),
         "scenarios": list(entries),
     }
 

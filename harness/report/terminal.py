@@ -7,6 +7,7 @@ rich markup, with every non-printable character shown as its escape
 
 from __future__ import annotations
 
+import statistics
 from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
@@ -16,11 +17,12 @@ from rich.text import Text
 
 from harness.judge.records import RunResult
 from harness.report.baseline import KINDS
-from harness.report.summary import passed_line, verdict_of
+from harness.report.summary import alignment_fails, passed_line, verdict_of
 from harness.safe_text import DIAGNOSTICS_LIMIT, TEXT_LIMIT, clip, for_terminal
 from harness.scenario.schema import Scenario
 
 if TYPE_CHECKING:
+    from harness.judge.alignment import Alignment
     from harness.report.baseline import Comparison
 
 DIAGNOSTIC_LINES = 15
@@ -93,10 +95,16 @@ def results_table(results: Sequence[RunResult], wall_s: float | None = None) -> 
 
 
 def print_results(
-    console: Console, results: Sequence[RunResult], *, wall_s: float | None = None
+    console: Console,
+    results: Sequence[RunResult],
+    *,
+    wall_s: float | None = None,
+    alignment: Alignment | None = None,
+    alignment_mode: str = "warn",
 ) -> None:
     """The table, then for each failed scenario its first failure and diagnostics;
-    `wall_s`, the command's wall time so far, goes in the total row."""
+    `wall_s`, the command's wall time so far, goes in the total row; `alignment`,
+    the fit of the board's /scan (serial links), a line at the end."""
     console.print(results_table(results, wall_s))
     failed = [r for r in results if not r.ok]
     shown: set[str] = set()
@@ -131,6 +139,40 @@ def print_results(
             "with nothing within the threshold",
             highlight=False,
         )
+    gaps = gap_line(results)
+    if gaps:
+        console.print(gaps, highlight=False, markup=False)
+    if alignment is not None:
+        print_alignment(console, alignment, mode=alignment_mode)
+
+
+def gap_line(results: Sequence[RunResult]) -> str:
+    """'between scenarios the device kept streaming: 0.8-1.2 s (median 0.9 s)'; '' when
+    no result had a run-long device session."""
+    gaps = sorted(r.gap_s for r in results if r.gap_s is not None)
+    if not gaps:
+        return ""
+    lead = "between scenarios the device kept streaming"
+    low, high = f"{gaps[0]:.1f}", f"{gaps[-1]:.1f}"
+    if low == high:
+        return f"{lead}: {low} s"
+    return f"{lead}: {low}-{high} s (median {statistics.median(gaps):.1f} s)"
+
+
+def alignment_text(alignment: Alignment, mode: str = "warn") -> tuple[str, str]:
+    """The terminal's line on the board's /scan against the truth, and its style: quiet
+    when aligned or unknown, a warning when misaligned, a failure with `--alignment fail`."""
+    if not alignment.misaligned:
+        return f"alignment: {alignment.text()}", ""
+    if alignment_fails(alignment, mode):
+        return f"alignment: FAILED (--alignment fail): {alignment.text()}", "bold red"
+    return f"alignment: WARNING: {alignment.text()}", "bold yellow"
+
+
+def print_alignment(console: Console, alignment: Alignment, *, mode: str = "warn") -> None:
+    """`run` on a serial link: whether the board's /scan is the truth turned or mirrored."""
+    line, style = alignment_text(alignment, mode)
+    print_safe(console, line, style=style)
 
 
 def print_comparison(console: Console, comparison: Comparison) -> None:
