@@ -429,3 +429,137 @@ def test_the_warning_rule_is_a_field_and_settings_override_it(tmp_path: Path) ->
     path = write(tmp_path, changed("warning_when_clear: always\n"), "bad.yaml")
     with pytest.raises(ConfigError, match=rf"^{path}: warning_when_clear: .*'optional'"):
         load_scenario_file(path)
+
+
+# -- the LIDAR's mount: read from the robot model ---------------------------------
+
+
+def mount_urdf(tmp_path: Path, device_joint: str, *, scan_rpy: str = "0 0 0") -> None:
+    """`bot.urdf`: base -> laser (the scan link, at `scan_rpy`) and a device link `dev`."""
+    (tmp_path / "bot.urdf").write_text(
+        '<?xml version="1.0"?><robot name="bot">'
+        '<link name="base"/><link name="laser"/><link name="dev"/>'
+        '<joint name="scan" type="fixed"><parent link="base"/><child link="laser"/>'
+        f'<origin xyz="0 0 0.2" rpy="{scan_rpy}"/></joint>'
+        f"{device_joint}</robot>"
+    )
+
+
+def device_on(parent: str, rpy: str, kind: str = "fixed") -> str:
+    return (
+        f'<joint name="device" type="{kind}"><parent link="{parent}"/><child link="dev"/>'
+        f'<origin xyz="0.01 0 0" rpy="{rpy}"/><axis xyz="0 0 1"/></joint>'
+    )
+
+
+BOT = "robot: {urdf: bot.urdf, lidar_link: laser, lidar_device_link: dev}\n"
+
+
+def test_the_v2_model_puts_the_devices_zero_to_the_right() -> None:
+    """The FOSSBot v2's A1 mount comes from fossbot_v2.urdf: zero at -90 deg, clockwise."""
+    from harness.lidar.mount import LidarMount
+    from harness.scenario import scenario_mount
+
+    scenario = resolve_scenario("approach_wall")
+    assert scenario.robot.lidar_device_link == "lidar_device_frame"
+    assert scenario_mount(scenario) == LidarMount(yaw_deg=-90.0, mirrored=False)
+    assert scenario_mount(scenario).driver_settings() == (True, -90.0)
+
+
+@pytest.mark.parametrize(
+    ("device_joint", "scan_rpy", "yaw", "mirrored"),
+    [
+        (device_on("laser", "0 0 -1.5707963267948966"), "0 0 0", -90.0, False),
+        (device_on("laser", "0 0 3.141592653589793"), "0 0 0", -180.0, False),
+        (device_on("laser", "3.141592653589793 0 0"), "0 0 0", 0.0, True),  # upside down
+        (device_on("laser", "0 3.141592653589793 0"), "0 0 0", -180.0, True),  # flipped end over
+        (device_on("laser", "0.01 0 0.5"), "0 0 0", 28.64788976, False),  # within 1 deg of level
+        (device_on("base", "0 0 0"), "0 0 1.5707963267948966", -90.0, False),  # siblings
+        (device_on("base", "3.141592653589793 0 0.3"), "0 0 0.3", 0.0, True),
+    ],
+)
+def test_the_mount_is_the_device_links_orientation_in_the_scan_frame(
+    tmp_path: Path, device_joint: str, scan_rpy: str, yaw: float, mirrored: bool
+) -> None:
+    """Yaw of the device's x about the scan frame's z; mirrored when its z points down."""
+    from harness.scenario import scenario_mount
+
+    mount_urdf(tmp_path, device_joint, scan_rpy=scan_rpy)
+    mount = scenario_mount(load_scenario_file(write(tmp_path, STILL + BOT)))
+    assert mount.yaw_deg == pytest.approx(yaw, abs=1e-7)
+    assert mount.mirrored is mirrored
+
+
+def test_the_scan_link_below_the_device_link_is_composed_too(tmp_path: Path) -> None:
+    """The device link may be the scan link's parent: the scan frame's own yaw counts."""
+    from harness.scenario import scenario_mount
+
+    (tmp_path / "bot.urdf").write_text(
+        '<?xml version="1.0"?><robot name="bot"><link name="base"/><link name="dev"/>'
+        '<link name="laser"/>'
+        '<joint name="a" type="fixed"><parent link="base"/><child link="dev"/></joint>'
+        '<joint name="b" type="fixed"><parent link="dev"/><child link="laser"/>'
+        '<origin rpy="0 0 0.5"/></joint></robot>'
+    )
+    mount = scenario_mount(load_scenario_file(write(tmp_path, STILL + BOT)))
+    assert mount.yaw_deg == pytest.approx(-28.64788976, abs=1e-7)
+
+
+def test_a_robot_without_a_device_link_has_the_generic_mount(tmp_path: Path) -> None:
+    """Left at its default, a missing lidar_device_frame means zero straight ahead."""
+    from harness.lidar.mount import FORWARD
+    from harness.scenario import scenario_mount
+
+    mount_urdf(tmp_path, "")
+    (tmp_path / "bot.urdf").write_text(
+        (tmp_path / "bot.urdf").read_text().replace('<link name="dev"/>', "")
+    )
+    robot = "robot: {urdf: bot.urdf, lidar_link: laser}\n"
+    assert scenario_mount(load_scenario_file(write(tmp_path, STILL + robot))) is FORWARD
+    named = write(tmp_path, STILL + BOT, "named.yaml")
+    with pytest.raises(
+        ConfigError,
+        match=rf"^{named}: robot\.lidar_device_link: no link named 'dev' in 'bot\.urdf' "
+        r"\(leave the field out",
+    ):
+        load_scenario_file(named)
+
+
+@pytest.mark.parametrize(
+    ("device_joint", "reason"),
+    [
+        (
+            device_on("laser", "0.5 0 0"),
+            r"'dev' in 'bot\.urdf' is tilted 28\.6 deg from the z axis of 'laser'; "
+            r"a spinning LIDAR's axis must be parallel to it",
+        ),
+        (
+            device_on("laser", "0 1.5707963267948966 0"),
+            r"'dev' in 'bot\.urdf' is tilted 90\.0 deg",
+        ),
+        (
+            device_on("laser", "0 0 0", "continuous"),
+            r"'dev' in 'bot\.urdf' is joined to 'laser' through the continuous joint 'device'; "
+            r"the device must be fixed to the scan link",
+        ),
+    ],
+)
+def test_a_device_that_cannot_be_a_mount_is_refused_at_load(
+    tmp_path: Path, device_joint: str, reason: str
+) -> None:
+    """Tilted, or on a moving joint: one line naming the scenario file, the field and the link."""
+    mount_urdf(tmp_path, device_joint)
+    path = write(tmp_path, STILL + BOT)
+    with pytest.raises(ConfigError, match=rf"^{path}: robot\.lidar_device_link: {reason}"):
+        load_scenario_file(path)
+
+
+def test_a_mount_is_read_once_per_file_version(tmp_path: Path) -> None:
+    """The URDF is cached per file; a changed file is read again."""
+    from harness.scenario import scenario_mount
+
+    mount_urdf(tmp_path, device_on("laser", "0 0 0.5"))
+    scenario = load_scenario_file(write(tmp_path, STILL + BOT))
+    assert scenario_mount(scenario).yaw_deg == pytest.approx(28.64788976)
+    mount_urdf(tmp_path, device_on("laser", "0 0 -1.0"))
+    assert scenario_mount(scenario).yaw_deg == pytest.approx(-57.29577951)

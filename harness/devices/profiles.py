@@ -11,6 +11,7 @@ from typing import Any
 
 from harness.devices.revolution import Sample, samples_at_beams, samples_from_scan
 from harness.errors import ConfigError
+from harness.lidar.mount import FORWARD, LidarMount
 from harness.lidar.scan import Scan
 
 # A revolution of standard nodes may fill this share of the line's time per
@@ -33,23 +34,30 @@ class DeviceProfile:
     at_beam_angles: Callable[[Any], bool] = lambda device: False  # (device) -> no resampling?
 
     def revolution(
-        self, device: Any, scan: Scan, rate_hz: float, max_range_m: float | None
+        self,
+        device: Any,
+        scan: Scan,
+        rate_hz: float,
+        max_range_m: float | None,
+        *,
+        mount: LidarMount = FORWARD,
     ) -> list[Sample]:
-        """The samples `device` sends for one revolution of `scan` at `rate_hz`.
+        """The samples `device` sends for one revolution of `scan` at `rate_hz`, on `mount`.
 
         Where the device reports each sample's own angle (the A1's standard
         nodes) every beam goes out at the angle it was cast, as many as the
         line carries in one revolution (else the device's native count,
         still at the beams' angles); otherwise the revolution is resampled
-        to the native count at evenly spaced angles.
+        to the native count at evenly spaced angles. `mount` says where the
+        device's zero points on the robot (the FOSSBot v2: to the right).
         """
         native = self.samples_per_rev(device, rate_hz)
         if self.at_beam_angles(device):
             bytes_per_rev = LINE_SHARE * self.baudrate / 10 / rate_hz
             fits = scan.ranges.size * device.bytes_per_sample <= bytes_per_rev
             count = None if fits else native
-            return samples_at_beams(scan, max_count=count, max_range_m=max_range_m)
-        return samples_from_scan(scan, samples_per_rev=native, max_range_m=max_range_m)
+            return samples_at_beams(scan, max_count=count, max_range_m=max_range_m, mount=mount)
+        return samples_from_scan(scan, samples_per_rev=native, max_range_m=max_range_m, mount=mount)
 
 
 def _rplidar(rate_hz: float) -> Any:

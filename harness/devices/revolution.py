@@ -1,10 +1,13 @@
 """Turning an emitted Scan into the measurements a spinning LIDAR would send.
 
 Both emulated devices (RPLIDAR A1, LD06/LD19) turn clockwise seen from above
-and report angles in degrees clockwise from their own forward direction,
-while a ``Scan`` follows REP-103 (radians, counter-clockwise). This module is
-the one place that flips the convention, so the codecs only ever see device
-samples. See docs/devices.md for the conventions and their sources.
+and report angles in degrees clockwise from their own zero, while a ``Scan``
+follows REP-103 (radians, counter-clockwise, 0 straight ahead). Where the
+device's zero points on the robot, and which way it counts, is its mount
+(``harness.lidar.mount``; the FOSSBot v2's A1 points its zero to the right).
+This module is the one place that turns scan angles into device angles, so
+the codecs only ever see device samples. See docs/devices.md for the
+conventions and their sources.
 """
 
 from __future__ import annotations
@@ -14,6 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from harness.lidar.mount import FORWARD, LidarMount
 from harness.lidar.scan import Scan
 
 # The quality the vendor SDK gives every express-scan sample (0x2F): a
@@ -26,14 +30,22 @@ DEFAULT_QUALITY = 47
 class Sample:
     """One device measurement, in the device's own convention."""
 
-    angle_deg: float  # clockwise from the device's forward, [0, 360)
+    angle_deg: float  # clockwise from the device's zero, [0, 360)
     distance_mm: float  # 0.0 = no return (also "too close": devices send 0 for both)
     quality: int  # RPLIDAR: 0..63 (0 when distance is 0); LD: intensity 0..255
 
 
-def device_angle_deg(ccw_rad: float | np.ndarray) -> float | np.ndarray:
-    """A REP-103 angle (CCW, radians) as a device angle (CW, degrees, [0, 360))."""
-    deg = np.mod(-np.degrees(np.asarray(ccw_rad, dtype=np.float64)), 360.0)
+def device_angle_deg(
+    ccw_rad: float | np.ndarray, mount: LidarMount = FORWARD
+) -> float | np.ndarray:
+    """A REP-103 angle (CCW, radians) as a device angle (degrees, [0, 360)) on `mount`.
+
+    Clockwise from the device's zero at ``mount.yaw_deg``; counter-clockwise
+    when the device is mirrored (upside down). The generic mount: ``-degrees mod 360``.
+    """
+    deg = np.degrees(np.asarray(ccw_rad, dtype=np.float64))
+    turn = deg - mount.yaw_deg if mount.mirrored else mount.yaw_deg - deg
+    deg = np.mod(turn, 360.0)
     # A tiny negative angle rounds to 360.0, and -0.0 prints oddly: both are 0.
     deg = np.where(deg >= 360.0, 0.0, deg) + 0.0
     return float(deg) if deg.ndim == 0 else deg
@@ -61,22 +73,30 @@ def samples_from_scan(
     samples_per_rev: int | None = None,
     max_range_m: float | None = None,
     quality: int = DEFAULT_QUALITY,
+    mount: LidarMount = FORWARD,
 ) -> list[Sample]:
     """The samples of one revolution, in increasing device angle from about 0.
 
-    Without ``samples_per_rev`` there is one sample per beam. With it, the
+    Each beam is where `mount` puts it in the device's angles. Without
+    ``samples_per_rev`` there is one sample per beam. With it, the
     revolution is resampled to the device's native count: sample ``j`` looks
-    at device angle ``j * 360 / samples_per_rev`` and takes the nearest beam,
-    or no return where the scan has no beam within half an increment.
+    at device angle ``j * 360 / samples_per_rev`` (plus less than a step, so
+    that every mount looks at the same robot-frame angles; nothing on the
+    generic mount) and takes the nearest beam, or no return where the scan
+    has no beam within half an increment.
     """
     distances = encode_distances_mm(scan.ranges, max_range_m)
     if samples_per_rev is None:
-        angles = np.asarray(device_angle_deg(scan.angles()), dtype=np.float64)
+        angles = np.asarray(device_angle_deg(scan.angles(), mount), dtype=np.float64)
     else:
         if samples_per_rev < 1:
             raise ValueError(f"samples_per_rev must be positive, got {samples_per_rev}")
-        angles = np.arange(samples_per_rev, dtype=np.float64) * (360.0 / samples_per_rev)
-        distances = _nearest_beam(scan, angles, distances)
+        step = 360.0 / samples_per_rev
+        angles = np.arange(samples_per_rev, dtype=np.float64) * step
+        phase = _grid_phase(mount, step)
+        if phase:
+            angles = angles + phase
+        distances = _nearest_beam(scan, angles, distances, mount)
     order = np.argsort(angles, kind="stable")
     qualities = np.where(distances > 0.0, int(quality), 0)
     return [
@@ -90,13 +110,15 @@ def samples_at_beams(
     max_count: int | None = None,
     max_range_m: float | None = None,
     quality: int = DEFAULT_QUALITY,
+    mount: LidarMount = FORWARD,
 ) -> list[Sample]:
     """One sample per beam, at the angle the simulator cast it, in increasing device angle.
 
     A device that reports each sample's own angle (the RPLIDAR's standard
     nodes, 1/64 degree) need not resample: it can say exactly where each
-    beam looked. With ``max_count`` below the number of beams, that many
-    beams are kept, spread evenly over the scan, each still at its own angle.
+    beam looked (in its own angles: `mount`). With ``max_count`` below the
+    number of beams, that many beams are kept, spread evenly over the scan,
+    each still at its own angle.
     """
     n = scan.ranges.size
     index = np.arange(n)
@@ -105,7 +127,8 @@ def samples_at_beams(
             raise ValueError(f"max_count must be positive, got {max_count}")
         if n > max_count:
             index = np.unique(np.floor(np.arange(max_count) * (n / max_count)).astype(np.int64))
-    angles = np.asarray(device_angle_deg(scan.angles()), dtype=np.float64).reshape(-1)[index]
+    angles = np.asarray(device_angle_deg(scan.angles(), mount), dtype=np.float64)
+    angles = angles.reshape(-1)[index]
     distances = encode_distances_mm(scan.ranges, max_range_m)[index]
     order = np.argsort(angles, kind="stable")
     qualities = np.where(distances > 0.0, int(quality), 0)
@@ -114,12 +137,30 @@ def samples_at_beams(
     ]
 
 
-def _nearest_beam(scan: Scan, device_deg: np.ndarray, distances: np.ndarray) -> np.ndarray:
-    """Distances seen at the given device angles: nearest beam, 0 if none is near."""
+def _grid_phase(mount: LidarMount, step: float) -> float:
+    """Where the resampled device angles start, in [0, step): 0 on the generic mount.
+
+    A real device's samples fall wherever its rotation puts them; the emulator
+    puts them on the same robot-frame angles whatever the mount (a multiple of
+    `step` from straight ahead), so a mount whose yaw is not a whole number of
+    steps (the v2's -90 deg is 112.5 of an LD19's 0.8) does not land every
+    sample half-way between a driver's bins.
+    """
+    turn = -mount.yaw_deg if mount.mirrored else mount.yaw_deg
+    phase = float(np.mod(turn, step))
+    return 0.0 if phase < 1e-9 or phase > step - 1e-9 else phase
+
+
+def _nearest_beam(
+    scan: Scan, device_deg: np.ndarray, distances: np.ndarray, mount: LidarMount = FORWARD
+) -> np.ndarray:
+    """Distances seen at the given device angles on `mount`: nearest beam, 0 if none is near."""
     n = scan.ranges.size
     if n == 0:
         return np.zeros(device_deg.size)
-    ccw = np.radians(-device_deg)
+    # device_angle_deg's inverse (mod 360): where in the scan frame each device angle looks.
+    scan_deg = device_deg + mount.yaw_deg if mount.mirrored else mount.yaw_deg - device_deg
+    ccw = np.radians(scan_deg)
     inc = scan.angle_increment if n > 1 else 2 * math.pi
     rel = np.mod(ccw - scan.angle_min, 2 * math.pi)  # [0, 2*pi) past the first beam
     index = np.rint(rel / inc).astype(np.int64)

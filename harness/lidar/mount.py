@@ -69,7 +69,9 @@ def parse_mount(text: str) -> LidarMount | None:
         return FORWARD
     yaw_text, _, flag = value.partition(",")
     if flag not in ("", "mirrored"):
-        raise ConfigError(f"--lidar-mount {text[:40]!r}: after the angle only ',mirrored' may follow")
+        raise ConfigError(
+            f"--lidar-mount {text[:40]!r}: after the angle only ',mirrored' may follow"
+        )
     try:
         yaw = float(yaw_text)
     except ValueError:

@@ -9,6 +9,8 @@ in a file becomes one ``ConfigError`` line naming the file and the field.
 - ``checks``: rules across fields and files (run length, reachable
   conditions, model files, a start clear of obstacles), with ``ahead``,
   ``footprint``, ``geometry`` and ``model_files`` as their pure helpers;
+- ``mount``: where the LIDAR device's zero points, read from the robot
+  model (``scenario_mount``);
 - ``yaml_loader``: YAML 1.2 core only, bounded;
 - ``variations``: a scenario with its wall moved, its start moved or its
   speed scaled, checked as a file is (a campaign's generated factors).
@@ -26,6 +28,7 @@ _EXPORTS = {
     "resolve_scenario": "files",
     "shipped_scenarios": "files",
     "shipped_dir": "files",
+    "scenario_mount": "mount",
 }
 __all__ = sorted(_EXPORTS)
 __getattr__ = lazy_exports(__name__, _EXPORTS)

@@ -30,6 +30,7 @@ from harness.scenario.model_files import (
     parse_xml,
     robot_models_dir,
 )
+from harness.scenario.mount import lidar_mount
 from harness.scenario.schema import WHEEL_JOINTS, Cylinder, Model, Scenario, point_text
 
 
@@ -135,7 +136,9 @@ def check_model_files(scenario: Scenario) -> Path:
 
     The same check ``harness.sim.world.World`` runs before PyBullet sees a
     file; here it runs when the scenario file is loaded, before any node
-    or board is started. Returns the robot URDF's resolved path.
+    or board is started. The robot's LIDAR mount must read too (an upright
+    device link, or none: ``harness.scenario.mount``). Returns the robot
+    URDF's resolved path.
     """
     folders = [scenario.base_dir, robot_models_dir()]
     where = shown(scenario.source or "<scenario>")
@@ -158,6 +161,7 @@ def check_model_files(scenario: Scenario) -> Path:
             f"{where}: robot.lidar_link: no link named {scenario.robot.lidar_link!r} in "
             f"{urdf!r} (links: {', '.join(robot.links)})"
         )
+    lidar_mount(scenario, robot_path)
     if scenario.motion.mode == "wheels":
         joints = dict(robot.joints)
         for name in WHEEL_JOINTS:

@@ -39,6 +39,9 @@ from harness.scenario.limits import (
 from harness.scenario.yaml_loader import FLOAT_1_2, INT_1_2
 
 WHEEL_JOINTS = ("left_wheel_joint", "right_wheel_joint")  # what wheels mode drives
+# The link whose frame is the LIDAR device's own (+x its 0 degrees, +z its top);
+# a URDF without it has a generic mount (harness.scenario.mount).
+DEFAULT_DEVICE_LINK = "lidar_device_frame"
 
 
 class _Strict(BaseModel):
@@ -138,11 +141,15 @@ class Pose2D(_Strict):
     yaw: Finite = 0.0
 
 
+LinkName = Annotated[Text, Field(min_length=1, max_length=255)]
+
+
 class RobotConfig(_Strict):
-    """Which URDF to load, its LIDAR link and where it starts."""
+    """Which URDF to load, its LIDAR links and where it starts."""
 
     urdf: ModelPath = "fossbot_v2.urdf"
-    lidar_link: Annotated[Text, Field(min_length=1, max_length=255)] = "lidar_scan_frame"
+    lidar_link: LinkName = "lidar_scan_frame"  # the scan frame: x forward, z up
+    lidar_device_link: LinkName = DEFAULT_DEVICE_LINK  # where the device's zero points
     start: Pose2D = Pose2D()
 
     @field_validator("urdf")

@@ -34,7 +34,9 @@ INF = math.inf
 MODULE = "rplidar_node"
 
 # (quality, device angle clockwise in degrees, distance in mm); the first
-# sample carries the start flag. Comments: the CCW bin and what it must hold.
+# sample carries the start flag. Comments: the CCW bin of a device whose zero
+# points forward (invert, offset 0) and what it must hold; the driver's default
+# (the v2 bridge's invert, -90) puts each of them 90 bins clockwise.
 REVOLUTION = [
     (20, 0.0, 1000.0),  # bin 0: 1.0 ...
     (20, 359.6, 900.0),  # ... beaten across the wrap by 0.9 (ccw 0.41 deg)
@@ -54,10 +56,14 @@ EXPECTED_FINITE = {0: 0.9, 270: 0.5, 90: 0.7, 350: 12.0, 60: 0.15, 30: 1.2342, 2
 LEAD_IN = rp_sample(False, 20, 5.0, 3000.0) + rp_sample(False, 20, 6.0, 3000.0)
 
 
-def expected_ranges() -> np.ndarray:
+V2_OFFSET_DEG = -90  # the driver's default angle_offset_deg: the v2 bridge's
+
+
+def expected_ranges(offset_deg: int = V2_OFFSET_DEG) -> np.ndarray:
+    """The scan of REVOLUTION for a driver with `invert` and this angle_offset_deg."""
     ranges = np.full(360, INF, dtype=np.float32)
     for index, value in EXPECTED_FINITE.items():
-        ranges[index] = value
+        ranges[(index + offset_deg) % 360] = value
     return ranges
 
 
@@ -66,7 +72,7 @@ def start_device(pty, **kwargs) -> RplidarResponder:
 
 
 def test_one_scan_per_revolution_in_the_lab_robots_layout(pty, start_driver, scan_probe) -> None:
-    """Bins, filtering, header and timing of what a scripted A1 turns into."""
+    """Bins (the v2 bridge's mapping by default), filtering, header and timing of a scripted A1."""
     device = start_device(pty, period=0.05)
     driver = start_driver(MODULE, "-p", f"port:={pty.name}")
     probe = scan_probe()

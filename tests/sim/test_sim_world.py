@@ -84,6 +84,11 @@ def test_urdf_dimensions_as_loaded():
         assert lidar_pos[2] == pytest.approx(0.155, abs=0.005)
         assert lidar_pos[0] == pytest.approx(-0.016, abs=1e-6)
         assert lidar_orn == pytest.approx((0, 0, 0, 1), abs=1e-12)
+        # The A1's own frame: where the scan frame is, its zero turned to the right.
+        device_pos, device_orn = world.link_pose(world.link_index("lidar_device_frame"))
+        assert device_pos == pytest.approx(lidar_pos, abs=1e-9)
+        half = math.sqrt(0.5)
+        assert device_orn == pytest.approx((0, 0, -half, half), abs=1e-7)
         caster = world.link_index("caster")
         # PyBullet keeps URDF joint origins in single precision: 1e-6 m is exact here
         assert world.link_pose(caster)[0] == pytest.approx((-0.095, 0.0, 0.015), abs=1e-6)
@@ -97,10 +102,15 @@ def test_urdf_dimensions_as_loaded():
 def test_robot_collision_geometry_stays_below_the_scan_plane():
     """No link's collision box reaches the scan plane, so no beam can graze the robot."""
     with World(make_scenario(start=(0, 0, 0.7))) as world:
-        links = range(-1, pb.getNumJoints(world.robot, physicsClientId=world.client))
-        tops = [pb.getAABB(world.robot, i, physicsClientId=world.client)[1][2] for i in links]
-        assert world.link_names()[world.lidar_link + 1] == "lidar_scan_frame"
-        tops.pop(world.lidar_link + 1)  # the scan frame link has no geometry (a point AABB)
+        c = world.client
+        links = range(-1, pb.getNumJoints(world.robot, physicsClientId=c))
+        # Frames without geometry (the root, the scan and device frames) have a point AABB.
+        solid = [i for i in links if pb.getCollisionShapeData(world.robot, i, physicsClientId=c)]
+        tops = [pb.getAABB(world.robot, i, physicsClientId=c)[1][2] for i in solid]
+        names = world.link_names()
+        assert names[world.lidar_link + 1] == "lidar_scan_frame"
+        frames = {names[i + 1] for i in links if i not in solid}
+        assert frames == {"base_footprint", "lidar_scan_frame", "lidar_device_frame"}
     assert max(tops) < 0.155 - 0.01
 
 

@@ -10,6 +10,13 @@ angle_increment 2*pi/bins) by
     nearest: k = floor(((a mod 360) * bins / 360) + 0.5) mod bins
     floor:   k = int(((radians(a)) mod 2*pi) / (2*pi / bins))   (dropped if k == bins)
 
+A device whose zero points ``yaw`` degrees counter-clockwise from the robot's
+forward and counts clockwise (seen from above) is shown in the robot's frame
+by ``invert`` true and ``angle_offset_deg = yaw``; mounted upside down, it
+counts counter-clockwise: ``invert`` false. The FOSSBot v2's A1 points its
+zero to the right (yaw -90), the nodes' default; these functions default to a
+device whose zero points forward (offset 0).
+
 ``nearest`` (the default) centres bin ``k`` on its labelled angle
 ``k * angle_increment``, so a sample sent at exactly that angle (as an
 emulator naturally does) always lands in bin ``k``. It works in degrees,

@@ -135,7 +135,11 @@ class DriverNode(Node):
         bins = self._declare('bins', 'bins over [0, 2*pi)')
         timeout = self._number('timeout', 'seconds without data before the driver gives up')
         invert = self._declare('invert', 'device angles are clockwise: negate them')
-        offset = self._number('angle_offset_deg', 'added to the (negated) device angle')
+        offset = self._number(
+            'angle_offset_deg',
+            "added to the (negated) device angle: where the device's zero points, degrees "
+            'counter-clockwise from forward (the FOSSBot v2: -90)',
+        )
         bin_mode = self._declare('bin_mode', f'bin rule: {", ".join(BIN_MODES)}')
         if not port:
             raise ConfigError('port must name a serial device')

@@ -6,7 +6,10 @@ Points are grouped into revolutions where their angle wraps, and each
 revolution is published on a fixed layout of ``bins`` (450: 0.8 degree, what
 an LD19 at 10 Hz measures) over [0, 2*pi). Readings follow the vendor ROS 2
 driver (ldlidar_stl_ros2): no return (distance 0 and intensity 0) and empty
-bins are NaN, every other reading is published as sent. Run it as ``ros2 run
+bins are NaN, every other reading is published as sent. Angles default to
+the FOSSBot v2 bridge's mapping (``invert`` true, ``angle_offset_deg`` -90, a
+device whose zero points to the robot's right); a device mounted zero
+forward needs ``-p angle_offset_deg:=0.0``. Run it as ``ros2 run
 fossbot_lidar_driver ldlidar_node --ros-args -p port:=/dev/ttyUSB0``.
 """
 
@@ -37,8 +40,9 @@ DEFAULTS: dict[str, Any] = {
     'range_max': 25.0,  # the vendor driver's header value (LD19 data sheet: 12 m)
     'bins': 450,
     'timeout': 1.0,
+    # The FOSSBot v2 bridge's mapping: the A1's zero points to the robot's right.
     'invert': True,
-    'angle_offset_deg': 0.0,
+    'angle_offset_deg': -90.0,
     'bin_mode': 'nearest',
 }
 # Upper bound of one blocking read: how late a stop or a silence is noticed.

@@ -4,9 +4,12 @@ RPLIDAR A1 on a serial port to sensor_msgs/LaserScan, as the FOSSBot v2 robot pu
 Reads the device with the PyPI ``rplidar`` package (0.9.2, SkoltechRobotics)
 and publishes one scan per revolution: ``bins`` bins over [0, 2*pi), empty
 bins +inf, returns outside [range_min, range_max] dropped, the nearest
-return kept per bin. Run it as ``ros2 run fossbot_lidar_driver rplidar_node
---ros-args -p port:=/dev/ttyUSB0``; see the package README for the angle
-mapping and how it compares with the lab robot's bridge.
+return kept per bin. Angles follow the lab robot's bridge by default
+(``invert`` true, ``angle_offset_deg`` -90: the v2's A1 points its zero to
+the robot's right), so straight ahead is angle 0. Run it as ``ros2 run
+fossbot_lidar_driver rplidar_node --ros-args -p port:=/dev/ttyUSB0``; see
+the package README for the angle mapping and how it compares with the lab
+robot's bridge.
 """
 
 from __future__ import annotations
@@ -46,8 +49,9 @@ DEFAULTS: dict[str, Any] = {
     'range_max': 12.0,
     'bins': 360,
     'timeout': 1.0,
+    # The FOSSBot v2 bridge's mapping: the A1's zero points to the robot's right.
     'invert': True,
-    'angle_offset_deg': 0.0,
+    'angle_offset_deg': -90.0,
     'bin_mode': 'nearest',
     # rplidar 0.9.2 discards the input buffer beyond this many samples (0: never).
     'max_buf_meas': 500,

@@ -18,3 +18,10 @@ def test_rplidar_keeps_the_nearest_return_in_range():
     ranges = rplidar_ranges(angles, distances, 360, range_min=0.15, range_max=12.0)
     assert ranges[270] == 0.7
     assert math.isinf(ranges[180]) and math.isinf(ranges[315])
+
+
+def test_the_v2_mapping_shows_the_a1_in_the_robots_frame():
+    """invert, -90 (the v2 bridge, the nodes' default): the A1's 270 is ahead, 180 left."""
+    angles = np.array([270.0, 180.0, 0.0, 90.0])
+    bins = bin_indices(angles, 360, invert=True, angle_offset_deg=-90.0)
+    assert bins.tolist() == [0, 90, 270, 180]

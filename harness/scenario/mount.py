@@ -1,0 +1,189 @@
+"""Where the LIDAR device's zero points on the robot, as the robot model says (pure).
+
+A robot URDF may carry a link for the device itself (``robot.lidar_device_link``,
+default ``lidar_device_frame``): its +x is the device's 0 degrees, its +z the
+device's top, so its angles run clockwise seen from that top. Its orientation
+relative to the scan link (``robot.lidar_link``), composed through the fixed
+joints between the two (rpy only; where the device sits does not matter),
+is the mount: the yaw of its x about the scan frame's z, mirrored when its z
+points down. A tilted device is refused: a spinning LIDAR's plane is the scan
+plane.
+
+A URDF without that link has the generic mount (``FORWARD``: zero straight
+ahead) while the field is its default; a scenario that names another link
+its URDF lacks is a ``ConfigError``. (The value decides, not whether the
+file wrote it: a varied scenario is rebuilt from its dumped fields.) Read with ``xml.etree``
+only (no pybullet), so a scenario file is checked when it is loaded.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import xml.etree.ElementTree as ET
+from dataclasses import dataclass
+from functools import lru_cache
+from pathlib import Path
+
+import numpy as np
+
+from harness.errors import ConfigError
+from harness.lidar.mount import FORWARD, LidarMount
+from harness.safe_text import shown
+from harness.scenario.model_files import find_model_file, parse_xml, robot_models_dir
+from harness.scenario.schema import DEFAULT_DEVICE_LINK, Scenario
+
+__all__ = ["TILT_TOLERANCE_DEG", "lidar_mount", "scenario_mount", "urdf_mount"]
+
+TILT_TOLERANCE_DEG = 1.0  # a device axis within this of the scan frame's z counts as parallel
+
+
+@dataclass(frozen=True)
+class _Reading:
+    """What a URDF says about the mount: a mount, no device link (None), or a problem."""
+
+    mount: LidarMount | None
+    problem: str = ""
+
+
+def _rpy(roll: float, pitch: float, yaw: float) -> np.ndarray:
+    """URDF's fixed-axis roll, pitch, yaw as a rotation matrix (Rz @ Ry @ Rx)."""
+    cr, sr = math.cos(roll), math.sin(roll)
+    cp, sp = math.cos(pitch), math.sin(pitch)
+    cy, sy = math.cos(yaw), math.sin(yaw)
+    rz = np.array([[cy, -sy, 0.0], [sy, cy, 0.0], [0.0, 0.0, 1.0]])
+    ry = np.array([[cp, 0.0, sp], [0.0, 1.0, 0.0], [-sp, 0.0, cp]])
+    rx = np.array([[1.0, 0.0, 0.0], [0.0, cr, -sr], [0.0, sr, cr]])
+    return rz @ ry @ rx
+
+
+def _joint_rotation(joint: ET.Element) -> np.ndarray:
+    """The rotation of a joint's child frame in its parent's (its origin's rpy)."""
+    origin = joint.find("origin")
+    text = (origin.get("rpy") if origin is not None else None) or "0 0 0"
+    try:
+        roll, pitch, yaw = (float(v) for v in text.split())
+    except ValueError:  # model_files.check_model_file refuses these first
+        raise ConfigError(f"joint {joint.get('name')!r}: rpy is not 3 numbers") from None
+    return _rpy(roll, pitch, yaw)
+
+
+def _parent_link(joint: ET.Element) -> str:
+    parent = joint.find("parent")
+    return parent.get("link", "") if parent is not None else ""
+
+
+def _chain(parents: dict[str, ET.Element], link: str) -> list[str]:
+    """`link` and its ancestors up to the root (bounded: a loop ends it)."""
+    chain = [link]
+    while chain[-1] in parents and len(chain) <= len(parents):
+        chain.append(_parent_link(parents[chain[-1]]))
+    return chain
+
+
+def _down_to(
+    parents: dict[str, ET.Element], link: str, ancestor: str
+) -> tuple[np.ndarray, str | None]:
+    """Rotation of `link` in `ancestor`'s frame, and a moving joint on the way (if any)."""
+    rotation, moving = np.eye(3), None
+    while link != ancestor:
+        joint = parents[link]
+        rotation = _joint_rotation(joint) @ rotation
+        if joint.get("type") != "fixed":
+            moving = f"{joint.get('type')} joint {joint.get('name')!r}"
+        link = _parent_link(joint)
+    return rotation, moving
+
+
+def urdf_mount(
+    root: ET.Element, scan_link: str, device_link: str, *, model: str = "the URDF"
+) -> LidarMount | None:
+    """The mount of `device_link` relative to `scan_link` in a URDF; None if it has no such link.
+
+    ConfigError naming the field and `model` (callers add the scenario file)
+    when the scan link is missing, the device is tilted, or the two are not
+    joined by fixed joints alone.
+    """
+    links = {link.get("name", "") for link in root.findall("link")}
+    if device_link not in links:
+        return None
+    scan, device = repr(shown(scan_link, 100)), repr(shown(device_link, 100))
+    if scan_link not in links:
+        raise ConfigError(f"robot.lidar_link: no link named {scan} in {model}")
+    parents: dict[str, ET.Element] = {}
+    for joint in root.findall("joint"):
+        child, parent = joint.find("child"), joint.find("parent")
+        if child is not None and parent is not None:
+            parents.setdefault(child.get("link", ""), joint)
+    what = f"robot.lidar_device_link: {device} in {model}"
+    scan_chain, device_chain = _chain(parents, scan_link), _chain(parents, device_link)
+    common = next((link for link in scan_chain if link in device_chain), None)
+    if common is None:
+        raise ConfigError(f"{what} is not joined to {scan}")
+    scan_rotation, scan_moving = _down_to(parents, scan_link, common)
+    device_rotation, device_moving = _down_to(parents, device_link, common)
+    moving = device_moving or scan_moving
+    if moving is not None:
+        raise ConfigError(
+            f"{what} is joined to {scan} through the {moving}; "
+            "the device must be fixed to the scan link"
+        )
+    relative = scan_rotation.T @ device_rotation  # columns: the device's axes in the scan frame
+    up = float(np.clip(relative[2, 2], -1.0, 1.0))
+    tilt = math.degrees(math.acos(abs(up)))
+    if tilt > TILT_TOLERANCE_DEG:
+        raise ConfigError(
+            f"{what} is tilted {tilt:.1f} deg from the z axis of {scan}; a spinning "
+            "LIDAR's axis must be parallel to it (up, or down when mounted upside down)"
+        )
+    yaw = math.degrees(math.atan2(relative[1, 0], relative[0, 0]))
+    yaw = round((yaw + 180.0) % 360.0 - 180.0, 9) + 0.0
+    return LidarMount(yaw_deg=yaw, mirrored=up < 0.0)
+
+
+@lru_cache(maxsize=32)
+def _read(path: str, stamp: tuple[int, int], scan: str, device: str, model: str) -> _Reading:
+    """`urdf_mount` of one file, cached per file version (`stamp`: mtime, size)."""
+    root = parse_xml(Path(path), shown(path))
+    try:
+        return _Reading(urdf_mount(root, scan, device, model=model))
+    except ConfigError as err:
+        return _Reading(None, str(err))
+
+
+def lidar_mount(scenario: Scenario, robot_urdf: Path) -> LidarMount:
+    """The scenario's mount, read from `robot_urdf` (its robot, already found and checked)."""
+    where = shown(scenario.source or "<scenario>")
+    robot = scenario.robot
+    model = repr(shown(robot.urdf, 100))
+    try:
+        info = os.stat(robot_urdf)
+    except OSError as err:
+        reason = err.strerror or type(err).__name__
+        raise ConfigError(f"{where}: robot.urdf: cannot read {model}: {reason}") from None
+    stamp = (info.st_mtime_ns, info.st_size)
+    reading = _read(str(robot_urdf), stamp, robot.lidar_link, robot.lidar_device_link, model)
+    if reading.problem:
+        raise ConfigError(f"{where}: {reading.problem}")
+    if reading.mount is not None:
+        return reading.mount
+    if robot.lidar_device_link != DEFAULT_DEVICE_LINK:
+        raise ConfigError(
+            f"{where}: robot.lidar_device_link: no link named "
+            f"{shown(robot.lidar_device_link, 100)!r} in {model} (leave the field out for "
+            "a generic mount, zero straight ahead)"
+        )
+    return FORWARD
+
+
+def scenario_mount(scenario: Scenario) -> LidarMount:
+    """How the scenario's LIDAR device sits on its robot: what its robot model says.
+
+    The robot URDF is looked up as ``check_model_files`` does (the scenario's
+    folder, then robot_models/); reading it is cached per file version.
+    """
+    where = shown(scenario.source or "<scenario>")
+    ref = scenario.robot.urdf
+    folders = [scenario.base_dir, robot_models_dir()]
+    found = find_model_file(ref, folders, what=f"{where}: robot.urdf: cannot load {ref!r}")
+    return lidar_mount(scenario, found.path)
