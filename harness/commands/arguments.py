@@ -19,6 +19,7 @@ from dataclasses import replace
 from typing import TYPE_CHECKING
 
 from harness.errors import ConfigError
+from harness.lidar.mount import LidarMount, parse_mount
 from harness.links.base import LinkOptions, known_links
 from harness.ros.names import (
     InvalidName,
@@ -308,12 +309,39 @@ def add_device_options(parser: argparse.ArgumentParser) -> None:
         help="drive a physical board through this USB-UART, in real time "
         "(default: a virtual board on a pty)",
     )
+    serial.add_argument(
+        "--board-command",
+        action="append",
+        type=given("--board-command"),
+        default=[],
+        metavar="CMD",
+        help="virtual board: run the board's own software instead of the bundled driver, "
+        "{port} replaced by the emulated device's path (repeatable; started before the "
+        "first scenario with the run's ROS environment and working modem lines, stopped "
+        "after the last; the device then runs in real time; see docs/hil.md)",
+    )
+    serial.add_argument(
+        "--lidar-mount",
+        type=lidar_mount,
+        metavar="MOUNT",
+        help="how the device sits on the robot: model (default: what the robot model says; "
+        "the FOSSBot v2's A1 has its zero to the right), forward (zero straight ahead), or "
+        "DEG[,mirrored] (the device's zero, degrees counter-clockwise from forward)",
+    )
     inprocess = parser.add_argument_group("inprocess link")
     inprocess.add_argument(
         "--processor",
         metavar="MODULE:FUNCTION",
         help="fn(scan, threshold) -> (status, warning) instead of the reference",
     )
+
+
+def lidar_mount(text: str) -> LidarMount | None:
+    """--lidar-mount's value (None: the robot model's)."""
+    try:
+        return parse_mount(text)
+    except ConfigError as err:
+        raise argparse.ArgumentTypeError(str(err).removeprefix("--lidar-mount ")) from None
 
 
 def link_options(args: argparse.Namespace) -> LinkOptions:
@@ -344,6 +372,8 @@ def unchecked_link_options(args: argparse.Namespace) -> LinkOptions:
         ros_network=args.ros_network,
         realtime=args.realtime,
         port=getattr(args, "port", None),
+        board_commands=tuple(getattr(args, "board_command", ()) or ()),
+        lidar_mount=getattr(args, "lidar_mount", None),
     )
 
 
@@ -356,6 +386,23 @@ def check_link_options(args: argparse.Namespace) -> LinkOptions:
         check_port("--port", port)
     if port and args.link not in SERIAL_LINKS:
         raise ConfigError(f"--port needs --link rplidar or ldlidar, not {args.link}")
+    board = getattr(args, "board_command", None)
+    if board and args.link not in SERIAL_LINKS:
+        raise ConfigError(f"--board-command needs --link rplidar or ldlidar, not {args.link}")
+    if board and port:
+        raise ConfigError(
+            "--board-command runs the board's software on the virtual board; with --port the "
+            "physical board runs its own"
+        )
+    if board:
+        from harness.links.board_session import board_commands
+
+        board_commands(tuple(board))  # each program must exist: exit 2 now, not later
+    if getattr(args, "lidar_mount", None) is not None and args.link not in SERIAL_LINKS:
+        raise ConfigError(
+            f"--lidar-mount needs --link rplidar or ldlidar (the {args.link} link sends the "
+            "scan frame itself)"
+        )
     if processor and args.link != "inprocess":
         raise ConfigError(f"--processor needs --link inprocess (the {args.link} link runs a node)")
     if args.link == "inprocess":

@@ -13,7 +13,7 @@ import argparse
 
 from rich.console import Console
 
-from harness.commands.arguments import check_port, fault_list, seed
+from harness.commands.arguments import check_port, fault_list, lidar_mount, seed
 
 NAME = "emulate"
 HELP = "serve a scenario's scans as a LIDAR device on a serial port"
@@ -34,6 +34,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--seed", type=seed, help="override the scenario's seed")
     parser.add_argument("--faults", metavar="NAME[,NAME]", help="fault profiles to apply")
     parser.add_argument(
+        "--lidar-mount",
+        type=lidar_mount,
+        metavar="MOUNT",
+        help="how the device sits on the robot: model (default: what the scenario's robot "
+        "model says; the FOSSBot v2's A1 has its zero to the right), forward (zero straight "
+        "ahead), or DEG[,mirrored] (see docs/hil.md)",
+    )
+    parser.add_argument(
         "-v",
         "--verbose",
         action="store_true",
@@ -51,6 +59,12 @@ def run(args: argparse.Namespace, console: Console) -> int:
         check_port("--port", args.port)
     scenario = resolve_scenario(args.scenario)
     settings = RunSettings(seed=args.seed, faults=fault_list(args.faults))
+    if args.lidar_mount is not None:
+        mount = args.lidar_mount
+    else:
+        from harness.scenario.mount import scenario_mount
+
+        mount = scenario_mount(scenario)
     summary = emulate(
         profile(args.device),
         scenario,
@@ -58,6 +72,7 @@ def run(args: argparse.Namespace, console: Console) -> int:
         settings=settings,
         announce=_print_safe,
         verbose=args.verbose,
+        mount=mount,
     )
     for line in summary.lines():
         _print_safe(line)

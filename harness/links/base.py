@@ -7,8 +7,9 @@ import pkgutil
 import time
 from abc import ABC, abstractmethod
 from collections.abc import Callable
+from contextlib import AbstractContextManager, nullcontext
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, ClassVar, TypeVar
+from typing import TYPE_CHECKING, Any, ClassVar, TypeVar
 
 from harness.errors import ConfigError
 from harness.nodes.setup_problems import is_ros_module
@@ -16,6 +17,7 @@ from harness.nodes.setup_problems import is_ros_module
 if TYPE_CHECKING:  # naming the links and their options needs none of these (nor numpy)
     from harness.faults.link import LineDamage
     from harness.judge.answers import Answers, Received
+    from harness.lidar.mount import LidarMount
     from harness.lidar.scan import Scan
 
 
@@ -41,6 +43,12 @@ class LinkOptions:
     realtime: bool = False
     port: str | None = None  # serial links: a real adapter wired to a board (None: virtual board)
     scan_rate_hz: float = 10.0  # the scenario's LIDAR rate (the runner fills it in)
+    # Serial links, virtual board: the board's own software instead of the bundled
+    # driver, each a command line in which {port} is the emulated device's path.
+    board_commands: tuple[str, ...] = ()
+    # Serial links: how the device sits on the robot (None: what the robot model says;
+    # the runner fills it in).
+    lidar_mount: LidarMount | None = None
 
 
 class Link(ABC):
@@ -51,6 +59,15 @@ class Link(ABC):
 
     def __init__(self, options: LinkOptions) -> None:
         self.options = options
+        # On a run-long device session: seconds between the previous scenario's last
+        # judged revolution and this one's first (None where there is no session).
+        self.gap_s: float | None = None
+
+    @classmethod
+    def run_session(cls, options: LinkOptions) -> AbstractContextManager[Any]:
+        """What every scenario's link of one run shares (given to ``create_link``), as a
+        context manager for the whole run; None for links that share nothing."""
+        return nullcontext(None)
 
     # A suite may start the next scenarios' links while one runs (`start`)
     # and let finished ones stop while the next runs (`stop`, then `close`).
@@ -150,7 +167,7 @@ def _where(cls: type[Link]) -> str:
 
 # Modules of this package that are not links themselves: the contract, and
 # what several links share.
-HELPER_MODULES = ("base", "board", "processor_child")
+HELPER_MODULES = ("base", "board", "board_session", "processor_child")
 
 
 def known_links() -> list[str]:
@@ -161,9 +178,11 @@ def known_links() -> list[str]:
     return sorted(m.name for m in found if m.name not in HELPER_MODULES)
 
 
-def create_link(name: str, options: LinkOptions) -> Link:
-    """The link registered as `name`, importing its module on first use."""
-    return link_class(name)(options)
+def create_link(name: str, options: LinkOptions, session: Any = None) -> Link:
+    """The link registered as `name`, importing its module on first use; `session` is
+    what its class's ``run_session`` gave the run, if anything."""
+    cls = link_class(name)
+    return cls(options) if session is None else cls(options, session=session)  # type: ignore[call-arg]
 
 
 def link_class(name: str) -> type[Link]:

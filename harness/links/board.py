@@ -1,35 +1,45 @@
 """Links through a LIDAR on a serial line: the harness plays the device.
 
 Virtual board (default): a pty pair stands in for the USB cable; the board's
-own LIDAR driver node (bundled from node/fossbot_lidar_driver) reads the
-emulated device and publishes /scan, and the node under test answers it,
-each in its own process. Physical board (``--port``): the emulator drives a
-real USB-UART wired to the board's LIDAR input in real time, and the
-harness joins the board's ROS 2 graph to watch what it publishes.
+own software (the bundled LIDAR driver from node/fossbot_lidar_driver, or
+the user's ``--board-command`` processes) reads the emulated device and
+publishes /scan, and the node under test answers it, each in its own
+process. Physical board (``--port``): the emulator drives a real USB-UART
+wired to the board's LIDAR input in real time, and the harness joins the
+board's ROS 2 graph to watch what it publishes.
 
-Either way the lockstep machinery of the ros2 link is reused; only the
-delivery differs: a scan becomes device samples, goes down the line, and the
-driver's /scan for that revolution (quantised and re-binned) is what the
-oracle judges, because it is what the node saw.
+The device, the line and the board's software live for the whole run
+(``board_session.BoardSession``, the class's ``run_session``); each
+scenario's link uses them, and on the virtual board starts a fresh node
+under test. The lockstep machinery of the ros2 link is reused; only the
+delivery differs: a scan becomes device samples, goes down the line, and
+the driver's /scan for that revolution (quantised and re-binned) is what
+the oracle judges, because it is what the node saw.
+
+Which board scan is which revolution: the first scan the board published
+after the write that carried the revolution's last byte (a driver can
+publish a revolution only once it has all of it, and it has published the
+one before by then, when it answers within a revolution's time). Scans of
+revolutions the device sent on its own (repeats between scenarios, or
+when the harness was late) are told apart the same way and not judged.
 """
 
 from __future__ import annotations
 
 import os
-import sys
 import time
 from dataclasses import replace
 from typing import TYPE_CHECKING, Any, ClassVar
 
 from harness.devices.profiles import DeviceProfile
-from harness.errors import ConfigError, LinkError
+from harness.errors import ConfigError
 from harness.faults.link import LineDamage
 from harness.judge.answers import Answers
+from harness.lidar.mount import FORWARD
 from harness.lidar.scan import Scan
 from harness.links.base import LinkOptions
-from harness.links.ros2 import CATCH_UP_S, POLL_S, Ros2Link
-from harness.nodes.command import NodeCommand, ros_arguments
-from harness.nodes.process import NodeProcess, prepare_start
+from harness.links.board_session import BoardSession
+from harness.links.ros2 import POLL_S, Ros2Link
 from harness.ros.observer import Heard
 
 if TYPE_CHECKING:
@@ -38,7 +48,24 @@ if TYPE_CHECKING:
 SCAN_CATCH_UP_S = 0.05  # a driver scan published before its answer reaches us within this
 LATE_SCAN_WAIT_S = 0.2  # after a lost revolution: how long a second driver scan may follow
 LOST_IN_A_ROW = 5  # line faults: this many revolutions without a driver scan is a failure
-DRIVER_READY_S = 10.0  # the driver connects to the device (info, health, scan request)
+# A driver may skip a revolution with this few returns: rplidar's iter_scans
+# (the FOSSBot v2's agent) yields none of 5 or fewer.
+SPARSE_RETURNS = 5
+SPARSE_WAIT_S = 0.25  # at least this long for the board's scan of such a revolution
+
+
+def board_options(options: LinkOptions) -> LinkOptions:
+    """Options for a board: a physical board's own nodes, in its own domain."""
+    physical = options.port is not None
+    if physical and (options.node or options.package):
+        raise ConfigError(
+            "--port drives a physical board, which runs its own nodes: drop --node/--package"
+        )
+    if physical and options.domain_id is None:
+        # Joining a board's graph: its domain, not a reserved private one.
+        env_id = os.environ.get("ROS_DOMAIN_ID", "0")
+        options = replace(options, domain_id=int(env_id) if env_id.isdigit() else 0)
+    return options
 
 
 class BoardLink(Ros2Link):
@@ -49,85 +76,67 @@ class BoardLink(Ros2Link):
     publishes_scans = False  # the board's driver publishes /scan; the harness listens
     starts_ahead = False  # one line, one board at a time
 
-    def __init__(self, options: LinkOptions) -> None:
-        physical = options.port is not None
-        if physical and (options.node or options.package):
-            raise ConfigError(
-                "--port drives a physical board, which runs its own nodes: drop --node/--package"
-            )
-        if physical and options.domain_id is None:
-            # Joining a board's graph: its domain, not a reserved private one.
-            env_id = os.environ.get("ROS_DOMAIN_ID", "0")
-            options = replace(options, domain_id=int(env_id) if env_id.isdigit() else 0)
+    def __init__(self, options: LinkOptions, session: BoardSession | None = None) -> None:
+        options = board_options(options)
+        if session is not None:  # the run's device and domain
+            options = replace(options, domain_id=session.domain_id)
         super().__init__(options)
-        self.physical = physical
-        self.device = self.profile.make_device(options.scan_rate_hz)
-        self.port: Any = None
-        self.server: Any = None
-        self.driver: NodeProcess | None = None
+        self.physical = options.port is not None
+        self.session = session
+        self._own_session = session is None  # one scenario on its own: its own device
+        self.mount = options.lidar_mount or FORWARD
+        self._pushed = False  # the first push ends the session's idle stream
+        self._gap_measured = False
         self._seen: Scan | None = None
         self._delivery_problem: str | None = None
-        self._lost: str | None = None  # line faults: why the driver made no scan of it
+        self._lost: str | None = None  # why the driver made no scan of it (not a failure)
         self._scans_from = 0  # source time of the first driver scan of this revolution
         self._lost_in_a_row = 0
         self._heard_scans: list[Heard] = []
         self._line_damage: LineDamage | None = None
 
+    @classmethod
+    def run_session(cls, options: LinkOptions) -> BoardSession:
+        """One device, line and board for the whole run (see board_session)."""
+        return BoardSession(cls.profile, board_options(options))
+
+    # -- the session's parts ------------------------------------------------
+    @property
+    def device(self) -> Any:
+        assert self.session is not None, "start() the link first"
+        return self.session.device
+
+    @property
+    def server(self) -> Any:
+        return self.session.server if self.session is not None else None
+
+    @property
+    def port(self) -> Any:
+        return self.session.port if self.session is not None else None
+
     # -- processes and ports ----------------------------------------------
     @classmethod
     def prepare(cls, options: LinkOptions) -> None:
-        """Start the fork servers of the virtual board's driver and of the node."""
+        """Start the fork server of the virtual board's node under test."""
         if options.port is None:
-            prepare_start(cls._driver_command())
-        super().prepare(options)
+            super().prepare(options)
 
-    @classmethod
-    def _driver_command(cls) -> NodeCommand:
-        module = cls.profile.driver_module
-        return NodeCommand(
-            (sys.executable, "-m", module),
-            description=f"board driver {module}",
-            module=module,  # forked from a warm process, as the node
-        )
+    def start(self) -> None:
+        """Open this link's own session if it has none (a scenario run on its own)."""
+        if self.session is None and not self._started:
+            try:
+                self.session = BoardSession(self.profile, self.options).open()
+            except Exception as err:  # raised again by open(), as a start failure
+                self._started, self._start_error = True, err
+                return
+            self.options = replace(self.options, domain_id=self.session.domain_id)
+        super().start()
 
     def _start_processes(self, env: dict[str, str]) -> None:
-        from harness.serial_line.ports import PtyPort, SerialPort
-        from harness.serial_line.server import DeviceServer
-
-        opts = self.options
-        if self.physical:
-            assert opts.port is not None
-            self.port = SerialPort(opts.port, self.profile.baudrate)
-        else:
-            self.port = PtyPort()
-        mode = "realtime" if (opts.realtime or self.physical) else "lockstep"
-        self.server = DeviceServer(
-            self.device,
-            self.port,
-            mode=mode,
-            baudrate=self.profile.baudrate,
-            revolution_period_s=1.0 / opts.scan_rate_hz,
-            next_start="replace",  # no driver ever sees an extra, marker-only revolution
-        ).start()
-        if self.physical:
-            return  # the board runs its own driver and nodes
-        # The emulated device is quiet until the run starts and, in lockstep,
-        # while the harness waits for the node (bounded: the deadline, then
-        # the catch-up wait). A real device never pauses, so the driver's
-        # no-data timeout must outlast those waits and the start-up.
-        longest_wait = opts.scan_timeout + max(CATCH_UP_S, 3 * opts.scan_timeout)
-        read_timeout = max(longest_wait, opts.ready_timeout) + 2.0
-        driver_args = ros_arguments(
-            (
-                f"port:={self.port.slave_path}",
-                f"scan_topic:={opts.scan_topic}",
-                f"timeout:={read_timeout!r}",
-            ),
-            use_sim_time=False,
-        )
-        self.driver = NodeProcess(self._driver_command(), driver_args, env)
-        self.driver.start()
-        super()._start_processes(env)
+        assert self.session is not None
+        self.session.set_rate(self.options.scan_rate_hz)
+        if not self.physical:
+            super()._start_processes(env)  # the node under test; the board's software runs
 
     def _ready(self) -> bool:
         assert self.observer is not None and self.server is not None
@@ -145,9 +154,10 @@ class BoardLink(Ros2Link):
         )
         graph = self.observer.graph_summary() if self.observer is not None else ""
         report = self.line_diagnosis()
-        if not report.likely:
-            # Nothing wrong on the line (an LD06/LD19's line cannot tell: its driver
-            # sends nothing back): what was missing is on the board's ROS 2 side.
+        if not report.likely or self.profile.streams_unasked:
+            # Nothing wrong on the line (an LD06/LD19's line cannot tell, even after
+            # streaming for a while: its driver sends nothing back): what was missing
+            # is on the board's ROS 2 side.
             quiet = (
                 "an LD06/LD19 driver sends nothing back, so the line cannot tell"
                 if self.profile.streams_unasked
@@ -180,14 +190,14 @@ class BoardLink(Ros2Link):
         )
 
     def node_gone(self, when: str = "") -> str | None:
-        if self.server is not None and self.server.error is not None:
-            return f"{self.profile.name} line: {self.server.error}"
-        if self.driver is not None and self.driver.returncode() is not None:
-            return f"the board's LIDAR driver {self.driver.exit_summary(when)}"
+        gone = self.session.gone(when) if self.session is not None else None
+        if gone is not None:
+            return gone
         return None if self.physical else super().node_gone(when)
 
     def damage_line(self, damage: LineDamage) -> None:
-        """Line faults: the device's revolutions reach the driver damaged from now on.
+        """Line faults: the device's revolutions reach the driver damaged from now on
+        (until this scenario ends).
 
         A revolution the driver then publishes no scan of is lost, not a
         broken link: the node had nothing to answer.
@@ -203,45 +213,151 @@ class BoardLink(Ros2Link):
         obs = self.observer
         obs.publish_clock(scan.stamp if clock is None else clock)
         rate = 1.0 / scan.scan_time if scan.scan_time > 0 else self.options.scan_rate_hz
-        samples = self.profile.revolution(self.device, scan, rate, scan.range_max)
-        pushed = time.time_ns()
-        self.server.send_revolution(samples, tick, 1.0 / rate)  # real time: its own period
+        samples = self.profile.revolution(self.device, scan, rate, scan.range_max, mount=self.mount)
+        returns = sum(1 for sample in samples if sample.distance_mm > 0)
         self._seen, self._delivery_problem, self._lost = None, None, None
+        if not self._pushed:  # this scenario's first revolution: the idle stream ends
+            self._pushed = True
+            self._after_idle_stream(rate)
+        written_ns = self._push(samples, tick, rate)
+        if written_ns is None:
+            return time.time_ns()
 
         def driver_scan() -> Any:
-            return next((h for h in obs.inbox if h.kind == "scan" and h.source_ns >= pushed), None)
+            return next(
+                (h for h in obs.inbox if h.kind == "scan" and h.source_ns >= written_ns), None
+            )
 
-        deadline = time.perf_counter() + max(self.options.scan_timeout, 1.0 / rate)
+        wait = max(self.options.scan_timeout, 1.0 / rate)
+        sparse = returns <= SPARSE_RETURNS
+        if sparse:  # the board may never publish it: do not wait a whole deadline
+            skips = self.session.skips_sparse
+            wait = 0.0 if skips else min(wait, max(2.0 / rate, SPARSE_WAIT_S))
+        deadline = time.perf_counter() + wait
         while (heard := driver_scan()) is None:
             gone = self.node_gone()
             if gone or time.perf_counter() >= deadline:
-                missing = (
-                    f"the board's driver published no {self.options.scan_topic} for this "
-                    "revolution in time"
-                )
-                self._lost_in_a_row += 1
-                if not gone and self._line_damage is not None:
-                    if self._lost_in_a_row < LOST_IN_A_ROW:
-                        self._lost = f"{missing} (damaged on the line)"
-                        return time.time_ns()
-                    missing = (
-                        f"the board's driver published no {self.options.scan_topic} for "
-                        f"{self._lost_in_a_row} revolutions in a row (line faults lose some, "
-                        "not all)"
+                if not gone and sparse:
+                    # A board that skipped one such turn is taken to skip them all: the
+                    # next are not waited for (a scan that comes after all is told
+                    # apart by time, and not judged).
+                    self.session.skips_sparse = True
+                    self._lost = (
+                        f"the board published no {self.options.scan_topic} of this revolution: "
+                        f"it had {returns} return{'' if returns == 1 else 's'}, and a driver may "
+                        f"skip so sparse a turn (rplidar's iter_scans skips {SPARSE_RETURNS} or "
+                        "fewer)"
                     )
-                if not gone and self.physical:
-                    missing += f" (on the line: {self.line_report()})"
-                self._delivery_problem = gone or missing
-                return time.time_ns()
+                    return time.time_ns()
+                return self._no_driver_scan(gone)
             obs.spin(min(POLL_S, deadline - time.perf_counter()))
+        if sparse:
+            self.session.skips_sparse = False
+        self._not_this_revolution(written_ns)
         self._seen = heard.value
         self._scans_from = heard.source_ns
+        if tick >= 0 and not self._gap_measured:  # this scenario's first judged revolution
+            self._gap_measured = True
+            if self.session.judged_at is not None:  # the scenario before judged one
+                self.gap_s = time.perf_counter() - self.session.judged_at
         if self._lost_in_a_row:
             # The last revolution made no scan in time: this one may be it, late (the
             # line ate what closed it), with this revolution's own scan just behind.
             self._wait_for(lambda: len(self._driver_scans()) >= 2, LATE_SCAN_WAIT_S)
         self._lost_in_a_row = 0
         return heard.source_ns
+
+    def warm_up(self, scan: Scan) -> None:
+        """As the ros2 link's; then the stream ends on a whole start marker, so the
+        scenario's revolutions are the same bytes however many warm-up pushes it took."""
+        super().warm_up(scan)
+        assert self.server is not None
+        self.server.align_stream()
+
+    def _reached_node(self) -> bool:
+        return self._lost is None  # a revolution the board published no scan of: lost
+
+    def _after_idle_stream(self, rate: float) -> None:
+        """Lockstep: stop the session's idle stream and let the driver's scan of its last
+        revolution come first, so it is never taken for this scenario's."""
+        assert self.session is not None and self.observer is not None
+        since = self.session.end_idle()
+        if since is None:
+            return
+        obs = self.observer
+
+        def idle_scan() -> bool:
+            return any(h.kind == "scan" and h.source_ns >= since for h in obs.inbox)
+
+        self._wait_for(idle_scan, max(self.options.scan_timeout, 1.0 / rate))
+
+    def _push(self, samples: list[Any], tick: int, rate: float) -> int | None:
+        """Queue the revolution and wait (bounded) until it went out whole; the system time
+        before its last write, or None (the reason kept in `_delivery_problem`).
+
+        A device the board's driver stopped (a driver restarting: STOP, RESET,
+        ... SCAN) is waited for, as long as a board may take to come up, and
+        the revolution goes out again once it scans.
+        """
+        assert self.server is not None and self.observer is not None
+        server, period = self.server, 1.0 / rate
+        push = server.send_revolution(samples, tick, period)
+        limit = self.options.scan_timeout + (3 * period if server.mode == "realtime" else 0.0)
+        deadline = time.perf_counter() + limit
+        while (delivery := server.delivery_of(push)) is None:
+            gone = self.node_gone()
+            if gone is not None:
+                self._delivery_problem = gone
+                return None
+            if not self.profile.streams_unasked and self.device.mode == "idle":
+                if not server.wait_until(lambda d: d.mode != "idle", self.options.ready_timeout):
+                    self._delivery_problem = (
+                        f"the device stopped scanning and the board's driver did not ask "
+                        f"again within {self.options.ready_timeout:g} s (on the line: "
+                        f"{self.line_report()})"
+                    )
+                    return None
+                push = server.send_revolution(samples, tick, period)
+                deadline = time.perf_counter() + limit
+            elif time.perf_counter() >= deadline:
+                self._delivery_problem = (
+                    f"the device could not send this revolution within {limit:.2f} s "
+                    f"(on the line: {self.line_report()})"
+                )
+                return None
+            self.observer.spin(POLL_S / 5)
+        return delivery.written_ns
+
+    def _no_driver_scan(self, gone: str | None) -> int:
+        """No driver scan of the revolution in time: lost on a damaged line, else a failure."""
+        missing = (
+            f"the board's driver published no {self.options.scan_topic} for this revolution in time"
+        )
+        self._lost_in_a_row += 1
+        if not gone and self._line_damage is not None:
+            if self._lost_in_a_row < LOST_IN_A_ROW:
+                self._lost = f"{missing} (damaged on the line)"
+                return time.time_ns()
+            missing = (
+                f"the board's driver published no {self.options.scan_topic} for "
+                f"{self._lost_in_a_row} revolutions in a row (line faults lose some, "
+                "not all)"
+            )
+        if not gone and self.physical:
+            missing += f" (on the line: {self.line_report()})"
+        self._delivery_problem = gone or missing
+        return time.time_ns()
+
+    def _not_this_revolution(self, written_ns: int) -> None:
+        """Driver scans of revolutions the device sent on its own (a repeat while the
+        harness was late) came before this one's: answers to them answer no tick."""
+        assert self.observer is not None
+        others = sorted(
+            h.source_ns
+            for h in self.observer.inbox
+            if h.kind == "scan" and self._scans_from < h.source_ns < written_ns
+        )
+        self._sends = [*self._sends, *((None, ns) for ns in others)]
 
     def _driver_scans(self) -> list[Heard]:
         """The driver's scans since this revolution went down the line, oldest first."""
@@ -279,6 +395,8 @@ class BoardLink(Ros2Link):
         answers.lost = self._lost
         if self._delivery_problem and answers.problem is None:
             answers.problem = self._delivery_problem
+        if self.session is not None:
+            self.session.judged_at = time.perf_counter()
         return answers
 
     def _sort(self, answers: Answers, heard: Any, mine: Any) -> None:
@@ -289,24 +407,29 @@ class BoardLink(Ros2Link):
     # -- reporting and teardown ---------------------------------------------
     def diagnostics(self) -> str:
         parts = [super().diagnostics()] if not self.physical else []
-        if self.driver is not None:
-            for which in ("stderr", "stdout"):
-                tail = self.driver.tail(which)
-                if tail:
-                    parts.append(f"board driver {which} (last lines):\n{tail}")
+        if self.session is not None:
+            parts.append(self.session.diagnostics())
         return "\n".join(p for p in parts if p)
 
+    def stop(self) -> None:
+        """The scenario is over: the device streams on (the run's session), the node stops."""
+        if self.session is not None and not self._own_session:
+            if self.server is not None:
+                self.server.damage = None  # line faults are the scenario's
+            self.session.between()
+        super().stop()
+
     def close(self) -> None:
-        if self.server is not None:
-            try:
-                self.server.close()
-            except LinkError:
-                pass  # already reported by the exchange that met it
+        self.stop()
         super().close()
-        if self.driver is not None:
-            self.driver.stop()
-        if self.port is not None:
-            self.port.close()
+        if self.session is not None and self._own_session:
+            self.session.close()
+
+    def stop_note(self) -> str:
+        notes = [super().stop_note()]
+        if self.session is not None and self._own_session:
+            notes.append(self.session.stop_note())
+        return "\n".join(n for n in notes if n)
 
 
 def _pair_with_driver_scans(answers: Answers, scans: list[Heard]) -> None:

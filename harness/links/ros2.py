@@ -109,7 +109,8 @@ class Ros2Link(Link):
         self.domain: DomainReservation | None = None
         self._sent_ns: int = 0
         self._sent_at: float = 0.0
-        self._sends: list[tuple[int, int]] = []  # (tick, sent_ns) of recent scans
+        # (tick, sent_ns) of recent scans; tick None: a scan no tick sent (a board's repeat)
+        self._sends: list[tuple[int | None, int]] = []
         self._started_at: float | None = None  # real time: when scan 0 went out
         self._delay = 0.0  # seconds the next scan is held (link fault)
         self._bool_first_seen = 0
@@ -265,6 +266,10 @@ class Ros2Link(Link):
         assert self.observer is not None
         return self.observer.publish(scan, clock=clock)
 
+    def _reached_node(self) -> bool:
+        """Did the scan `_deliver` just sent reach the node? (A board may drop one.)"""
+        return True
+
     def warm_up(self, scan: Scan) -> None:
         """Exchange the first scan until the node's answer reaches us, then forget it.
 
@@ -277,6 +282,8 @@ class Ros2Link(Link):
         deadline = time.perf_counter() + opts.ready_timeout
         while True:
             sent_ns = self._deliver(scan, -1)
+            if not self._reached_node():
+                break  # no answer can come (a board that published no scan of it)
 
             def answered(since: int = sent_ns) -> bool:
                 return obs.heard_since("status", since)

@@ -43,28 +43,29 @@ def reference_node() -> NodeCommand:
     )
 
 
-def shell_node(command: str) -> NodeCommand:
-    """A user's command line, e.g. ``python3 my_node.py``, split like a shell does."""
+def shell_node(command: str, *, option: str = "--node") -> NodeCommand:
+    """A user's command line, e.g. ``python3 my_node.py``, split like a shell does;
+    errors name `option`, the option that gave it."""
     try:
         argv = shlex.split(command)
     except ValueError as err:
-        raise ConfigError(f"--node {command!r}: {err}") from None
+        raise ConfigError(f"{option} {command!r}: {err}") from None
     if not argv:
-        raise ConfigError("--node: the command is empty")
+        raise ConfigError(f"{option}: the command is empty")
     program = argv[0]
     if program.endswith(".py") and Path(program).is_file():  # as grade runs a script
         argv = [sys.executable, *argv]
         program = argv[0]
     if "/" in program:
         if not Path(program).is_file():
-            raise ConfigError(f"--node {command!r}: no such file {program}")
+            raise ConfigError(f"{option} {command!r}: no such file {program}")
         if not os.access(program, os.X_OK):
-            raise ConfigError(f"--node {command!r}: {program} is not executable")
+            raise ConfigError(f"{option} {command!r}: {program} is not executable")
     elif shutil.which(program) is None:
-        raise ConfigError(f"--node {command!r}: {program!r} not found on PATH")
+        raise ConfigError(f"{option} {command!r}: {program!r} not found on PATH")
     script = _script_of(argv)
     if script is not None and not Path(script).is_file():
-        raise ConfigError(f"--node {command!r}: no such script {script}")
+        raise ConfigError(f"{option} {command!r}: no such script {script}")
     return NodeCommand(tuple(argv), description=command)
 
 

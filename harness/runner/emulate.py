@@ -27,6 +27,7 @@ import numpy as np
 from harness.devices.profiles import DeviceProfile
 from harness.errors import ConfigError, Interrupted
 from harness.faults.link import LINE_KINDS, LinkFaults, scan_periods
+from harness.lidar.mount import FORWARD, LidarMount
 from harness.runner.settings import RunSettings, effective_seed, fault_profile
 from harness.scenario.schema import Scenario
 
@@ -197,8 +198,10 @@ def emulate(
     announce: Callable[[str], None] = print,
     verbose: bool = False,
     status_every_s: float = STATUS_EVERY_S,
+    mount: LidarMount = FORWARD,
 ) -> EmulationSummary:
-    """Serve every revolution of `scenario` in real time until it ends or is stopped.
+    """Serve every revolution of `scenario` in real time until it ends or is stopped;
+    `mount` says where the device's zero points on the robot.
 
     Ctrl-C or SIGTERM (``KeyboardInterrupt``) stops it like the scenario's
     end: the summary says which.
@@ -253,7 +256,9 @@ def emulate(
                         log.line(status_line(server.stats()))
                         status_due += status_every_s
                 scan = faults.emit(tick.truth, spec, rng, stamp=tick.t)
-                samples = profile.revolution(device, scan, 1.0 / tick.period, spec.range_max)
+                samples = profile.revolution(
+                    device, scan, 1.0 / tick.period, spec.range_max, mount=mount
+                )
                 revolutions += 1  # first: a stop may come inside send_revolution
                 server.send_revolution(samples, tick.tick, tick.period)
             server.wait_idle(IDLE_WAIT_S)

@@ -7,7 +7,7 @@ differs.
 from __future__ import annotations
 
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import replace
 from typing import TYPE_CHECKING
 
@@ -19,8 +19,9 @@ from harness.faults.link import (
 )
 from harness.faults.sensor import FaultProfile
 from harness.judge.records import RunResult, TickRecord
+from harness.lidar.mount import FORWARD
 from harness.lidar.scan import Scan
-from harness.links.base import Link, LinkOptions, create_link
+from harness.links.base import Link, LinkOptions, create_link, link_class
 from harness.runner.frames import Frame, check_link_faults, judge_frames
 from harness.runner.settings import (
     RunSettings,
@@ -128,8 +129,12 @@ def run_through(
 
 
 def closed(result: RunResult, link: Link, waited: float) -> None:
-    """The link is closed: the time waited for it, and how its stop went, join the result."""
+    """The link is closed: the time waited for it, and how its stop went, join the result
+    (and, on a serial link, the device's mount and the gap since the scenario before)."""
     result.stop_s = waited
+    result.gap_s = link.gap_s
+    if link.serial_line:
+        result.lidar_mount = link.options.lidar_mount or FORWARD
     note = link.stop_note()
     if note:
         result.diagnostics = "\n".join(part for part in (result.diagnostics, note) if part)
@@ -141,6 +146,26 @@ def scenario_options(
     """The link options for one scenario: its threshold and its LIDAR's rate."""
     threshold = effective_threshold(scenario, settings)
     return replace(options, threshold=threshold, scan_rate_hz=scenario.lidar_spec.rate_hz)
+
+
+def run_mount(scenarios: Sequence[Scenario], options: LinkOptions) -> LinkOptions:
+    """`options` with the device's mount for the run: the option's, else what the robot
+    model says. A serial link plays one device on one robot for the whole run, so the
+    scenarios' models must agree (ConfigError naming the two when they do not)."""
+    if options.lidar_mount is not None or not scenarios:
+        return options
+    from harness.scenario.mount import scenario_mount
+
+    mounts = [(scenario_mount(s), s) for s in scenarios]
+    mount, first = mounts[0]
+    for other, scenario in mounts[1:]:
+        if other != mount:
+            raise ConfigError(
+                f"{scenario.source}: its robot model mounts the LIDAR {other.describe()}, but "
+                f"{first.source}'s {mount.describe()}; one device serves the whole run: "
+                "run them apart, or give --lidar-mount"
+            )
+    return replace(options, lidar_mount=mount)
 
 
 def not_started_as(
@@ -172,6 +197,8 @@ def run(
     A link that cannot bring the software under test up gives a result with
     the reason and ``not_started`` set, not an exception.
     """
+    if link_class(link_name).serial_line:
+        options = run_mount([scenario], options)
     return with_link(
         link_name,
         scenario_options(scenario, options, settings),

@@ -16,6 +16,7 @@ from harness.runner.link_pipeline import LinkPipeline
 from harness.runner.scenario_run import (
     closed,
     not_started_as,
+    run_mount,
     run_scenario,
     run_through,
     scenario_options,
@@ -38,8 +39,10 @@ def run_suite(
 
     Where links can overlap (their own ROS domains), the next scenarios'
     links start while one runs and finished ones stop behind it
-    (``harness.runner.link_pipeline``). Once the software under test fails to come
-    up, the rest are marked not run instead of each waiting out its start.
+    (``harness.runner.link_pipeline``). What the links share for the whole run
+    (a serial link's device, line and board software) is their class's
+    ``run_session``. Once the software under test fails to come up, the rest
+    are marked not run instead of each waiting out its start.
     """
     results: list[RunResult] = []
 
@@ -48,11 +51,19 @@ def run_suite(
         if on_result is not None:
             on_result(result)
 
-    def make(index: int) -> Link:
-        return create_link(link_name, scenario_options(scenarios[index], options, settings))
+    if not scenarios:
+        return results
+    cls = link_class(link_name)
+    cls.prepare(options)
+    if cls.serial_line:  # one device on one robot serves the whole run
+        options = run_mount(scenarios, options)
+    first = scenario_options(scenarios[0], options, settings)
+    with fork_servers(), _explicit_domain(link_name, options), cls.run_session(first) as session:
 
-    link_class(link_name).prepare(options)
-    with fork_servers(), _explicit_domain(link_name, options):
+        def make(index: int) -> Link:
+            link_options = scenario_options(scenarios[index], options, settings)
+            return create_link(link_name, link_options, session)
+
         pipeline = LinkPipeline(make, len(scenarios), overlap=_links_overlap(link_name, options))
         failed_start: str | None = None
         index = 0

@@ -275,6 +275,7 @@ class DeviceServer:
         self._idle_due = 0.0
         self._idle_request: tuple[Sequence[Any], float] | None = None  # held samples, period
         self._idle_quiet = threading.Event()  # the thread saw the idle stream end
+        self._whole_marker_pending = False  # end the stream on a whole start marker, first
         self._next_due: float | None = None  # realtime: nominal start of the next revolution
         self._was_streaming = self._streaming()
         self._dtr: bool | None = None
@@ -386,30 +387,42 @@ class DeviceServer:
             if samples is not None:
                 self._idle_request = (list(samples), period_s or self.period_s)
             self._idling = self.mode == "lockstep"
-            self._idle_quiet.clear()
         self._wake()
 
     def end_idle(self, timeout: float) -> Delivery | None:
         """Continuous lockstep: stop the idle stream before the next push; wait (at most
         `timeout` s) until the revolution it was writing is out. Returns the last
         repeat written since the last push (its driver scan comes before the
-        push's), or None."""
+        push's), or None.
+
+        The stream then ends on a whole start marker (one packet of an LD06's,
+        one node of an A1's), however many idle revolutions went out, so the
+        bytes of the pushes that follow do not depend on how long the idle
+        stream ran (same seed, same bytes, line damage included).
+        """
         self._check()
         with self._lock:
             was = self._idling
             self._idling = False
-        if self.mode != "lockstep":
-            return None
-        if was:
-            self._wake()
-            self._idle_quiet.wait(max(0.0, timeout))
-            self._check()
+            if not (was and self.mode == "lockstep"):
+                return None
+            self._whole_marker_pending = True
+            self._idle_quiet.clear()
+        self._wake()
+        self._idle_quiet.wait(max(0.0, timeout))
+        self._check()
         with self._lock:
-            for delivery in reversed(self._deliveries):
-                if not delivery.repeat:
-                    return None
-                return delivery
-        return None
+            last = self._deliveries[-1] if self._deliveries else None
+        return last if last is not None and last.repeat else None
+
+    def align_stream(self) -> None:
+        """Lockstep: end what was sent so far on a whole start marker before the next push,
+        so the pushes that follow are the same bytes however many went before (a warm-up
+        retried, say); see ``end_idle``."""
+        self._check()
+        with self._lock:
+            self._whole_marker_pending = self.mode == "lockstep"
+        self._wake()
 
     def delivery_of(self, push_id: int) -> Delivery | None:
         """When the pushed revolution `push_id` went out whole, or None (not yet, or never)."""
@@ -573,8 +586,6 @@ class DeviceServer:
 
     def _step(self) -> None:
         now = time.monotonic()
-        if not self._idling and not (self._current is not None and self._current[3]):
-            self._idle_quiet.set()  # end_idle: no repeat in flight
         self._poll_dtr(now)
         self._housekeeping(now)
         self._next_revolution(now)
@@ -724,11 +735,15 @@ class DeviceServer:
     def _next_revolution(self, now: float) -> None:
         if self._stream:
             return
-        with self._lock:
+        with self._lock:  # a whole marker asked for goes before anything pushed after it
+            whole, self._whole_marker_pending = self._whole_marker_pending, False
             due = self.mode == "lockstep" or self._next_due is None or now >= self._next_due
             item = self._inbox.popleft() if self._inbox and due else None
             request, self._idle_request = self._idle_request, None
             idling = self._idling
+        if whole:
+            self._whole_marker(now)
+            self._idle_quiet.set()
         if request is not None:  # the revolution to stream while nothing new comes
             self._last_samples, self._last_period = request
             if idling:
@@ -767,6 +782,13 @@ class DeviceServer:
         if not self._marker_sent:
             return self._next_due
         return self._marker_at + self._last_period / 2
+
+    def _whole_marker(self, now: float) -> None:
+        """End the stream on a start marker of a whole unit (see ``end_idle``)."""
+        if self._last_samples is None or not self._streaming():
+            return
+        if not self._marker_sent or self._marker_size != self._unit():
+            self._append_marker(self._last_samples, self._last_tick + 1, now)
 
     def _repeat(self, now: float) -> None:
         """Send the last revolution again (the device keeps scanning the same world)."""

@@ -21,6 +21,7 @@ from third_party import roboticia_site
 from harness.devices.revolution import device_angle_deg, encode_distances_mm
 from harness.runner.settings import RunSettings, fault_profile
 from harness.scenario.files import resolve_scenario
+from harness.scenario.mount import scenario_mount
 from harness.sim.simulation import Simulation
 
 pytestmark = pytest.mark.timeout(90)
@@ -40,7 +41,7 @@ def simulated_revolutions() -> list[np.ndarray]:
     with Simulation(scenario) as sim:
         for tick in sim.ticks():
             scan = faults.emit(tick.truth, spec, rng, stamp=tick.t)
-            angles = np.asarray(device_angle_deg(scan.angles()))
+            angles = np.asarray(device_angle_deg(scan.angles(), scenario_mount(scenario)))
             distances = encode_distances_mm(scan.ranges, spec.range_max)
             revolutions.append(np.column_stack([angles, distances])[distances > 0])
     return revolutions
