@@ -8,17 +8,13 @@ same test against real hardware is tests/hil (run with --hil-port).
 
 from __future__ import annotations
 
-import os
 import subprocess
 import sys
 import time
-from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
-from pty_clients import NullModem
-
-from harness.ros.domain import reserve_domain
+from far_end import REFERENCE_NODE, FarEnd, bundled_driver
 
 pytestmark = [pytest.mark.ros, pytest.mark.timeout(120)]
 
@@ -29,82 +25,7 @@ SHORT = (
 )
 
 
-def holds_open(pid: int, path: str) -> bool:
-    """Whether process `pid` has `path` open (from /proc)."""
-    fds = Path(f"/proc/{pid}/fd")
-    try:
-        return any(os.path.realpath(fd) == path for fd in fds.iterdir())
-    except OSError:
-        return False
-
-
-class Board:
-    """The far end of the cable: the board's LIDAR driver and lab node, in their domain.
-
-    As with a real board, its driver is (re)started once the harness holds
-    the adapter open: requests sent to a line nobody listens on are lost.
-    """
-
-    def __init__(self, cable: NullModem, domain_id: int, logs: Path) -> None:
-        self.cable, self.domain_id, self.logs = cable, domain_id, logs
-        self.processes: list[subprocess.Popen[bytes]] = []
-
-    def start_when_harness_listens(self, harness: subprocess.Popen[str]) -> None:
-        deadline = time.monotonic() + 30
-        while not holds_open(harness.pid, self.cable.harness_end):
-            assert harness.poll() is None, "the harness exited before opening the port"
-            assert time.monotonic() < deadline, "the harness never opened the port"
-            time.sleep(0.05)  # polling an observable condition, bounded
-        env = {
-            **os.environ,
-            "ROS_DOMAIN_ID": str(self.domain_id),
-            "ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST",
-        }
-        for name, argv in (
-            (
-                "driver",
-                [
-                    "harness.board_driver.rplidar_node",
-                    "--ros-args",
-                    "-p",
-                    f"port:={self.cable.board_end}",
-                    "-p",
-                    "timeout:=30.0",
-                ],
-            ),
-            ("node", ["harness.reference.lidar_node"]),
-        ):
-            with open(self.logs / f"{name}.log", "wb") as log:
-                self.processes.append(
-                    subprocess.Popen(
-                        [sys.executable, "-m", *argv],
-                        env=env,
-                        stdout=subprocess.DEVNULL,
-                        stderr=log,
-                    )
-                )
-
-    def stop(self) -> None:
-        for process in self.processes:
-            process.terminate()
-        for process in self.processes:
-            process.wait(timeout=10)
-
-
-@pytest.fixture
-def board(tmp_path: Path) -> Iterator[Board]:
-    cable = NullModem()
-    reservation = reserve_domain()
-    board = Board(cable, reservation.domain_id, tmp_path)
-    try:
-        yield board
-    finally:
-        board.stop()
-        cable.cut()
-        reservation.release()
-
-
-def start_harness(board: Board, scenario: Path) -> subprocess.Popen[str]:
+def start_harness(far_end: FarEnd, scenario: Path) -> subprocess.Popen[str]:
     return subprocess.Popen(
         [
             sys.executable,
@@ -115,9 +36,9 @@ def start_harness(board: Board, scenario: Path) -> subprocess.Popen[str]:
             "--link",
             "rplidar",
             "--port",
-            board.cable.harness_end,
+            far_end.cable.harness_end,
             "--domain-id",
-            str(board.domain_id),
+            str(far_end.domain_id),
         ],
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
@@ -125,26 +46,26 @@ def start_harness(board: Board, scenario: Path) -> subprocess.Popen[str]:
     )
 
 
-def test_run_against_a_board_on_a_serial_port(board: Board, tmp_path: Path) -> None:
+def test_run_against_a_board_on_a_serial_port(far_end: FarEnd, tmp_path: Path) -> None:
     """--port with --domain-id: real-time emulation into the board, its answers judged."""
     scenario = tmp_path / "facing_wall.yaml"
     scenario.write_text(SHORT)
-    harness = start_harness(board, scenario)
-    board.start_when_harness_listens(harness)
+    harness = start_harness(far_end, scenario)
+    far_end.start(harness, bundled_driver(far_end.cable.board_end), REFERENCE_NODE)
     out, err = harness.communicate(timeout=90)
     assert harness.returncode == 0, out + err
     assert "1 of 1 scenario passed" in out
 
 
-def test_unplugged_adapter_fails_the_run_promptly(board: Board, tmp_path: Path) -> None:
+def test_unplugged_adapter_fails_the_run_promptly(far_end: FarEnd, tmp_path: Path) -> None:
     """Pulling the cable mid-run ends the run with a clear message, not a hang."""
     scenario = tmp_path / "long.yaml"
     scenario.write_text(SHORT.replace("duration: 2.0", "duration: 30.0"))
-    harness = start_harness(board, scenario)
-    board.start_when_harness_listens(harness)
+    harness = start_harness(far_end, scenario)
+    far_end.start(harness, bundled_driver(far_end.cable.board_end), REFERENCE_NODE)
     time.sleep(6.0)  # the run is under way by then (not synchronisation: any moment will do)
     cut_at = time.monotonic()
-    board.cable.cut()
+    far_end.cable.cut()
     out, err = harness.communicate(timeout=30)
     elapsed = time.monotonic() - cut_at
     assert harness.returncode == 1, out + err
@@ -175,7 +96,7 @@ def test_unplugged_adapter_fails_the_run_promptly(board: Board, tmp_path: Path) 
     ],
 )
 def test_a_board_that_never_answers_is_told_what_went_down_the_line(
-    board: Board, tmp_path: Path, link: str, expected: list[str]
+    far_end: FarEnd, tmp_path: Path, link: str, expected: list[str]
 ) -> None:
     """Nothing on the far end: the error says what was sent, that nothing came back, and
     why; an LD06/LD19 line says nothing back, so its error names the ROS 2 side."""
@@ -184,7 +105,7 @@ def test_a_board_that_never_answers_is_told_what_went_down_the_line(
     harness = subprocess.run(
         [
             *(sys.executable, "-m", "harness.cli", "run", str(scenario), "--link", link),
-            *("--port", board.cable.harness_end, "--domain-id", str(board.domain_id)),
+            *("--port", far_end.cable.harness_end, "--domain-id", str(far_end.domain_id)),
             *("--ready-timeout", "2"),
         ],
         capture_output=True,
@@ -194,4 +115,4 @@ def test_a_board_that_never_answers_is_told_what_went_down_the_line(
     text = harness.stdout + harness.stderr
     assert harness.returncode == 1, text
     for line in expected:
-        assert line.format(domain=board.domain_id) in text, text
+        assert line.format(domain=far_end.domain_id) in text, text

@@ -21,16 +21,11 @@ import os
 import socket
 import subprocess
 import sys
-import time
-from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
-from pty_clients import NullModem
+from far_end import REFERENCE_NODE, FarEnd, bundled_driver
 from third_party import roboticia_site
-
-from harness.ros.domain import reserve_domain
-from harness.serial_line.modem_lines import client_environment
 
 pytestmark = [pytest.mark.ros, pytest.mark.slow, pytest.mark.timeout(420)]
 
@@ -124,12 +119,13 @@ def wall_ahead_angles(out: Path) -> list[float]:
     return [math.remainder(a, 2 * math.pi) for a in angles]
 
 
-def assert_whole_suite_passed(text: str, out: Path) -> dict:
-    """Every shipped scenario passed in one run, one device session across them."""
-    assert f"{DEFAULT_SUITE} of {DEFAULT_SUITE} scenarios passed" in text, text
+def assert_whole_suite_passed(text: str, out: Path, count: int = DEFAULT_SUITE) -> dict:
+    """Every scenario (all shipped ones by default) passed in one run, one device
+    session across them."""
+    assert f"{count} of {count} scenarios passed" in text, text
     data = summary(out)
     entries = data["scenarios"]
-    assert [e["verdict"] for e in entries] == ["PASS"] * DEFAULT_SUITE, text
+    assert [e["verdict"] for e in entries] == ["PASS"] * count, text
     # One device for the run: every scenario after the first followed the one before.
     assert entries[0]["gap_s"] is None
     assert all(e["gap_s"] is not None and e["gap_s"] >= 0 for e in entries[1:]), entries
@@ -195,75 +191,9 @@ def test_a_misaligned_bridge_is_named(
 # -- the same chain on the far end of a cable (--port) --------------------------------
 
 
-class FarEnd:
-    """The board at the other end of a pty null-modem cable, in its ROS domain: started
-    once the harness holds the port open, as a board's driver must be."""
-
-    def __init__(self, cable: NullModem, domain_id: int, folder: Path) -> None:
-        self.cable, self.domain_id, self.folder = cable, domain_id, folder
-        self.processes: list[subprocess.Popen[bytes]] = []
-
-    def start(self, harness_process: subprocess.Popen[str], *argvs: list[str]) -> None:
-        deadline = time.monotonic() + 60
-        while not holds_open(harness_process.pid, self.cable.harness_end):
-            assert harness_process.poll() is None, "the harness exited before opening the port"
-            assert time.monotonic() < deadline, "the harness never opened the port"
-            time.sleep(0.05)  # polling an observable condition, bounded
-        env = {
-            **os.environ,
-            "ROS_DOMAIN_ID": str(self.domain_id),
-            "ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST",
-        }
-        # A pty has no modem lines: the documented environment makes the board's
-        # pyserial calls on it succeed (they go nowhere: --port cannot carry them).
-        env.update(client_environment(self.cable.board_end, None, env))
-        for index, argv in enumerate(argvs):
-            own = with_roboticia(env) if str(AGENT) in argv else env  # only the agent's library
-            with open(self.folder / f"board{index}.log", "wb") as log:
-                self.processes.append(
-                    subprocess.Popen(argv, env=own, stdout=log, stderr=subprocess.STDOUT)
-                )
-
-    def logs(self) -> str:
-        return "\n".join(p.read_text(errors="replace") for p in self.folder.glob("board*.log"))
-
-    def stop(self) -> None:
-        for process in self.processes:
-            process.terminate()
-        for process in self.processes:
-            try:
-                process.wait(timeout=10)
-            except subprocess.TimeoutExpired:
-                process.kill()
-                process.wait(timeout=5)
-
-
-def holds_open(pid: int, path: str) -> bool:
-    """Whether process `pid` has `path` open (from /proc)."""
-    try:
-        return any(os.path.realpath(fd) == path for fd in Path(f"/proc/{pid}/fd").iterdir())
-    except OSError:
-        return False
-
-
-@pytest.fixture
-def far_end(tmp_path: Path) -> Iterator[FarEnd]:
-    cable = NullModem()
-    reservation = reserve_domain()
-    board = FarEnd(cable, reservation.domain_id, tmp_path)
-    try:
-        yield board
-    finally:
-        board.stop()
-        cable.cut()
-        reservation.release()
-
-
-REFERENCE_NODE = [sys.executable, "-m", "harness.reference.lidar_node"]
-
-
-def port_run(far_end: FarEnd, out: Path) -> subprocess.Popen[str]:
+def port_run(far_end: FarEnd, out: Path, *scenarios: str) -> subprocess.Popen[str]:
     return harness(
+        *scenarios,
         *("--link", "rplidar", "--port", far_end.cable.harness_end, "--out", str(out)),
         *("--domain-id", str(far_end.domain_id), "--ready-timeout", "60"),
         # The board's node keeps its own threshold (0.5 m, the lab's default) for the whole
@@ -278,7 +208,13 @@ def test_v2_chain_runs_the_whole_suite_over_a_serial_port(far_end: FarEnd, tmp_p
     chain = V2Chain(tmp_path)
     out = tmp_path / "report"
     run = port_run(far_end, out)
-    far_end.start(run, chain.agent(far_end.cable.board_end), chain.bridge(), REFERENCE_NODE)
+    far_end.start(
+        run,
+        chain.agent(far_end.cable.board_end),
+        chain.bridge(),
+        REFERENCE_NODE,
+        env_for=lambda argv, env: with_roboticia(dict(env)) if str(AGENT) in argv else env,
+    )
     text = finished(run)
     assert run.returncode == 0, text + far_end.logs()
     assert_whole_suite_passed(text, out)
@@ -289,17 +225,14 @@ def test_bundled_driver_runs_the_whole_suite_over_a_serial_port(
     far_end: FarEnd, tmp_path: Path
 ) -> None:
     """The bundled board driver with its defaults (the v2 bridge's mapping) on the far
-    end: the same whole run."""
+    end: one device across scenarios (two of them: the whole suite in real time is the
+    v2 chain's test above; the bundled driver's whole suite runs on the virtual board)."""
     out = tmp_path / "report"
-    run = port_run(far_end, out)
-    driver = [
-        *(sys.executable, "-m", "harness.board_driver.rplidar_node", "--ros-args"),
-        *("-p", f"port:={far_end.cable.board_end}", "-p", "timeout:=30.0"),
-    ]
-    far_end.start(run, driver, REFERENCE_NODE)
+    run = port_run(far_end, out, "approach_wall", "rotate_beside_wall")
+    far_end.start(run, bundled_driver(far_end.cable.board_end), REFERENCE_NODE)
     text = finished(run)
     assert run.returncode == 0, text + far_end.logs()
-    assert_whole_suite_passed(text, out)
+    assert_whole_suite_passed(text, out, count=2)
 
 
 # -- the bundled driver on the virtual board (lockstep) ---------------------------------
