@@ -38,6 +38,7 @@ if TYPE_CHECKING:
     from harness.serial_line.server import DeviceServer
 
 PORT_FIELD = "{port}"
+DRIVER = "board driver"  # the bundled driver's description starts so
 END_IDLE_S = 1.0  # lockstep: for the idle stream's last revolution to be written
 
 
@@ -166,7 +167,7 @@ class BoardSession:
         """The bundled board driver, started anew (not forked: its modem lines come from
         the interpreter's start-up, as for the board's own software)."""
         module = self.profile.driver_module
-        return NodeCommand((sys.executable, "-m", module), description=f"board driver {module}")
+        return NodeCommand((sys.executable, "-m", module), description=f"{DRIVER} {module}")
 
     def _driver_arguments(self, path: str) -> list[str]:
         """The bundled driver's parameters: this device, this mount, a bounded read wait."""
@@ -223,12 +224,13 @@ class BoardSession:
             return f"{self.profile.name} line: {self.server.error}"
         for process in self.processes:
             if process.returncode() is not None:
-                return f"the board's {self._name(process)} {process.exit_summary(when)}"
+                return f"{self._name(process)} {process.exit_summary(when)}"
         return None
 
     def _name(self, process: NodeProcess) -> str:
+        """For messages: "the board's LIDAR driver", or "board command '...'"."""
         description = process.command.description
-        return "LIDAR driver" if description.startswith("board driver") else description
+        return "the board's LIDAR driver" if description.startswith(DRIVER) else description
 
     def diagnostics(self) -> str:
         """The board's software's last output, for a failure report."""
@@ -262,8 +264,6 @@ class BoardSession:
     def stop_note(self) -> str:
         """After `close`: what stopping the board's software took beyond the usual."""
         notes = [
-            f"stopping the board's {self._name(p)}: {p.stop_note()}"
-            for p in self.processes
-            if p.stop_note()
+            f"stopping {self._name(p)}: {p.stop_note()}" for p in self.processes if p.stop_note()
         ]
         return "\n".join(notes)

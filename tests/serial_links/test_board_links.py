@@ -69,3 +69,44 @@ def test_what_the_lab_driver_hides_is_not_a_failure(variant: str) -> None:
         f"{sys.executable} {STUDENT} {variant}",
     )
     assert done.returncode == 0, done.stdout + done.stderr
+
+
+# -- --board-command and --lidar-mount: what a user can get wrong ------------------------
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (
+            ["--link", "rplidar", "--board-command", "no-such-agent {port}"],
+            "--board-command 'no-such-agent {port}': 'no-such-agent' not found on PATH",
+        ),
+        (["--board-command", "true"], "--board-command needs --link rplidar or ldlidar, not ros2"),
+        (
+            ["--link", "rplidar", "--port", "/dev/null", "--board-command", "true"],
+            "with --port the physical board runs its own",
+        ),
+        (["--link", "rplidar", "--lidar-mount", "sideways"], "give model, forward, or the angle"),
+        (["--link", "rplidar", "--lidar-mount", "90,upside"], "only ',mirrored' may follow"),
+        (["--lidar-mount", "90"], "--lidar-mount needs --link rplidar or ldlidar"),
+    ],
+)
+def test_board_options_are_checked_before_anything_runs(args: list[str], message: str) -> None:
+    """A board command that cannot start or an option that cannot apply: exit 2, one line."""
+    done = fossbot_hil("run", "approach_wall", *args, timeout=60)
+    assert done.returncode == 2, done.stdout + done.stderr
+    lines = done.stderr.strip().splitlines()
+    assert len(lines) == 1 and message in lines[0], done.stderr
+
+
+def test_a_board_command_that_dies_is_named_with_its_output() -> None:
+    """The board's own software exiting before the board is ready: the scenario says which
+    command, how it ended and its last output; the others are not run."""
+    dying = "sh -c 'echo no LIDAR here >&2; exit 3'"
+    done = fossbot_hil(
+        "run", "approach_wall", "out_of_range", "--link", "rplidar", "--board-command", dying
+    )
+    assert done.returncode == 1, done.stdout + done.stderr
+    assert f"board command {dying!r} exited with code 3" in done.stdout, done.stdout
+    assert "no LIDAR here" in done.stdout
+    assert "1 not run" in done.stdout
