@@ -93,6 +93,7 @@ class BoardLink(Ros2Link):
         self._scans_from = 0  # source time of the first driver scan of this revolution
         self._lost_in_a_row = 0
         self._heard_scans: list[Heard] = []
+        self._repeat_at: int | None = None  # the first repeat's scan in this exchange, if any
         self._line_damage: LineDamage | None = None
 
     @classmethod
@@ -360,10 +361,29 @@ class BoardLink(Ros2Link):
         self._sends = [*self._sends, *((None, ns) for ns in others)]
 
     def _driver_scans(self) -> list[Heard]:
-        """The driver's scans since this revolution went down the line, oldest first."""
+        """The driver's scans of this exchange, oldest first: its revolution's, and on a
+        damaged line the ones the line made late or split (not the device's repeats)."""
         assert self.observer is not None
+        since, until = self._scans_from, self._repeat_from()
+        return [
+            h
+            for h in self.observer.inbox
+            if h.kind == "scan" and since <= h.source_ns and (until is None or h.source_ns < until)
+        ]
+
+    def _repeat_from(self) -> int | None:
+        """When the first scan of a revolution the device sent again on its own came (the
+        harness slower than a revolution: real time), or None. The node answers in
+        order: its first answer is this tick's, the next ones the repeats'. With line
+        faults a later scan may be this revolution split or made late instead
+        (`_pair_with_driver_scans`)."""
+        if self._line_damage is not None or self.observer is None:
+            return None
         since = self._scans_from
-        return [h for h in self.observer.inbox if h.kind == "scan" and h.source_ns >= since]
+        later = [
+            h.source_ns for h in self.observer.inbox if h.kind == "scan" and h.source_ns > since
+        ]
+        return min(later) if later else None
 
     def _statuses(self) -> int:
         assert self.observer is not None
@@ -390,6 +410,9 @@ class BoardLink(Ros2Link):
         self._heard_scans = []
         answers = super().collect(scan, tick, may_be_ignored=may_be_ignored)
         _pair_with_driver_scans(answers, self._heard_scans)
+        if self._repeat_at is not None:  # answers to the device's repeats answer no tick
+            _first_answer_only(answers)
+            self._sends = [*self._sends, (None, self._repeat_at)]
         if answers.seen is None:
             answers.seen = self._seen
         answers.lost = self._lost
@@ -400,8 +423,10 @@ class BoardLink(Ros2Link):
         return answers
 
     def _sort(self, answers: Answers, heard: Any, mine: Any) -> None:
-        """Keep the driver's scans of this exchange, in order, for pairing."""
+        """Keep the driver's scans of this exchange, in order, for pairing, and when the
+        device's first repeat came."""
         self._heard_scans = self._driver_scans()  # `heard` is the inbox they are read from
+        self._repeat_at = self._repeat_from()
         super()._sort(answers, heard, mine)
 
     # -- reporting and teardown ---------------------------------------------
@@ -430,6 +455,23 @@ class BoardLink(Ros2Link):
         if self.session is not None and self._own_session:
             notes.append(self.session.stop_note())
         return "\n".join(n for n in notes if n)
+
+
+def _first_answer_only(answers: Answers) -> None:
+    """The device sent this tick's revolution again while the node worked on it: the
+    node's first status (and the Bools published nearest to it) answer this tick; the
+    later ones answer the repeats, kept as late answers of no tick, never judged."""
+    statuses = sorted(answers.statuses, key=lambda r: r.source_ns)
+    if not statuses:
+        return
+    first, rest = statuses[0], statuses[1:]
+    answers.statuses = [first]
+    kept = []
+    for item in answers.warnings:
+        nearest = min(statuses, key=lambda r: abs(r.source_ns - item.source_ns))
+        (kept if nearest is first else rest).append(item)
+    answers.warnings = kept
+    answers.late += [replace(r, tick=None) for r in rest]
 
 
 def _pair_with_driver_scans(answers: Answers, scans: list[Heard]) -> None:

@@ -110,3 +110,18 @@ def test_a_board_command_that_dies_is_named_with_its_output() -> None:
     assert f"board command {dying!r} exited with code 3" in done.stdout, done.stdout
     assert "no LIDAR here" in done.stdout
     assert "1 not run" in done.stdout
+
+
+def test_a_late_answer_in_real_time_is_not_taken_for_the_repeats() -> None:
+    """Real time (the board's own software: here the bundled driver as a board command):
+    while a node is slow on one scan, the device sends the revolution again (a real one
+    never waits) and the node answers that too; those answers answer no tick, so the
+    late tick is judged once and the run passes."""
+    driver = f"{sys.executable} -m harness.board_driver.rplidar_node --ros-args -p port:={{port}}"
+    done = fossbot_hil(
+        *("run", "obstacle_at_side", "--link", "rplidar", "--board-command", driver),
+        *("--node", f"{sys.executable} {STUDENT} correct"),
+        *("--param", "delay_s:=0.5", "--param", "slow_scan:=8"),
+    )
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert "1 of 1 scenario passed" in done.stdout
