@@ -47,8 +47,9 @@ def test_student_bugs_caught_through_the_board(variant: str, scenario: str, phra
     assert phrase in done.stdout
 
 
+# (The correct node through the board: the whole-run tests in test_whole_run.py.)
 @pytest.mark.parametrize(
-    "variant", ["correct", "min_over_raw_ranges", "no_range_min_filter", "angle_without_angle_min"]
+    "variant", ["min_over_raw_ranges", "no_range_min_filter", "angle_without_angle_min"]
 )
 def test_what_the_lab_driver_hides_is_not_a_failure(variant: str) -> None:
     """Through the lab robot's driver these nodes are right.
