@@ -2,8 +2,8 @@
 
 The board scans are made the way the real chain makes them: the harness
 sends scan angle phi at the device angle its mount gives
-(``LidarMount.device_angle_deg``, on the RPLIDAR's 1/64-degree steps, ranges
-in 1/4 mm), and the bundled driver's pure binning
+(``harness.devices.revolution.device_angle_deg``, on the RPLIDAR's
+1/64-degree steps, ranges in 1/4 mm), and the bundled driver's pure binning
 (``harness.board_driver.binning.rplidar_ranges``, the v2 bridge's floor
 binning) turns them into 360 bins over [0, 2 pi), +inf where empty.
 """
@@ -19,6 +19,7 @@ import numpy as np
 import pytest
 
 from harness.board_driver.binning import rplidar_ranges, scan_increment
+from harness.devices.revolution import device_angle_deg
 from harness.judge.alignment import Alignment, fit_alignment, likely_fix, run_alignment
 from harness.judge.answers import Answers
 from harness.judge.oracle import Oracle
@@ -110,8 +111,7 @@ def _board(
     """What the board publishes for `truth`: sent at the mount's device angles, binned
     by the bundled driver with (`invert`, `offset`), the v2 bridge's floor binning
     unless `mode` says, +inf empty."""
-    scan_deg = np.degrees(truth.angles())
-    device = np.array([mount.device_angle_deg(a) for a in scan_deg])
+    device = np.asarray(device_angle_deg(truth.angles(), mount), dtype=np.float64)
     device = np.floor(device * 64.0) / 64.0  # the A1's angle field: 1/64 degree
     ranges = truth.ranges.astype(np.float64)
     rng = rng if rng is not None else np.random.default_rng(7)

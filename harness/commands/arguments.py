@@ -395,9 +395,9 @@ def check_link_options(args: argparse.Namespace) -> LinkOptions:
             "physical board runs its own"
         )
     if board:
-        from harness.links.board_session import board_commands
+        from harness.links.board_session import check_board_commands
 
-        board_commands(tuple(board))  # each program must exist: exit 2 now, not later
+        check_board_commands(tuple(board))  # each program must exist: exit 2 now, not later
     if getattr(args, "lidar_mount", None) is not None and args.link not in SERIAL_LINKS:
         raise ConfigError(
             f"--lidar-mount needs --link rplidar or ldlidar (the {args.link} link sends the "

@@ -33,12 +33,6 @@ class LidarMount:
     yaw_deg: float = 0.0  # where the device's 0 degrees points: CCW from forward, degrees
     mirrored: bool = False  # True: device angles run counter-clockwise seen from above
 
-    def device_angle_deg(self, scan_deg: float) -> float:
-        """The device angle (degrees, [0, 360)) of a beam at `scan_deg` (CCW, scan frame)."""
-        turn = scan_deg - self.yaw_deg if self.mirrored else self.yaw_deg - scan_deg
-        angle = turn % 360.0
-        return 0.0 if angle >= 360.0 else angle + 0.0
-
     def driver_settings(self) -> tuple[bool, float]:
         """(invert, angle_offset_deg) that turn this device's angles back into the scan frame."""
         return (not self.mirrored, self.yaw_deg)

@@ -35,7 +35,7 @@ from harness.devices.profiles import DeviceProfile
 from harness.errors import ConfigError
 from harness.faults.link import LineDamage
 from harness.judge.answers import Answers
-from harness.lidar.mount import FORWARD
+from harness.lidar.mount import LidarMount
 from harness.lidar.scan import Scan
 from harness.links.base import LinkOptions
 from harness.links.board_session import BoardSession
@@ -84,7 +84,6 @@ class BoardLink(Ros2Link):
         self.physical = options.port is not None
         self.session = session
         self._own_session = session is None  # one scenario on its own: its own device
-        self.mount = options.lidar_mount or FORWARD
         self._pushed = False  # the first push ends the session's idle stream
         self._gap_measured = False
         self._seen: Scan | None = None
@@ -114,6 +113,12 @@ class BoardLink(Ros2Link):
     @property
     def port(self) -> Any:
         return self.session.port if self.session is not None else None
+
+    @property
+    def mount(self) -> LidarMount:
+        """How the device sits on the robot: one mount for the run (the session's)."""
+        assert self.session is not None, "start() the link first"
+        return self.session.mount
 
     # -- processes and ports ----------------------------------------------
     @classmethod

@@ -38,27 +38,26 @@ if TYPE_CHECKING:
     from harness.serial_line.server import DeviceServer
 
 PORT_FIELD = "{port}"
-DRIVER = "board driver"  # the bundled driver's description starts so
+DRIVER_NAME = "the board's LIDAR driver"  # the bundled driver, in messages
 END_IDLE_S = 1.0  # lockstep: for the idle stream's last revolution to be written
 
 
-def board_commands(texts: tuple[str, ...]) -> list[NodeCommand]:
-    """`--board-command` items, checked as a node's command is (the program exists),
-    with `{port}` standing for the emulated device's path."""
-    checked = []
+def board_command(text: str, port: str = "/dev/null") -> NodeCommand:
+    """A `--board-command` item with `{port}` replaced by the device's path, checked as a
+    node's command is (the program exists; ConfigError naming the item as given)."""
+    try:
+        argv = shell_node(
+            text.replace(PORT_FIELD, shlex.quote(port)), option="--board-command"
+        ).argv
+    except ConfigError as err:
+        raise ConfigError(str(err).replace(shlex.quote(port), PORT_FIELD)) from None
+    return NodeCommand(argv, description=f"board command {text!r}")
+
+
+def check_board_commands(texts: tuple[str, ...]) -> None:
+    """Every `--board-command` can start (checked before anything runs: exit 2 now)."""
     for text in texts:
-        try:
-            command = shell_node(text.replace(PORT_FIELD, "/dev/null"), option="--board-command")
-        except ConfigError as err:
-            raise ConfigError(str(err).replace("/dev/null", PORT_FIELD)) from None
-        checked.append(NodeCommand(command.argv, description=f"board command {text!r}"))
-    return checked
-
-
-def with_port(command: NodeCommand, text: str, port: str) -> NodeCommand:
-    """`command` (checked from `text`) with `{port}` replaced by the device's path."""
-    argv = shell_node(text.replace(PORT_FIELD, shlex.quote(port)), option="--board-command").argv
-    return NodeCommand(argv, description=command.description)
+        board_command(text)
 
 
 class BoardSession:
@@ -78,16 +77,17 @@ class BoardSession:
                 "--board-command runs the board's software on the virtual board; with --port "
                 "the physical board runs its own"
             )
-        self.commands = board_commands(options.board_commands)
+        check_board_commands(options.board_commands)
         self.mount: LidarMount = options.lidar_mount or FORWARD
         self.device = profile.make_device(options.scan_rate_hz)
         # Real time on a physical line, when asked, and for the board's own software,
         # which may not be held in lockstep (a driver with its own timing or timeouts).
-        self.mode = "realtime" if options.realtime or self.physical or self.commands else "lockstep"
+        own_software = bool(options.board_commands)
+        self.mode = "realtime" if options.realtime or self.physical or own_software else "lockstep"
         self.port: DevicePort | None = None
         self.server: DeviceServer | None = None
         self.domain: DomainReservation | None = None
-        self.processes: list[NodeProcess] = []
+        self.processes: list[tuple[str, NodeProcess]] = []  # (name in messages, process)
         self.judged_at: float | None = None  # perf_counter of the last judged scan's answers
         # Does the board skip revolutions with next to no returns (rplidar's iter_scans
         # does)? None until one such revolution was sent.
@@ -138,36 +138,38 @@ class BoardSession:
         return self.domain.domain_id
 
     def _environment(self) -> dict[str, str]:
-        """What the board's processes get: the run's ROS domain and discovery, modem lines."""
-        assert self.port is not None
-        env = {
+        """What the board's processes get: the run's ROS domain and discovery, and the
+        pty's modem lines (only a virtual board starts the board's software)."""
+        from harness.serial_line.ports import PtyPort
+
+        assert isinstance(self.port, PtyPort)
+        return {
             "ROS_DOMAIN_ID": str(self.domain_id),
             **discovery_environment(network=self.options.ros_network),
+            **self.port.client_environment(),
         }
-        modem = getattr(self.port, "client_environment", None)
-        if modem is not None:
-            env.update(modem())
-        return env
 
     def _start_board_software(self) -> None:
         assert self.port is not None
         path = self.port.slave_path
         env = self._environment()
-        if self.commands:
-            for command, text in zip(self.commands, self.options.board_commands, strict=True):
-                process = NodeProcess(with_port(command, text, path), [], env)
-                self.processes.append(process)
-                process.start()
-            return
-        process = NodeProcess(self._driver_command(), self._driver_arguments(path), env)
-        self.processes.append(process)
+        if self.options.board_commands:
+            for text in self.options.board_commands:
+                command = board_command(text, path)
+                self._start(command.description, NodeProcess(command, [], env))
+        else:
+            driver = NodeProcess(self._driver_command(), self._driver_arguments(path), env)
+            self._start(DRIVER_NAME, driver)
+
+    def _start(self, name: str, process: NodeProcess) -> None:
+        self.processes.append((name, process))
         process.start()
 
     def _driver_command(self) -> NodeCommand:
         """The bundled board driver, started anew (not forked: its modem lines come from
         the interpreter's start-up, as for the board's own software)."""
         module = self.profile.driver_module
-        return NodeCommand((sys.executable, "-m", module), description=f"{DRIVER} {module}")
+        return NodeCommand((sys.executable, "-m", module), description=f"board driver {module}")
 
     def _driver_arguments(self, path: str) -> list[str]:
         """The bundled driver's parameters: this device, this mount, a bounded read wait."""
@@ -222,24 +224,19 @@ class BoardSession:
         """Why the device or the board's software stopped, or None while all run."""
         if self.server is not None and self.server.error is not None:
             return f"{self.profile.name} line: {self.server.error}"
-        for process in self.processes:
+        for name, process in self.processes:
             if process.returncode() is not None:
-                return f"{self._name(process)} {process.exit_summary(when)}"
+                return f"{name} {process.exit_summary(when)}"
         return None
-
-    def _name(self, process: NodeProcess) -> str:
-        """For messages: "the board's LIDAR driver", or "board command '...'"."""
-        description = process.command.description
-        return "the board's LIDAR driver" if description.startswith(DRIVER) else description
 
     def diagnostics(self) -> str:
         """The board's software's last output, for a failure report."""
         parts = []
-        for process in self.processes:
+        for name, process in self.processes:
             for which in ("stderr", "stdout"):
                 tail = process.tail(which)
                 if tail:
-                    parts.append(f"{self._name(process)} {which} (last lines):\n{tail}")
+                    parts.append(f"{name} {which} (last lines):\n{tail}")
         return "\n".join(parts)
 
     def close(self) -> None:
@@ -247,14 +244,14 @@ class BoardSession:
         if self._closed:
             return
         self._closed = True
-        for process in self.processes:
+        for _, process in self.processes:
             process.request_stop()
         if self.server is not None:
             try:
                 self.server.close()
             except LinkError:
                 pass  # already reported by the exchange that met it
-        for process in self.processes:
+        for _, process in self.processes:
             process.stop()
         if self.port is not None:
             self.port.close()
@@ -263,7 +260,5 @@ class BoardSession:
 
     def stop_note(self) -> str:
         """After `close`: what stopping the board's software took beyond the usual."""
-        notes = [
-            f"stopping {self._name(p)}: {p.stop_note()}" for p in self.processes if p.stop_note()
-        ]
+        notes = [f"stopping {name}: {p.stop_note()}" for name, p in self.processes if p.stop_note()]
         return "\n".join(notes)

@@ -78,6 +78,15 @@ class V2Chain:
         commands = [self.agent("{port}"), self.bridge(**bridge)]  # type: ignore[arg-type]
         return [arg for argv in commands for arg in ("--board-command", " ".join(argv))]
 
+    def run_on_virtual_board(self, *args: str, **bridge: object) -> tuple[int, str]:
+        """`fossbot-hil run ARGS --link rplidar` with the agent and the bridge as board
+        commands; its exit code and output."""
+        run = harness(
+            *args, "--link", "rplidar", *self.board_commands(**bridge), env=with_roboticia()
+        )
+        text = finished(run)
+        return run.returncode, text
+
     def openings(self) -> list[str]:
         """What the agent logged about opening the LIDAR (one client, one reset: no restart)."""
         lines = self.log.read_text().splitlines() if self.log.exists() else []
@@ -144,13 +153,8 @@ def test_v2_board_software_runs_the_whole_suite_on_the_virtual_board(tmp_path: P
     scenario in one run; the agent opened the device once."""
     chain = V2Chain(tmp_path)
     out = tmp_path / "report"
-    run = harness(
-        *("--link", "rplidar", "--out", str(out)),
-        *chain.board_commands(),
-        env=with_roboticia(),
-    )
-    text = finished(run)
-    assert run.returncode == 0, text
+    code, text = chain.run_on_virtual_board("--out", str(out))
+    assert code == 0, text
     assert_whole_suite_passed(text, out)
     assert len(chain.openings()) == 2, chain.openings()  # one client, one LIDAR open
     assert "between scenarios" in text, text
@@ -173,13 +177,10 @@ def test_a_misaligned_bridge_is_named(
     scenario.write_text(LOPSIDED)
     chain = V2Chain(tmp_path)
     out = tmp_path / "report"
-    run = harness(
-        *(str(scenario), "--link", "rplidar", "--out", str(out), "--alignment", "fail"),
-        *chain.board_commands(**bridge),
-        env=with_roboticia(),
+    code, text = chain.run_on_virtual_board(
+        str(scenario), "--out", str(out), "--alignment", "fail", **bridge
     )
-    text = finished(run)
-    assert run.returncode == 1, text
+    assert code == 1, text
     found = summary(out)["alignment"]
     assert found["status"] == "misaligned", found
     assert found["rotation_deg"] == rotation and found["mirrored"] is mirrored, found
