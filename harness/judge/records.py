@@ -50,6 +50,7 @@ class RunResult:
     # On a run-long device session: seconds between the previous scenario's last
     # revolution and this scenario's first judged one (the device kept streaming).
     gap_s: float | None = None
+    node_start: str = ""  # how the node under test was started (by fork, as a command)
 
     @property
     def total_s(self) -> float:

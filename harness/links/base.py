@@ -62,6 +62,7 @@ class Link(ABC):
         # On a run-long device session: seconds between the previous scenario's last
         # judged revolution and this one's first (None where there is no session).
         self.gap_s: float | None = None
+        self.node_start = ""  # how the node under test was started, for the user
 
     @classmethod
     def run_session(cls, options: LinkOptions) -> AbstractContextManager[Any]:

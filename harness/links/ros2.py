@@ -253,6 +253,7 @@ class Ros2Link(Link):
         args = ros_arguments(node_parameters(self.options))
         self.process = NodeProcess(self.command, args, env)
         self.process.start()
+        self.node_start = f"{self.command.description}, {self.process.how}"
 
     def _make_observer(self, domain_id: int) -> Observer:
         return harness_observer(self.options, domain_id, publish_scans=self.publishes_scans)

@@ -6,8 +6,11 @@
   and stop, its output's tail kept;
 - ``reaper``: the supervisor every node runs under, so nothing it starts
   outlives it; ``process_group`` stops a whole group;
-- ``forkserver``: the bundled nodes forked warm from a process that has
-  imported them;
+- ``forkserver``: Python nodes forked warm from a process that has imported
+  what they import (the bundled nodes; students' scripts and console
+  scripts, from ``warm_python``); ``python_script`` decides which commands
+  it may serve, so a forked node is what its command would have started;
+- ``colcon_hooks``: the environment sourcing a colcon workspace would give;
 - ``quick_exit``: ending a process without the interpreter's teardown.
 
 No rclpy here: a node's ROS graph is ``harness.ros``'s.

@@ -17,6 +17,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from harness.errors import ConfigError
+from harness.nodes.colcon_hooks import hook_environment
 from harness.nodes.setup_problems import is_python
 
 AMENT_MARKERS = Path("share/ament_index/resource_index/packages")
@@ -112,6 +113,13 @@ def _env_for(prefixes: list[Path]) -> dict[str, str]:
     }
 
 
+def workspace_environment(prefixes: list[Path]) -> dict[str, str]:
+    """What sourcing the workspace would set: its folders' usual places, then what its
+    packages' colcon hooks add (a --symlink-install build's source links among them)."""
+    env = _env_for(prefixes)
+    return {**env, **hook_environment(prefixes, {**os.environ, **env})}
+
+
 def package_node(package: str, executable: str, workspace: str | None) -> NodeCommand:
     """Find `executable` of `package` as ``ros2 run`` does: through the ament index."""
     if workspace is not None:
@@ -154,7 +162,7 @@ def package_node(package: str, executable: str, workspace: str | None) -> NodeCo
             f"--executable {executable}: not in package {package} "
             f"(executables: {', '.join(there) or 'none'})"
         )
-    env = _env_for(prefixes) if workspace is not None else {}
+    env = workspace_environment(prefixes) if workspace is not None else {}
     return NodeCommand((str(program),), env, f"{package}/{executable} from {where}")
 
 

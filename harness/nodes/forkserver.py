@@ -1,25 +1,34 @@
-"""Start Python nodes by fork from a process that has imported them already.
+"""Start Python nodes by fork from a process that has imported what they import.
 
 A node's interpreter start and imports (rclpy, the message packages, numpy)
-cost about 0.3 s of CPU, paid again for every scenario. The fork server pays
-it once: it imports the node's module (nothing more: no rclpy context, no
-DDS participant, no thread), then forks per request. Each fork is a fresh
-process that has never run a node; it supervises the node exactly as
-``reaper.py`` does (``supervise``: subreaper, own session, the same
-stop and the same events), and the node itself is a second fork that runs
-the module as ``python -m MODULE ARGS`` would, with the request's
-environment and arguments. Only ``python -m`` commands of the harness's own
-interpreter are served (the bundled reference node); anything else is
-started by ``reaper.py`` as before.
+cost about 0.3-0.5 s of CPU, paid again for every scenario. The fork server
+pays it once: it imports a module (nothing more: no rclpy context, no DDS
+participant, no thread of its own), then forks per request. Each fork is a
+fresh process that has never run a node; it supervises the node exactly as
+``reaper.py`` does (``supervise``: subreaper, own session, the same stop and
+the same events), and the node itself is a second fork, with the request's
+environment, arguments and working folder, that runs either
+
+- the server's module as ``python -m MODULE ARGS`` would (the bundled
+  nodes: their server imports them), or
+- a script, as ``python SCRIPT ARGS`` would, with the module search path a
+  fresh interpreter would have (students' nodes: their server imports
+  ``warm_python``, never the student's code, so the script and what it
+  imports are read afresh by every node).
+
+Which commands may be served so is the harness's to decide
+(``python_script``); anything else is started by ``reaper.py`` as before.
 
 The harness side (`ForkServer`) starts the server lazily, once per process,
 and falls back to the plain start if the server cannot come up. The server
 exits when the harness closes its socket or dies (PDEATHSIG).
 
-Protocol, over a SOCK_SEQPACKET socket pair: the server sends ``ready`` (or
-``error MESSAGE``) once; each request is JSON (module, argv, env, graces)
-with three descriptors (the status pipe, stdout, stderr); the answer is
-JSON (the supervisor's pid, or an error) with a pidfd of the supervisor.
+Protocol, over a SOCK_SEQPACKET socket pair: the server sends ``ready JSON``
+(its Python version and where each module it imported came from) or
+``error MESSAGE`` once; each request is JSON (argv, env, graces, cwd, and
+for a script its path and sys.path) with three descriptors (the status
+pipe, stdout, stderr); the answer is JSON (the supervisor's pid, or an
+error) with a pidfd of the supervisor.
 """
 
 from __future__ import annotations
@@ -93,11 +102,13 @@ class ForkServer:
         self.problem: str | None = None  # why the server is not used, once known
         ours, theirs = socket.socketpair(socket.AF_UNIX, socket.SOCK_SEQPACKET)
         self._socket: socket.socket | None = ours
+        # What the server's interpreter started with: what a node started anew gets.
+        self.env = {**os.environ, "PYTHONUNBUFFERED": "1"}
         try:
             self._process: subprocess.Popen[bytes] | None = subprocess.Popen(
                 [sys.executable, "-m", __name__, str(theirs.fileno()), str(os.getpid()), module],
                 pass_fds=(theirs.fileno(),),
-                env={**os.environ, "PYTHONUNBUFFERED": "1"},  # what a node started anew gets
+                env=self.env,
                 stdin=subprocess.DEVNULL,
                 stdout=subprocess.DEVNULL,
                 stderr=subprocess.DEVNULL,
@@ -109,6 +120,10 @@ class ForkServer:
         finally:
             theirs.close()
         self._ready = False
+        self.version = ""  # the server's sys.version, once it is ready
+        # Where each module the server imported came from (top-level names): a
+        # script is served only where its own imports would find the same.
+        self.modules: dict[str, str] = {}
 
     def _fail(self, problem: str) -> None:
         self.problem = self.problem or problem
@@ -133,21 +148,41 @@ class ForkServer:
             except (OSError, TimeoutError) as err:
                 self._fail(f"the fork server did not come up: {err}")
                 return False
-            if message != b"ready":
+            kind, _, detail = message.partition(b" ")
+            if kind != b"ready":
                 self._fail(message.decode(errors="replace"))
                 return False
+            facts = json.loads(detail or b"{}")
+            self.version = str(facts.get("version", ""))
+            self.modules = dict(facts.get("modules", {}))
             self._ready = True
         return self._ready
 
+    def ready(self) -> bool:
+        """Wait (bounded) until the server has imported its module; False if it cannot."""
+        return self._wait_ready()
+
     def start(
-        self, argv: list[str], env: dict[str, str], graces: tuple[float, float], fds: list[int]
+        self,
+        argv: list[str],
+        env: dict[str, str],
+        graces: tuple[float, float],
+        fds: list[int],
+        *,
+        script: str | None = None,
+        sys_path: list[str] | None = None,
     ) -> ForkedSupervisor | None:
-        """Fork a supervisor running `self.module` with `argv`; None when the server is
-        not usable (then `problem` says why, and the caller starts the node itself)."""
+        """Fork a supervisor running `self.module` (or `script`, with `sys_path` as its
+        module search path) with `argv`, in this process's working folder; None when
+        the server is not usable (then `problem` says why, and the caller starts the
+        node itself)."""
         if not self._wait_ready():
             return None
         assert self._socket is not None
-        request = {"argv": argv, "env": env, "graces": graces}
+        request: dict[str, object] = {"argv": argv, "env": env, "graces": graces}
+        request["cwd"] = os.getcwd()
+        if script is not None:
+            request.update(script=script, sys_path=sys_path or [])
         try:
             socket.send_fds(self._socket, [json.dumps(request).encode()], fds)
             message, pidfds = self._receive(ANSWER_WAIT_S)
@@ -274,7 +309,8 @@ def _supervisor(sock: socket.socket, module: str, request: dict, fds: list[int])
 
 
 def _fork_node(module: str, request: dict, status_fd: int) -> int:
-    """Fork the node: in the child, become what ``python -m MODULE ARGV`` would be."""
+    """Fork the node: in the child, become what ``python -m MODULE ARGV`` (or
+    ``python SCRIPT ARGV``) would be."""
     pid = os.fork()
     if pid:
         return pid
@@ -285,18 +321,31 @@ def _fork_node(module: str, request: dict, status_fd: int) -> int:
         signal.pthread_sigmask(signal.SIG_SETMASK, [])  # the supervisor blocks its signals
         os.environ.clear()
         os.environ.update(request["env"])
-        code = _run_module(module, request["argv"])
+        code = _run(module, request)
     finally:
         exit_now(code)
 
 
-def _run_module(module: str, argv: list[str]) -> int:
-    """Run `module` as __main__ with `argv`; the exit code the interpreter would give."""
+def _run(module: str, request: dict) -> int:
+    """Run the request's script (or `module`) as __main__; the exit code the
+    interpreter would give."""
+    import importlib
     import runpy
 
-    sys.argv = [module, *argv]
+    script = request.get("script")
     try:
-        runpy.run_module(module, run_name="__main__", alter_sys=True)
+        os.chdir(request.get("cwd") or ".")
+        if script is not None:
+            sys.path[:] = request["sys_path"]
+            importlib.invalidate_caches()  # files may have changed since the server looked
+            sys.argv = [script, *request["argv"]]
+            if not os.path.isfile(script):  # as the interpreter says it
+                print(f"{sys.executable}: can't open file {script!r}", file=sys.stderr)
+                return 2
+            runpy.run_path(script, run_name="__main__")
+        else:
+            sys.argv = [module, *request["argv"]]
+            runpy.run_module(module, run_name="__main__", alter_sys=True)
         code = 0
     except SystemExit as stop:
         code = _exit_code(stop.code)
@@ -305,12 +354,23 @@ def _run_module(module: str, argv: list[str]) -> int:
         signal.signal(signal.SIGINT, signal.SIG_DFL)  # as Python does: die by the signal
         os.kill(os.getpid(), signal.SIGINT)
         code = 128 + signal.SIGINT  # not reached
-    except BaseException:  # as the interpreter does with any uncaught error
-        import traceback
-
-        traceback.print_exc()
+    except BaseException as error:  # as the interpreter does with any uncaught error
+        _print_uncaught(error)
         code = 1
     return code
+
+
+def _print_uncaught(error: BaseException) -> None:
+    """The traceback a fresh interpreter would print: from the node's own code on,
+    without this server's and runpy's frames."""
+    import runpy
+    import traceback
+
+    ours = {__file__, runpy.__file__, "<frozen runpy>"}
+    tb = error.__traceback__
+    while tb is not None and tb.tb_frame.f_code.co_filename in ours:
+        tb = tb.tb_next
+    traceback.print_exception(type(error), error, tb)
 
 
 def _exit_code(value: object) -> int:
@@ -350,6 +410,19 @@ def _load_type_support() -> None:
                     load()
 
 
+def imported_modules() -> dict[str, str]:
+    """Where each top-level module imported so far came from (its file, 'built-in',
+    'frozen', or its folders for a namespace package); the harness's own left out."""
+    found = {}
+    for name, module in list(sys.modules.items()):
+        spec = getattr(module, "__spec__", None)
+        if "." in name or name in ("__main__", "harness") or spec is None:
+            continue
+        locations = spec.submodule_search_locations
+        found[name] = spec.origin or os.pathsep.join(locations or ())
+    return found
+
+
 def main(argv: list[str]) -> int:
     """``python -m harness.nodes.forkserver SOCKET_FD PARENT_PID MODULE``."""
     import ctypes
@@ -370,7 +443,8 @@ def main(argv: list[str]) -> int:
     except BaseException as err:  # reported to the harness, which then starts nodes itself
         socket.send_fds(sock, [f"error cannot import {module}: {err!r}".encode()], [])
         return 1
-    socket.send_fds(sock, [b"ready"], [])
+    facts = {"version": sys.version, "modules": imported_modules()}
+    socket.send_fds(sock, [b"ready " + json.dumps(facts).encode()], [])
     code = _serve(sock, module)
     os._exit(code)  # nothing to clean up: the harness waits for this exit, so make it quick
 

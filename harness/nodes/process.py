@@ -25,8 +25,10 @@ from pathlib import Path
 
 from harness.errors import ConfigError
 from harness.nodes.command import NodeCommand
-from harness.nodes.forkserver import ForkedSupervisor
+from harness.nodes.forkserver import ForkedSupervisor, ForkServer
 from harness.nodes.forkserver import shared as shared_fork_server
+from harness.nodes.python_script import SERVER_MODULE as SCRIPT_SERVER_MODULE
+from harness.nodes.python_script import ScriptCommand, plan_start, script_command
 
 REAPER = Path(__file__).with_name("reaper.py")
 INT_GRACE_S = 2.0  # a ROS 2 node stops on SIGINT well within this
@@ -50,8 +52,12 @@ def fork_server_enabled() -> bool:
 
 def prepare_start(command: NodeCommand) -> None:
     """Start what starting `command` will use (its fork server), so it is ready sooner."""
-    if command.module is not None and fork_server_enabled():
+    if not fork_server_enabled():
+        return
+    if command.module is not None:
         shared_fork_server(command.module)
+    elif isinstance(script_command(command.argv, {**os.environ, **command.env}), ScriptCommand):
+        shared_fork_server(SCRIPT_SERVER_MODULE)
 
 
 _LIVE: set[NodeProcess] = set()
@@ -139,6 +145,7 @@ class NodeProcess:
         self._done = False  # the reaper finished its stop (its last event)
         self._stop_requested = False
         self.started_at = 0.0
+        self.how = "started as a command"  # how `start` started it, for the user
 
     def start(self) -> None:
         """Start the node under the reaper; wait (bounded) until it runs or cannot."""
@@ -197,12 +204,39 @@ class NodeProcess:
             raise ConfigError(f"cannot start {self.command.description}: {why}")
 
     def _forked(self, fds: list[int]) -> ForkedSupervisor | None:
-        """The node started by the fork server (a module of this interpreter), or None."""
-        module = self.command.module
-        if module is None or not fork_server_enabled():
+        """The node started by a fork server (a module of this interpreter, or a Python
+        script that may be served: ``python_script``), or None; `how` says which."""
+        graces = (INT_GRACE_S, TERM_GRACE_S)
+        if not fork_server_enabled():
+            self.how = f"started as a command ({FORK_SERVER_SETTING}=0)"
             return None
-        argv = self.argv[len(self.command.argv) :]
-        return shared_fork_server(module).start(argv, self.env, (INT_GRACE_S, TERM_GRACE_S), fds)
+        module = self.command.module
+        if module is not None:
+            server = shared_fork_server(module)
+            argv = self.argv[len(self.command.argv) :]
+            started = server.start(argv, self.env, graces, fds)
+            self.how = "started by fork from a warm Python" if started else self._fallback(server)
+            return started
+        server = shared_fork_server(SCRIPT_SERVER_MODULE)
+        if not server.ready():
+            self.how = self._fallback(server)
+            return None
+        facts = {"version": server.version, "modules": server.modules, "server_env": server.env}
+        plan = plan_start(self.argv, self.env, **facts)
+        self.how = plan.how
+        if plan.script is None:
+            return None
+        argv = list(plan.args)
+        started = server.start(
+            argv, self.env, graces, fds, script=plan.script, sys_path=list(plan.sys_path)
+        )
+        if started is None:
+            self.how = self._fallback(server)
+        return started
+
+    @staticmethod
+    def _fallback(server: ForkServer) -> str:
+        return f"started as a command: the fork server is not usable ({server.problem})"
 
     # -- what the reaper reports --------------------------------------------
     def _read_events(self, timeout: float = 0.0) -> None:

@@ -139,11 +139,20 @@ def print_results(
             "with nothing within the threshold",
             highlight=False,
         )
+    for line in node_start_lines(results):
+        console.print(line, style="dim", highlight=False, markup=False, soft_wrap=True)
     gaps = gap_line(results)
     if gaps:
         console.print(gaps, highlight=False, markup=False)
     if alignment is not None:
         print_alignment(console, alignment, mode=alignment_mode)
+
+
+def node_start_lines(results: Sequence[RunResult]) -> list[str]:
+    """'node: python3 node.py, started by fork ...', once for the run (once per way, if
+    the way changed during it)."""
+    ways = dict.fromkeys(r.node_start for r in results if r.node_start)
+    return [f"node: {for_terminal(clip(way, 300))}" for way in ways]
 
 
 def gap_line(results: Sequence[RunResult]) -> str:

@@ -133,6 +133,7 @@ def closed(result: RunResult, link: Link, waited: float) -> None:
     (and, on a serial link, the device's mount and the gap since the scenario before)."""
     result.stop_s = waited
     result.gap_s = link.gap_s
+    result.node_start = link.node_start
     if link.serial_line:
         result.lidar_mount = link.options.lidar_mount or FORWARD
     note = link.stop_note()

@@ -13,6 +13,8 @@ from pathlib import Path
 import pytest
 from child_process import alive
 
+from harness.nodes.python_script import FORKED
+
 pytestmark = [pytest.mark.ros, pytest.mark.timeout(300)]
 
 REPO = Path(__file__).resolve().parents[2]
@@ -145,6 +147,51 @@ def test_node_from_colcon_workspace_passes(workspace: Path) -> None:
         timeout=120,
     )
     assert done.returncode == 0, done.stdout + done.stderr
+    assert f"from workspace {workspace}/install, {FORKED}" in done.stdout  # its console script
+
+
+def test_a_symlink_install_node_is_forked_and_its_edits_are_seen(tmp_path: Path) -> None:
+    """A --symlink-install workspace runs its sources (the build hook's path, as
+    setup.bash sets it); an edit is seen by the next run without a rebuild."""
+    source = tmp_path / "src" / "fossbot_lidar_processing"
+    shutil.copytree(
+        REPO / "node" / "fossbot_lidar_processing",
+        source,
+        ignore=shutil.ignore_patterns("__pycache__", "*.egg-info"),
+    )
+    colcon = shutil.which("colcon") or "colcon"
+    built = subprocess.run(
+        [colcon, "build", "--symlink-install"],
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        timeout=180,
+    )
+    assert built.returncode == 0, built.stdout + built.stderr
+    command = [
+        sys.executable,
+        "-m",
+        "harness.cli",
+        "run",
+        "obstacle_at_side",
+        "--workspace",
+        str(tmp_path),
+        "--package",
+        "fossbot_lidar_processing",
+        "--executable",
+        "fossbot_lidar_node",
+    ]
+    done = subprocess.run(command, capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert FORKED in done.stdout
+    logic = source / "fossbot_lidar_processing" / "scan_logic.py"
+    text = logic.read_text()
+    slip = "{report.distance:.3f} m"
+    assert slip in text
+    logic.write_text(text.replace(slip, "{report.distance * 100:.1f} cm"))  # a student's slip
+    done = subprocess.run(command, capture_output=True, text=True, timeout=120)
+    assert done.returncode == 1, done.stdout + done.stderr
+    assert " cm, angle" in done.stdout
 
 
 def test_unknown_package_and_executable_in_workspace(workspace: Path) -> None:
