@@ -8,7 +8,7 @@ import math
 import pytest
 from command_line import fossbot_hil
 
-from harness.bench.figures import REQUIRED_KEYS, SUITE_KEYS
+from harness.bench.figures import REQUIRED_KEYS, STUDENT_SPLIT_KEYS, SUITE_KEYS
 
 
 def _number(value: object) -> bool:
@@ -17,14 +17,18 @@ def _number(value: object) -> bool:
 
 @pytest.mark.ros
 @pytest.mark.slow
-@pytest.mark.timeout(120)
+@pytest.mark.timeout(180)
 def test_quick_json_has_every_figure_and_the_machine() -> None:
-    done = fossbot_hil("bench", "--quick", "--json", timeout=110)
+    """The suite stage builds node/ with colcon (the `test` extra) and runs each kind once."""
+    done = fossbot_hil("bench", "--quick", "--json", timeout=170)
     assert done.returncode == 0, done.stderr
     report = json.loads(done.stdout)  # one JSON object and nothing else on stdout
-    suite = [k for k in SUITE_KEYS if k != "suite_runs_s"]  # the edit-run loop, split
+    # the edit-run loop, split; the workspace node and the inprocess link beside it
+    suite = [k for k in SUITE_KEYS if not k.endswith("_runs_s")]
     missing = [k for k in (*REQUIRED_KEYS, *suite) if not _number(report.get(k))]
     assert not missing, f"not numeric: {missing}; errors: {report['errors']}"
+    assert all(isinstance(report[k], str) for k in SUITE_KEYS if k.endswith("_runs_s"))
+    assert {k: report[k] for k in STUDENT_SPLIT_KEYS} == dict.fromkeys(STUDENT_SPLIT_KEYS)
     machine = report["machine"]
     assert machine["cores"] >= 1 and machine["cpu"] and machine["python"] and machine["os"]
     assert {t["key"] for t in report["targets"]} >= {
@@ -32,6 +36,8 @@ def test_quick_json_has_every_figure_and_the_machine() -> None:
         "overhead_ratio",
         "lab_suite_wall_s",
         "suite_s",
+        "student_suite_ratio",
+        "inprocess_suite_ratio",
         "serial_rate_error_pct",
         "serial_jitter_p99_ms",
     }

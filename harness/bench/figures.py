@@ -15,6 +15,7 @@ from harness.bench.stage import StageResult
 
 __all__ = [
     "REQUIRED_KEYS",
+    "STUDENT_SPLIT_KEYS",
     "SUITE_KEYS",
     "TARGETS",
     "OVERHEAD_FORMULA",
@@ -50,6 +51,24 @@ SUITE_KEYS = (
     "suite_scenarios",
     "suite_scans",
     "suite_runs_s",
+    # The same suite against the lab's package in a colcon workspace
+    # (a student's node), and with the inprocess link; the three runs alternated.
+    "student_build_s",
+    "student_suite_s",
+    "student_suite_runs_s",
+    "student_suite_ratio",
+    "inprocess_suite_s",
+    "inprocess_suite_runs_s",
+    "inprocess_suite_ratio",
+)
+
+#: The workspace node's suite split like the bundled one's (null with `--quick`).
+STUDENT_SPLIT_KEYS = (
+    "student_suite_startup_s",
+    "student_suite_ticking_s",
+    "student_suite_stop_s",
+    "student_suite_process_s",
+    "student_suite_inprocess_s",
 )
 
 OVERHEAD_FORMULA = (
@@ -84,6 +103,18 @@ TARGETS = (
     Target("lab_suite_wall_s", "lab trio over ROS 2", "< 5 s", lambda v: v < 5.0),
     Target("lab_suite_cli_wall_s", "lab trio, CLI from spawn", "< 5 s", lambda v: v < 5.0),
     Target("suite_s", "shipped suite over ROS 2, CLI from spawn", "<= 2.0 s", lambda v: v <= 2.0),
+    Target(
+        "student_suite_ratio",
+        "shipped suite, workspace node / bundled node",
+        "<= 1.2",
+        lambda v: v <= 1.2,
+    ),
+    Target(
+        "inprocess_suite_ratio",
+        "shipped suite, bundled node / inprocess link",
+        "<= 1.5",
+        lambda v: v <= 1.5,
+    ),
     Target("serial_rate_error_pct", "serial byte rate error", "within 1 %", lambda v: abs(v) <= 1),
     Target("serial_jitter_p99_ms", "revolution jitter p99", "< 2 ms", lambda v: v < 2.0),
 )
@@ -133,7 +164,7 @@ def figures(stages: Mapping[str, StageResult], harness_peak_rss_mb: float) -> di
     out["serial_startup_s"] = _extra(serial, "startup_s")
     out["lab_suite_wall_s"] = suite.seconds if suite else None
     out["lab_suite_cli_wall_s"] = _extra(suite, "cli_wall_s")
-    for key in SUITE_KEYS:
+    for key in (*SUITE_KEYS, *STUDENT_SPLIT_KEYS):
         out[key] = _extra(suite, key)
     out["serial_rate_error_pct"] = _extra(pacing, "reader_rate_error_pct")
     out["serial_jitter_p99_ms"] = _extra(pacing, "reader_jitter_p99_ms")

@@ -7,86 +7,116 @@ spawn to exit.
 
 ``suite_s`` is what a user waits for after an edit: ``fossbot-hil run`` (all
 shipped scenarios, the bundled reference node, a fresh process, interpreter
-start included), the median of a few runs. Its split comes from the same
-scenarios run in this process: waiting for nodes to come up
-(``suite_startup_s``), ticking (``suite_ticking_s``: simulating, exchanging,
-judging), waiting for nodes to stop (``suite_stop_s``); ``suite_process_s``
-is the rest of the command (interpreter start, imports, output, exit).
+start included), the median of a few runs. ``student_suite_s`` is the same
+command against the lab's package built in a colcon workspace of its own
+(``--workspace``: what a student runs), and ``inprocess_suite_s`` the same
+with ``--link inprocess`` (no ROS, no node process): the three take turns,
+so their ratios (``student_suite_ratio``, ``inprocess_suite_ratio``) hold
+under a changing load. Their split comes from the same scenarios run in
+this process: waiting for nodes to come up (``suite_startup_s``), ticking
+(``suite_ticking_s``: simulating, exchanging, judging), waiting for nodes to
+stop (``suite_stop_s``); ``suite_process_s`` is the rest of the command
+(interpreter start, imports, output, exit); ``student_suite_*`` likewise.
 """
 
 from __future__ import annotations
 
-import os
-import shutil
 import statistics
-import subprocess
-import sys
+import tempfile
 import time
+from collections.abc import Sequence
+from pathlib import Path
 
+from harness.bench.lab_workspace import build_lab_workspace, colcon_program, lab_package_source
 from harness.bench.stage import StageResult
+from harness.bench.suite_commands import alternate, cli_wall_s
 from harness.bench.workload import Workload
 from harness.errors import HarnessError
 from harness.links.base import LinkOptions
 from harness.runner.suite import run_suite
 from harness.scenario.files import shipped_scenarios
+from harness.scenario.schema import Scenario
 
-CLI_TIMEOUT_S = 120.0
+Figures = dict[str, float | int | str | None]
+_SPLIT = ("inprocess_s", "startup_s", "ticking_s", "stop_s", "process_s")
 
 
-def measure_suite(workload: Workload, *, cli: bool, suite_runs: int) -> StageResult:
-    """The lab trio in this process (and as a command); the shipped suite as a user runs it."""
+def measure_suite(
+    workload: Workload, *, cli: bool, suite_runs: int, student_split: bool = True
+) -> StageResult:
+    """The lab trio in this process (and as a command); the shipped suite as users run it."""
+    source, colcon = lab_package_source(), colcon_program()  # before anything is measured
     scenarios = list(workload.scenarios)
     started = time.perf_counter()
     results = run_suite(scenarios, "ros2", LinkOptions())
     seconds = time.perf_counter() - started
     scans = sum(len(r.records) for r in results)
     simulated = sum(r.records[-1].t + r.records[-1].scan.scan_time for r in results if r.records)
-    extra: dict[str, float | int | str | None] = {
+    extra: Figures = {
         "passed": sum(1 for r in results if r.ok),
         "scenarios": len(results),
-        "cli_wall_s": _cli_wall_s([s.name for s in scenarios]) if cli else None,
-        **_shipped_suite(suite_runs),
+        "cli_wall_s": cli_wall_s([s.name for s in scenarios]) if cli else None,
     }
+    with tempfile.TemporaryDirectory(prefix="fossbot-hil-bench-") as folder:
+        extra.update(_shipped_suite(suite_runs, student_split, Path(folder), source, colcon))
     return StageResult("suite", scans, seconds, simulated, extra=extra)
 
 
-def _shipped_suite(runs: int) -> dict[str, float | int | None]:
-    """`fossbot-hil run` from spawn to exit (median of `runs`) and where its time goes."""
+def _shipped_suite(
+    runs: int, student_split: bool, folder: Path, source: Path, colcon: str
+) -> Figures:
+    """The shipped suite three ways from spawn to exit (median of `runs`), and two splits."""
+    workspace = build_lab_workspace(folder, source, colcon)
     shipped = shipped_scenarios()
+    bundled = _split("suite", "the bundled node", shipped, LinkOptions())
+    student = (
+        _split("student_suite", "the workspace node", shipped, workspace.link_options())
+        if student_split
+        else dict.fromkeys((f"student_suite_{k}" for k in _SPLIT), None)
+    )
+    walls = alternate(
+        {
+            "suite": [],
+            "student_suite": workspace.run_args(),
+            "inprocess_suite": ["--link", "inprocess"],
+        },
+        runs,
+    )
+    out: Figures = {"student_build_s": workspace.build_s, **bundled, **student}
+    for name, seconds in walls.items():
+        out[f"{name}_s"] = statistics.median(seconds) if seconds else None
+        out[f"{name}_runs_s"] = ", ".join(f"{w:.2f}" for w in seconds) or None
+    for name in ("suite", "student_suite"):
+        wall, inside = out[f"{name}_s"], out[f"{name}_inprocess_s"]
+        both = isinstance(wall, float) and isinstance(inside, float)
+        out[f"{name}_process_s"] = wall - inside if both else None
+    out["student_suite_ratio"] = _ratio(out["student_suite_s"], out["suite_s"])
+    out["inprocess_suite_ratio"] = _ratio(out["suite_s"], out["inprocess_suite_s"])
+    return out
+
+
+def _split(prefix: str, node: str, scenarios: Sequence[Scenario], options: LinkOptions) -> Figures:
+    """The suite in this process over ROS 2: what it waited for in series (all must pass)."""
     started = time.perf_counter()
-    results = run_suite(shipped, "ros2", LinkOptions())
-    inprocess_s = time.perf_counter() - started
-    if not all(r.ok for r in results):
-        failed = [r.scenario for r in results if not r.ok]
-        raise HarnessError(f"the shipped suite failed in this process: {', '.join(failed)}")
-    walls = [_cli_wall_s([]) for _ in range(runs)]
-    suite_s = statistics.median(walls) if walls else None
+    results = run_suite(scenarios, "ros2", options)
+    seconds = time.perf_counter() - started
+    failed = [r for r in results if not r.ok]
+    if failed:
+        names = ", ".join(r.scenario for r in failed)
+        why = f" ({failed[0].error})" if failed[0].error else ""
+        raise HarnessError(f"the shipped suite with {node} failed in this process: {names}{why}")
     return {
-        "suite_scenarios": len(results),
-        "suite_scans": sum(len(r.records) for r in results),
-        "suite_s": suite_s,
-        "suite_runs_s": ", ".join(f"{w:.2f}" for w in walls) or None,
-        "suite_inprocess_s": inprocess_s,
-        "suite_startup_s": sum(r.startup_s for r in results),
-        "suite_ticking_s": sum(r.wall_s for r in results),
-        "suite_stop_s": sum(r.stop_s for r in results),
-        "suite_process_s": suite_s - inprocess_s if suite_s is not None else None,
+        f"{prefix}_scenarios": len(results),
+        f"{prefix}_scans": sum(len(r.records) for r in results),
+        f"{prefix}_inprocess_s": seconds,
+        f"{prefix}_startup_s": sum(r.startup_s for r in results),
+        f"{prefix}_ticking_s": sum(r.wall_s for r in results),
+        f"{prefix}_stop_s": sum(r.stop_s for r in results),
     }
 
 
-def _cli_wall_s(names: list[str]) -> float:
-    """`fossbot-hil run NAMES` from spawn to exit (exit code 0 required)."""
-    exe = shutil.which("fossbot-hil", path=os.path.dirname(sys.executable))
-    argv = [exe] if exe else [sys.executable, "-m", "harness.cli"]
-    started = time.perf_counter()
-    done = subprocess.run(
-        [*argv, "run", *names],
-        capture_output=True,
-        timeout=CLI_TIMEOUT_S,
-        check=False,
-    )
-    seconds = time.perf_counter() - started
-    if done.returncode != 0:
-        tail = (done.stderr or done.stdout).decode(errors="replace").strip()[-300:]
-        raise HarnessError(f"fossbot-hil run exited {done.returncode}: {tail}")
-    return seconds
+def _ratio(top: object, bottom: object) -> float | None:
+    """top / bottom when both were measured."""
+    if isinstance(top, float) and isinstance(bottom, float) and bottom > 0:
+        return top / bottom
+    return None

@@ -51,8 +51,15 @@ class BenchPlan:
         return not self.quick
 
     @property
+    def suite_student_split(self) -> bool:
+        """Also split the workspace node's suite in this process (not in quick runs:
+        one more suite of student node starts)."""
+        return not self.quick
+
+    @property
     def suite_runs(self) -> int:
-        """`fossbot-hil run` of the shipped suite: the median of three (quick: one)."""
+        """`fossbot-hil run` of the shipped suite, each of its three kinds (bundled node,
+        workspace node, inprocess link): the median of three (quick: one)."""
         return 1 if self.quick else 3
 
 
@@ -100,7 +107,10 @@ def _measure(name: str, plan: BenchPlan) -> StageResult:
         from harness.bench.lab_suite import measure_suite
 
         return measure_suite(
-            lab_workload(1, LAB_TRIO), cli=plan.suite_cli, suite_runs=plan.suite_runs
+            lab_workload(1, LAB_TRIO),
+            cli=plan.suite_cli,
+            suite_runs=plan.suite_runs,
+            student_split=plan.suite_student_split,
         )
     raise ValueError(name)
 

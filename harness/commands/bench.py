@@ -1,10 +1,12 @@
 """`fossbot-hil bench`: how fast each stage of the harness runs on this machine.
 
 Measures, in one run: ray casting alone, scan synthesis with faults, the
-inprocess, ROS 2 and serial lockstep loops, real-time serial pacing and the
-lab's three scenarios end to end (docs/benchmarks.md says how). Exit 0 when
-the bench ran, whether or not the targets were met (they are measured, not
-asserted); 1 when a stage could not run; 2 for bad options.
+inprocess, ROS 2 and serial lockstep loops, real-time serial pacing, the
+lab's three scenarios end to end and the shipped suite as users run it
+(bundled node, a colcon-built workspace node, the inprocess link;
+docs/benchmarks.md says how). Exit 0 when the bench ran, whether or not
+the targets were met (they are measured, not asserted); 1 when a stage
+could not run; 2 for bad options.
 """
 
 from __future__ import annotations
@@ -144,6 +146,15 @@ def figures_table(report: dict[str, Any]) -> Table:
         ("suite_ticking_s", "  of it: ticking (simulate, exchange, judge)", "s", 2),
         ("suite_stop_s", "  of it: waiting for nodes to stop", "s", 2),
         ("suite_process_s", "  of it: interpreter, imports, output, exit", "s", 2),
+        ("student_suite_s", "the same, workspace node (colcon build of node/)", "s", 2),
+        ("student_suite_startup_s", "  of it: waiting for nodes to come up", "s", 2),
+        ("student_suite_ticking_s", "  of it: ticking (simulate, exchange, judge)", "s", 2),
+        ("student_suite_stop_s", "  of it: waiting for nodes to stop", "s", 2),
+        ("student_suite_process_s", "  of it: interpreter, imports, output, exit", "s", 2),
+        ("student_build_s", "  colcon build of the workspace (not in it)", "s", 2),
+        ("inprocess_suite_s", "the same, `--link inprocess`", "s", 2),
+        ("student_suite_ratio", "shipped suite, workspace node / bundled node", "x", 2),
+        ("inprocess_suite_ratio", "shipped suite, bundled node / inprocess link", "x", 2),
         ("serial_rate_error_pct", "serial byte rate error (reader)", "%", 3),
         ("serial_jitter_p99_ms", "revolution jitter p99 (reader)", "ms", 3),
         ("serial_jitter_median_ms", "revolution jitter median (reader)", "ms", 3),

@@ -1,0 +1,52 @@
+"""`fossbot-hil run` as a user types it, timed from spawn to exit, several kinds alternated.
+
+The kinds of run take turns (a, b, c, a, b, c, ...) rather than running in
+blocks, so a change in the machine's load falls on all of them alike and
+the ratios between their medians hold within one bench.
+"""
+
+from __future__ import annotations
+
+import os
+import shlex
+import shutil
+import subprocess
+import sys
+import time
+from collections.abc import Mapping, Sequence
+
+from harness.errors import HarnessError
+
+CLI_TIMEOUT_S = 120.0  # the shipped suite takes 2-12 s here; a hung run ends the stage
+
+
+def _fossbot_hil() -> list[str]:
+    """The command beside this Python (the venv's entry point), else the module."""
+    exe = shutil.which("fossbot-hil", path=os.path.dirname(sys.executable))
+    return [exe] if exe else [sys.executable, "-m", "harness.cli"]
+
+
+def cli_wall_s(args: Sequence[str]) -> float:
+    """`fossbot-hil run ARGS` from spawn to exit; HarnessError unless it exits 0 (all passed)."""
+    argv = [*_fossbot_hil(), "run", *args]
+    started = time.perf_counter()
+    try:
+        done = subprocess.run(argv, capture_output=True, timeout=CLI_TIMEOUT_S, check=False)
+    except subprocess.TimeoutExpired:
+        raise HarnessError(
+            f"fossbot-hil run {shlex.join(args)} took longer than {CLI_TIMEOUT_S:g} s"
+        ) from None
+    seconds = time.perf_counter() - started
+    if done.returncode != 0:
+        tail = (done.stderr or done.stdout).decode(errors="replace").strip()[-300:]
+        raise HarnessError(f"fossbot-hil run {shlex.join(args)} exited {done.returncode}: {tail}")
+    return seconds
+
+
+def alternate(kinds: Mapping[str, Sequence[str]], rounds: int) -> dict[str, list[float]]:
+    """Each kind's `fossbot-hil run` arguments, run once per round in the mapping's order."""
+    walls: dict[str, list[float]] = {name: [] for name in kinds}
+    for _ in range(rounds):
+        for name, args in kinds.items():
+            walls[name].append(cli_wall_s(args))
+    return walls
