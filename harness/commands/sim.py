@@ -21,7 +21,7 @@ from harness.commands.arguments import (
     seed,
 )
 from harness.errors import ConfigError, Interrupted
-from harness.report.terminal import print_safe as say
+from harness.report.console_text import print_safe as say
 from harness.safe_text import shown
 
 if TYPE_CHECKING:

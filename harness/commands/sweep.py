@@ -21,7 +21,7 @@ from harness.commands.arguments import (
 )
 from harness.commands.cluster_options import add_cluster_options, describe_cluster
 from harness.errors import ConfigError
-from harness.report.terminal import print_safe as say
+from harness.report.console_text import print_safe as say
 
 if TYPE_CHECKING:
     from harness.campaign.plan import RunSpec, Variation

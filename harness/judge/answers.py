@@ -3,9 +3,12 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
+from typing import TYPE_CHECKING
 
-from harness.lidar.scan import Scan
 from harness.safe_text import TEXT_LIMIT, for_storage
+
+if TYPE_CHECKING:  # numpy, for the type only
+    from harness.lidar.scan import Scan
 
 
 @dataclass(frozen=True)

@@ -31,7 +31,6 @@ from typing import TYPE_CHECKING
 
 from harness.errors import ConfigError, LinkError
 from harness.judge.answers import Answers, Received
-from harness.lidar.scan import Scan
 from harness.links.base import Link, LinkOptions, register
 from harness.nodes.command import (
     NodeCommand,
@@ -43,7 +42,8 @@ from harness.nodes.command import (
 from harness.nodes.process import NodeProcess, prepare_start
 from harness.ros.domain import DomainReservation, discovery_environment, reserve_domain
 
-if TYPE_CHECKING:  # rclpy is imported when the first link starts, after its node
+if TYPE_CHECKING:  # numpy and rclpy are imported when the first link starts, after its node
+    from harness.lidar.scan import Scan
     from harness.ros.observer import Heard, Observer
 
 POLL_S = 0.05  # longest single spin; liveness of the node is checked this often

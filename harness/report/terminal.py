@@ -17,8 +17,9 @@ from rich.text import Text
 
 from harness.judge.records import RunResult
 from harness.report.baseline import KINDS
+from harness.report.console_text import print_safe
 from harness.report.summary import alignment_fails, passed_line, verdict_of
-from harness.safe_text import DIAGNOSTICS_LIMIT, TEXT_LIMIT, clip, for_terminal
+from harness.safe_text import DIAGNOSTICS_LIMIT, clip, for_terminal
 from harness.scenario.schema import Scenario
 
 if TYPE_CHECKING:
@@ -33,14 +34,6 @@ CHANGE_STYLES = {"regressed": "bold red", "fixed": "green", "still failing": "ye
 def _plain(text: object, style: str = "") -> Text:
     """A table cell shown as written (no markup), safe and bounded."""
     return Text(for_terminal(clip(str(text))), style=style)
-
-
-def print_safe(
-    console: Console, text: str, *, style: str = "", limit: int | None = TEXT_LIMIT
-) -> None:
-    """External text on the terminal: escaped, bounded (unless `limit` is None), no markup."""
-    shown = for_terminal(text if limit is None else clip(text, limit))
-    console.print(shown, style=style, markup=False, highlight=False, soft_wrap=True)
 
 
 def scenario_table(scenarios: Sequence[Scenario]) -> Table:
