@@ -39,7 +39,7 @@ from harness.nodes.command import (
     ros_arguments,
     shell_node,
 )
-from harness.nodes.process import NodeProcess, prepare_start
+from harness.nodes.process import NodeProcess, prepare_start, start_would_wait
 from harness.ros.domain import DomainReservation, discovery_environment, reserve_domain
 
 if TYPE_CHECKING:  # numpy and rclpy are imported when the first link starts, after its node
@@ -150,8 +150,12 @@ class Ros2Link(Link):
                 "ROS_DOMAIN_ID": str(self.domain.domain_id),
                 **discovery_environment(network=opts.ros_network),
             }
-            self._start_processes(env)
-            self.observer = self._make_observer(self.domain.domain_id)
+            if start_would_wait(self.command):  # build our side while its fork server imports
+                self.observer = self._make_observer(self.domain.domain_id)
+                self._start_processes(env)
+            else:  # the node first: it takes longest to come up
+                self._start_processes(env)
+                self.observer = self._make_observer(self.domain.domain_id)
         except Exception as err:  # raised again by open()
             self._start_error = err
 

@@ -162,6 +162,13 @@ class ForkServer:
         """Wait (bounded) until the server has imported its module; False if it cannot."""
         return self._wait_ready()
 
+    def still_importing(self) -> bool:
+        """Would a start wait for the server's imports now? (It has not said ready.)"""
+        if self._ready or self._socket is None:
+            return False
+        readable, _, _ = select.select([self._socket], [], [], 0)
+        return not readable
+
     def start(
         self,
         argv: list[str],

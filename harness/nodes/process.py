@@ -50,14 +50,28 @@ def fork_server_enabled() -> bool:
     return on and threading.current_thread() is threading.main_thread()
 
 
+def _fork_server_of(command: NodeCommand) -> str | None:
+    """The module of the fork server that may start `command` (None: none may)."""
+    if not fork_server_enabled():
+        return None
+    if command.module is not None:
+        return command.module
+    found = script_command(command.argv, {**os.environ, **command.env})
+    return SCRIPT_SERVER_MODULE if isinstance(found, ScriptCommand) else None
+
+
 def prepare_start(command: NodeCommand) -> None:
     """Start what starting `command` will use (its fork server), so it is ready sooner."""
-    if not fork_server_enabled():
-        return
-    if command.module is not None:
-        shared_fork_server(command.module)
-    elif isinstance(script_command(command.argv, {**os.environ, **command.env}), ScriptCommand):
-        shared_fork_server(SCRIPT_SERVER_MODULE)
+    module = _fork_server_of(command)
+    if module is not None:
+        shared_fork_server(module)
+
+
+def start_would_wait(command: NodeCommand) -> bool:
+    """Would starting `command` now wait for its fork server's imports? (Then the
+    caller can do its own work first.)"""
+    module = _fork_server_of(command)
+    return module is not None and shared_fork_server(module).still_importing()
 
 
 _LIVE: set[NodeProcess] = set()
