@@ -9,8 +9,19 @@ from __future__ import annotations
 
 import importlib.util
 import os
+from collections.abc import Iterator
 
 import pytest
+
+
+@pytest.fixture(autouse=True, scope="session")
+def _own_cache_folder(tmp_path_factory: pytest.TempPathFactory) -> Iterator[None]:
+    """Every `fossbot-hil run` keeps its verdicts in the user's cache folder
+    (docs/watch.md): the suite's runs keep theirs in a folder of the session's own,
+    so they never reorder a user's own runs (nor the user's theirs)."""
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setenv("FOSSBOT_HIL_CACHE_DIR", str(tmp_path_factory.mktemp("fossbot-hil-cache")))
+        yield
 
 
 @pytest.hookimpl(optionalhook=True)  # pytest-xdist's hook

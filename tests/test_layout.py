@@ -32,6 +32,7 @@ LAYERS: list[set[str]] = [
     {"links", "report"},
     {"runner"},
     {"bench", "grading", "live", "campaign"},
+    {"watch"},
     {"commands"},
     {"pytest_plugin", "cli"},
 ]
@@ -47,6 +48,11 @@ PURE = [
     "harness.ros.domain",
     "harness.ros.names",
     "harness.sim.motion",
+    "harness.nodes.sources",
+    "harness.nodes.python_script",
+    "harness.nodes.colcon_hooks",
+    "harness.watch.order",
+    "harness.watch.verdict_cache",
 ]
 
 

@@ -26,6 +26,7 @@ from harness.errors import ConfigError, Interrupted
 
 if TYPE_CHECKING:  # the rest is imported when a run starts (the parser is built for any command)
     from harness.judge.records import RunResult
+    from harness.links.base import LinkOptions
     from harness.report.baseline import Baseline, Comparison
     from harness.report.outputs import ReportFolder
     from harness.runner.settings import RunSettings
@@ -65,6 +66,19 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         action="store_true",
         help="with --out: also an animated top-down view of each scenario, "
         "scenarios/<name>.gif (a few seconds per scenario)",
+    )
+    parser.add_argument(
+        "--watch",
+        action="store_true",
+        help="run, then run again whenever the node's files (or scenario files given by path) "
+        "change, failed scenarios first; rebuilds a --workspace package with colcon when "
+        "needed; Ctrl-C to stop (see docs/watch.md)",
+    )
+    parser.add_argument(
+        "--failed-first",
+        action="store_true",
+        help="run the scenarios that failed when this node last ran here first, then the "
+        "rest (as pytest --ff; --watch does it always)",
     )
     parser.add_argument(
         "--baseline",
@@ -144,6 +158,25 @@ def check_animate(args: argparse.Namespace) -> None:
         raise ConfigError("--animate needs --out DIR (the animations go into the report folder)")
 
 
+#: Options that make no sense in the edit-run loop, and why.
+NOT_WITH_WATCH = {
+    "gui": "--gui opens a viewer window for every scenario of every run",
+    "animate": "--animate draws for seconds per scenario on every save",
+    "baseline": "--baseline compares one run with another (for CI)",
+}
+
+
+def check_watch(args: argparse.Namespace) -> None:
+    """`--watch` refuses what would make each save slow or has no meaning in a loop."""
+    if not args.watch:
+        return
+    for name, why in NOT_WITH_WATCH.items():
+        if getattr(args, name):
+            raise ConfigError(f"--{name} cannot go with --watch: {why}; run it without --watch")
+    if args.fail_on == "regression":
+        raise ConfigError("--fail-on regression cannot go with --watch: a loop has no exit code")
+
+
 def scenario_of(scenarios: Sequence[Scenario]) -> Callable[[RunResult], Scenario | None]:
     """The scenario each result ran: results come in the order of `scenarios`, one each."""
     pending = iter(scenarios)
@@ -159,32 +192,47 @@ def run(args: argparse.Namespace, console: Console) -> int:
     from harness.nodes.forkserver import scope
 
     check_animate(args)  # before a node or a fork server starts
+    check_watch(args)
     baseline = check_baseline(args)
 
-    with scope():  # whatever prepare() starts stops with the command
+    with scope():  # whatever prepare() starts stops with the command (servers live across runs)
+        if args.watch:
+            from harness.commands.run_watch import watch
+
+            return watch(args, console)
         return _run(args, console, baseline)
 
 
-def _run(args: argparse.Namespace, console: Console, baseline: Baseline | None) -> int:
+def prepared(args: argparse.Namespace) -> tuple[LinkOptions, list[Scenario]]:
+    """The checked link options and scenarios of a run, every check done before a report
+    folder exists. The node's fork server (if any) starts first: it takes a while, in
+    another process, while the checks run."""
     from harness.links.base import link_class
 
-    # First what takes a while in another process (the node's fork server),
-    # then the checks and the rest of the imports.
     link_class(args.link).prepare(unchecked_link_options(args))
-    options = check_link_options(args)  # all before the report folder exists
+    options = check_link_options(args)
+    scenarios = selected(args.scenarios)
+    check_output_file("--junit-xml", args.junit_xml)
+    check_status_regex(args)
+    from harness.runner.settings import check_settings
+
+    check_settings(scenarios, settings_from(args))
+    return options, scenarios
+
+
+def _run(args: argparse.Namespace, console: Console, baseline: Baseline | None) -> int:
+    options, scenarios = prepared(args)
     from harness.judge.alignment import run_alignment
     from harness.report.progress import RunProgress
     from harness.report.summary import alignment_fails
     from harness.report.terminal import print_results
     from harness.report.wall_clock import command_seconds
-
-    scenarios = selected(args.scenarios)
-    check_output_file("--junit-xml", args.junit_xml)
-    check_status_regex(args)
-    from harness.runner.settings import check_settings
     from harness.runner.suite import run_suite
+    from harness.watch.verdict_cache import verdict_cache
 
-    check_settings(scenarios, settings_from(args))
+    cache = verdict_cache(args.link, options)
+    if args.failed_first:
+        scenarios = ordered_by_last_run(console, scenarios, cache.failed())
     report = open_report(args.out, animate=args.animate)
     if report is not None and report.cleared:
         console.print(
@@ -201,7 +249,7 @@ def _run(args: argparse.Namespace, console: Console, baseline: Baseline | None) 
             progress.on_result(result)
             scenario = ran(result)
             if report is not None:
-                _write(f"--out {args.out}", report.add, result, scenario)
+                write_report_file(f"--out {args.out}", report.add, result, scenario)
 
         interrupted: Interrupted | None = None
         try:
@@ -216,6 +264,7 @@ def _run(args: argparse.Namespace, console: Console, baseline: Baseline | None) 
         except Interrupted as stop:  # Ctrl-C or SIGTERM: report what was judged, then stop
             interrupted, results = stop, stop.results
     wall_s = command_seconds()
+    cache.remember(results, interrupted=interrupted is not None)
     alignment = run_alignment(results)
     mode = args.alignment
     print_results(console, results, wall_s=wall_s, alignment=alignment, alignment_mode=mode)
@@ -225,7 +274,7 @@ def _run(args: argparse.Namespace, console: Console, baseline: Baseline | None) 
 
         print_comparison(console, comparison)
     if report is not None:
-        index = _write(
+        index = write_report_file(
             f"--out {args.out}",
             report.finish,
             wall_s,
@@ -238,7 +287,7 @@ def _run(args: argparse.Namespace, console: Console, baseline: Baseline | None) 
         from harness.report.junit import write_junit
 
         artifacts = [s.paths for s in report.scenarios] if report is not None else None
-        _write(
+        write_report_file(
             f"--junit-xml {args.junit_xml}",
             write_junit,
             args.junit_xml,
@@ -256,7 +305,23 @@ def _run(args: argparse.Namespace, console: Console, baseline: Baseline | None) 
     return 0 if all(r.ok for r in results) else 1
 
 
-def _write(option: str, writer: Callable[..., T], *args: Any, **kwargs: Any) -> T:
+def ordered_by_last_run(
+    console: Console, scenarios: list[Scenario], failed: set[str]
+) -> list[Scenario]:
+    """`--failed-first`: the scenarios that failed last time first, and a line saying so."""
+    from harness.report.console_text import print_safe
+    from harness.watch.order import failed_first
+
+    first = [s.name for s in scenarios if s.name in failed]
+    if first:
+        line = f"--failed-first: {len(first)} failed last time, run first: {', '.join(first)}"
+    else:
+        line = "--failed-first: none of these failed last time (or no earlier run): given order"
+    print_safe(console, line)
+    return failed_first(scenarios, failed)
+
+
+def write_report_file(option: str, writer: Callable[..., T], *args: Any, **kwargs: Any) -> T:
     """Run a report writer; a file system error is the user's to fix, in one line."""
     try:
         return writer(*args, **kwargs)

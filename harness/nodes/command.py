@@ -64,13 +64,13 @@ def shell_node(command: str, *, option: str = "--node") -> NodeCommand:
             raise ConfigError(f"{option} {command!r}: {program} is not executable")
     elif shutil.which(program) is None:
         raise ConfigError(f"{option} {command!r}: {program!r} not found on PATH")
-    script = _script_of(argv)
+    script = python_script_of(argv)
     if script is not None and not Path(script).is_file():
         raise ConfigError(f"{option} {command!r}: no such script {script}")
     return NodeCommand(tuple(argv), description=command)
 
 
-def _script_of(argv: Sequence[str]) -> str | None:
+def python_script_of(argv: Sequence[str]) -> str | None:
     """The script a Python command line runs (None for -m, -c or no script)."""
     if not is_python(argv[0]):
         return None

@@ -33,9 +33,16 @@ def run_suite(
     *,
     on_tick: Callable[[TickRecord], None] | None = None,
     on_result: Callable[[RunResult], None] | None = None,
+    on_judged: Callable[[RunResult], None] | None = None,
 ) -> list[RunResult]:
     """Run each scenario in turn, each through a link of its own, and report the
     results in order.
+
+    `on_result` gets each result once its link is closed (complete: the stop's
+    time and notes in it); `on_judged` gets it as soon as its ticks are judged,
+    while its node may still be stopping (the verdict is final; a screen can
+    show it at once). A scenario skipped or cut short by Ctrl-C is only
+    reported to `on_result`.
 
     Where links can overlap (their own ROS domains), the next scenarios'
     links start while one runs and finished ones stop behind it
@@ -86,6 +93,8 @@ def run_suite(
                 if result.not_started:
                     failed_start = scenario.name
                     _check_setup(result, options)
+                if on_judged is not None:
+                    on_judged(result)
                 pipeline.retire(link, _reporter(result, link, report))
         except KeyboardInterrupt as err:
             pipeline.drain()  # every process reaped; finished scenarios reported first

@@ -1,0 +1,149 @@
+"""`fossbot-hil run --watch`: the run command's options, in the edit-run loop.
+
+Everything `run` checks is checked once, before the first run (exit 2 as
+`run`). What is watched: the node's files and the scenario files given by
+path (harness.nodes.sources); with nothing to watch (the bundled node and
+shipped scenarios only) the command exits 2. The scenarios are read again
+when one of their files changes. After each run: the verdict cache (for
+the next run's order and for `--failed-first`), and `--out` / `--junit-xml`
+rewritten with that run, once its verdicts are on the screen.
+
+The command runs inside `run`'s fork-server scope, and every run_suite
+opens a nested one, so a fork server started by the first run serves every
+later one: the loop never restarts it.
+"""
+
+from __future__ import annotations
+
+import argparse
+from typing import TYPE_CHECKING
+
+from rich.console import Console
+
+from harness.commands.arguments import unchecked_link_options
+from harness.commands.run import (
+    open_report,
+    prepared,
+    scenario_of,
+    selected,
+    settings_from,
+    write_report_file,
+)
+from harness.errors import ConfigError
+
+if TYPE_CHECKING:
+    from collections.abc import Callable, Sequence
+
+    from harness.judge.records import RunResult, TickRecord
+    from harness.links.base import LinkOptions
+    from harness.nodes.sources import NodeSources
+    from harness.scenario.schema import Scenario
+
+__all__ = ["watch", "watch_sources"]
+
+
+def watch_sources(args: argparse.Namespace, options: LinkOptions) -> NodeSources:
+    """The node's files and the scenario files given by path; ConfigError when there are
+    none to watch."""
+    from harness.nodes.sources import node_sources, scenario_sources
+
+    sources = node_sources(args.link, options).plus(scenario_sources(args.scenarios))
+    if not sources.watched:
+        what = "processing function" if args.link == "inprocess" else "node"
+        given = (
+            "--processor FILE.py:FUNCTION"
+            if args.link == "inprocess"
+            else "--node CMD or --workspace/--package/--executable"
+        )
+        raise ConfigError(
+            f"--watch: nothing to watch: the bundled {what} is not yours to edit and no scenario "
+            f"file was given by path; give yours with {given}"
+        )
+    return sources
+
+
+def watch(args: argparse.Namespace, console: Console) -> int:
+    """Run, then run again on every change, until Ctrl-C (130) or SIGTERM (143)."""
+    sources = watch_sources(args, unchecked_link_options(args))  # before anything starts
+    if sources.build is not None:
+        from harness.grading.build import colcon_executable
+
+        colcon_executable()  # colcon missing: exit 2 now, not at the first save
+    options, _ = prepared(args)
+    if args.out is not None:
+        open_report(args.out).close()  # a bad folder fails now, not after the first run
+    from harness.runner.settings import check_settings
+    from harness.runner.suite import run_suite
+    from harness.watch.loop import WatchLoop
+    from harness.watch.screen import WatchScreen
+    from harness.watch.verdict_cache import verdict_cache
+
+    settings = settings_from(args)
+    cache = verdict_cache(args.link, options)
+    ran: list[Scenario] = []  # the order of the run in progress, for the reports
+
+    def load() -> list[Scenario]:
+        scenarios = selected(args.scenarios)
+        check_settings(scenarios, settings)
+        return scenarios
+
+    def suite(
+        order: Sequence[Scenario],
+        on_tick: Callable[[TickRecord], None],
+        on_result: Callable[[RunResult], None],
+        on_judged: Callable[[RunResult], None],
+    ) -> list[RunResult]:
+        ran[:] = order
+        return run_suite(
+            order,
+            args.link,
+            options,
+            settings,
+            on_tick=on_tick,
+            on_result=on_result,
+            on_judged=on_judged,
+        )
+
+    def after(results: list[RunResult]) -> list[str]:
+        cache.remember(results)
+        return write_reports(args, results, ran)
+
+    loop = WatchLoop(
+        sources,
+        WatchScreen(console, sources.description),
+        load=load,
+        suite=suite,
+        after=after,
+        failed=cache.failed(),
+    )
+    return loop.run_forever()
+
+
+def write_reports(
+    args: argparse.Namespace, results: list[RunResult], order: Sequence[Scenario]
+) -> list[str]:
+    """`--out` and `--junit-xml`, rewritten with this run; the lines that say where."""
+    written = []
+    report = open_report(args.out)
+    if report is not None:
+        try:
+            scenario = scenario_of(order)
+            for result in results:
+                write_report_file(f"--out {args.out}", report.add, result, scenario(result))
+            index = write_report_file(f"--out {args.out}", report.finish)
+        finally:
+            report.close()
+        written.append(f"report: {index}")
+    if args.junit_xml:
+        from harness.report.junit import write_junit
+
+        artifacts = [s.paths for s in report.scenarios] if report is not None else None
+        write_report_file(
+            f"--junit-xml {args.junit_xml}",
+            write_junit,
+            args.junit_xml,
+            results,
+            artifacts=artifacts,
+        )
+        written.append(f"junit: {args.junit_xml}")
+    return written

@@ -1,0 +1,319 @@
+"""Which files make up the node under test, and whether a change to them needs a build (pure).
+
+`run --watch` re-runs when these change. What the harness can know from the
+command line alone:
+
+- a Python script (``--node "python3 path/node.py ..."``, ``--node path/node.py``):
+  the script and the ``.py`` files beside it, which it may import (its folder
+  is watched, not the folders below it: a script in a home folder must not
+  cost a watch on every folder under it);
+- any other command whose program is a path to a file: that file;
+- ``--workspace W --package P``: the package's source folder (the folder under
+  W whose package.xml names P, as colcon finds it): its Python files,
+  setup.py, setup.cfg, package.xml and resource/. A workspace built with
+  ``--symlink-install`` runs its Python files where they are, so a change to
+  them needs no build; otherwise (and for setup.py, setup.cfg, package.xml
+  or resource/ in any case) ``colcon build --packages-select P`` must run
+  first, with the flags the workspace was built with;
+- ``--link inprocess --processor FILE.py:FUNCTION``: that file (it is loaded
+  anew for every scenario; a module it imports is not).
+
+Scenario files given by path are watched too. The bundled reference node is
+not the user's to edit: it brings nothing to watch. No rclpy here.
+"""
+
+from __future__ import annotations
+
+import os
+import shlex
+import xml.etree.ElementTree as ET
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from harness.errors import ConfigError
+from harness.nodes.command import python_script_of
+from harness.nodes.setup_problems import is_python
+
+if TYPE_CHECKING:
+    from harness.links.base import LinkOptions
+
+__all__ = ["Build", "NodeSources", "Watched", "node_sources", "scenario_sources"]
+
+WORKSPACE_OUTPUTS = ("build", "install", "log")  # colcon's folders in a workspace
+BUILD_FILES = frozenset({"setup.py", "setup.cfg", "package.xml"})
+RESOURCE_FOLDER = "resource"
+SKIPPED_FOLDERS = frozenset({"__pycache__", *WORKSPACE_OUTPUTS})
+AMENT_MARKERS = Path("share/ament_index/resource_index/packages")
+
+
+def _hidden(name: str) -> bool:
+    """An editor's or a tool's own file (.#node.py, .node.py.swp, .git, .ruff_cache)."""
+    return name.startswith((".", "~"))
+
+
+@dataclass(frozen=True)
+class Watched:
+    """A folder to watch and which of its files count.
+
+    Not `recursive`: the files directly in `folder` named in `names`, or
+    (when `suffixes` is given) any with one of those suffixes. `recursive`:
+    a package's source folder, under the package rules (`package_file`).
+    """
+
+    folder: Path
+    recursive: bool = False
+    names: frozenset[str] = frozenset()
+    suffixes: tuple[str, ...] = ()
+
+    def matches(self, path: Path) -> bool:
+        """Does a change to `path` concern the node (or the scenarios)?"""
+        try:
+            relative = path.relative_to(self.folder)
+        except ValueError:
+            return False
+        parts = relative.parts
+        if not parts or any(_hidden(p) for p in parts):
+            return False
+        if self.recursive:
+            return package_file(relative)
+        if len(parts) != 1:
+            return False
+        return parts[0] in self.names or (bool(self.suffixes) and path.suffix in self.suffixes)
+
+
+def package_file(relative: Path) -> bool:
+    """A file of a package's sources that the node's run depends on: a Python file, the
+    package's setup.py, setup.cfg or package.xml, or anything in its resource/ folder."""
+    parts = relative.parts
+    if any(p in SKIPPED_FOLDERS or p.endswith(".egg-info") for p in parts[:-1]):
+        return False
+    if len(parts) == 1 and parts[0] in BUILD_FILES:
+        return True
+    if parts[0] == RESOURCE_FOLDER and len(parts) > 1:
+        return True
+    return relative.suffix == ".py"
+
+
+def needs_build_files(relative: Path) -> bool:
+    """A change colcon must install even into a --symlink-install workspace."""
+    parts = relative.parts
+    return (len(parts) == 1 and parts[0] in BUILD_FILES) or parts[0] == RESOURCE_FOLDER
+
+
+@dataclass(frozen=True)
+class Build:
+    """How to rebuild the package under test: ``colcon build --packages-select`` in its
+    workspace, with the install layout the workspace already has."""
+
+    workspace: Path
+    package: str
+    source: Path  # the package's folder (its package.xml)
+    symlink_install: bool = False
+    merge_install: bool = False
+
+    def command(self, colcon: str, extra: Sequence[str] = ()) -> list[str]:
+        """The colcon command line, run in `workspace`; `extra` goes after ``build``."""
+        argv = [colcon, "build", *extra, "--packages-select", self.package]
+        if self.symlink_install:
+            argv.append("--symlink-install")
+        if self.merge_install:
+            argv.append("--merge-install")
+        return argv
+
+    def needed(self, changed: Iterable[Path]) -> bool:
+        """Must these changed files be built before the node runs them?"""
+        for path in changed:
+            try:
+                relative = path.relative_to(self.source)
+            except ValueError:
+                continue
+            if not package_file(relative):
+                continue
+            if not self.symlink_install or needs_build_files(relative):
+                return True
+        return False
+
+
+@dataclass(frozen=True)
+class NodeSources:
+    """What to watch for a run: folders and the files in them that count, what they are
+    (for the screen), and the build a change may need."""
+
+    watched: tuple[Watched, ...] = ()
+    description: tuple[str, ...] = ()
+    build: Build | None = None
+    scenario_files: frozenset[Path] = field(default_factory=frozenset)
+
+    def matches(self, path: str | Path) -> bool:
+        """Does a change to `path` concern this run?"""
+        resolved = Path(path)
+        return any(w.matches(resolved) for w in self.watched)
+
+    def plus(self, other: NodeSources) -> NodeSources:
+        """Both sets of sources (the node's and the scenarios'), one build at most."""
+        return NodeSources(
+            self.watched + other.watched,
+            self.description + other.description,
+            self.build or other.build,
+            self.scenario_files | other.scenario_files,
+        )
+
+
+def _real(path: str | Path) -> Path:
+    """An absolute path with symlinks resolved (the watcher reports real paths)."""
+    return Path(os.path.realpath(os.path.expanduser(path)))
+
+
+def _script_sources(script: Path, shown: str) -> NodeSources:
+    folder = script.parent
+    return NodeSources(
+        (Watched(folder, suffixes=(".py",)),),
+        (f"{shown} and the .py files beside it in {folder}",),
+    )
+
+
+def _file_sources(program: Path, shown: str) -> NodeSources:
+    return NodeSources((Watched(program.parent, names=frozenset({program.name})),), (shown,))
+
+
+def command_sources(command: str, *, option: str = "--node") -> NodeSources:
+    """The files a node command line runs: a script and the .py files beside it, or
+    its program when that is a file; ConfigError when the command names none."""
+    try:
+        argv = shlex.split(command)
+    except ValueError as err:
+        raise ConfigError(f"{option} {command!r}: {err}") from None
+    if not argv:
+        raise ConfigError(f"{option}: the command is empty")
+    program = argv[0]
+    script = python_script_of(argv) if is_python(program) else None
+    if script is None and is_python(program):  # -m or -c: no file on the command line
+        raise ConfigError(
+            f"--watch: cannot tell which files {option} {command!r} runs; "
+            f"give the script's path, e.g. {option} 'python3 path/to/node.py'"
+        )
+    if script is None and program.endswith(".py"):
+        script = program
+    if script is not None:
+        path = Path(os.path.expanduser(script))
+        if not path.is_file():
+            raise ConfigError(f"--watch: {option} {command!r}: no such script {script}")
+        return _script_sources(_real(path), path.name)
+    if "/" in program and Path(os.path.expanduser(program)).is_file():
+        return _file_sources(_real(program), program)
+    raise ConfigError(
+        f"--watch: cannot tell which files {option} {command!r} runs ({program!r} is a "
+        "program, not a file of yours); give the script's path, or use "
+        "--workspace/--package/--executable"
+    )
+
+
+def _package_name(package_xml: Path) -> str | None:
+    try:
+        name = ET.parse(package_xml).getroot().findtext("name")
+    except (OSError, ET.ParseError):
+        return None
+    return name.strip() if name else None
+
+
+def find_package(workspace: Path, package: str) -> Path | None:
+    """The folder under `workspace` whose package.xml names `package`, as colcon finds
+    it: not in the workspace's build/, install/ or log/, nor in hidden folders or
+    folders holding a COLCON_IGNORE; symlinked folders are followed (once each)."""
+    seen: set[Path] = set()
+    for folder, subfolders, files in os.walk(workspace, followlinks=True):
+        here = Path(folder)
+        real = _real(here)
+        if real in seen or "COLCON_IGNORE" in files:
+            subfolders[:] = []
+            continue
+        seen.add(real)
+        if "package.xml" in files and _package_name(here / "package.xml") == package:
+            return here
+        skip = WORKSPACE_OUTPUTS if here == workspace else ()
+        subfolders[:] = sorted(
+            d for d in subfolders if d not in skip and not _hidden(d) and d != "__pycache__"
+        )
+    return None
+
+
+def symlink_installed(workspace: Path, package: str) -> bool:
+    """Was `package` built with ``colcon build --symlink-install``? Then its install
+    has an .egg-link to the sources, and build/P links to the source folders."""
+    install = workspace / "install"
+    for prefix in (install / package, install):
+        if any(prefix.glob("lib/python3*/site-packages/*.egg-link")):
+            return True
+    build = workspace / "build" / package
+    try:
+        return any(p.is_symlink() and p.is_dir() for p in build.iterdir())
+    except OSError:
+        return False
+
+
+def merge_installed(workspace: Path) -> bool:
+    """Was the workspace built with ``--merge-install`` (one prefix for every package)?"""
+    return (workspace / "install" / AMENT_MARKERS).is_dir()
+
+
+def package_sources(workspace: str, package: str) -> NodeSources:
+    """The package's source folder in `workspace` and how to rebuild it."""
+    root = Path(os.path.expanduser(workspace))
+    if not (root / "install").is_dir():
+        raise ConfigError(
+            f"--watch: --workspace {workspace} has no install/ folder: give the colcon "
+            "workspace itself (the folder you run colcon build in), built once"
+        )
+    source = find_package(root, package)
+    if source is None:
+        raise ConfigError(
+            f"--watch: no package.xml naming {package} under --workspace {workspace} "
+            "(outside its build/, install/ and log/): its sources are what --watch watches"
+        )
+    symlinked = symlink_installed(root, package)
+    build = Build(_real(root), package, _real(source), symlinked, merge_installed(root))
+    how = "--symlink-install: a .py change needs no build" if symlinked else "rebuilt on change"
+    return NodeSources(
+        (Watched(build.source, recursive=True),),
+        (f"package {package} in {build.source} ({how})",),
+        build,
+    )
+
+
+def processor_sources(processor: str | None) -> NodeSources:
+    """`--processor FILE.py:FUNCTION`: the file; a module name brings nothing to watch
+    (Python keeps an imported module: a change would not be run)."""
+    target = (processor or "").rpartition(":")[0]
+    if not target.endswith(".py"):
+        return NodeSources()
+    path = Path(os.path.expanduser(target))
+    if not path.is_file():
+        raise ConfigError(f"--processor {processor!r}: no such file {target}")
+    return _file_sources(_real(path), target)
+
+
+def node_sources(link: str, options: LinkOptions) -> NodeSources:
+    """The files of the node (or processing function) `options` name; empty for the
+    bundled ones. ConfigError, one line, when the named ones cannot be found."""
+    if link == "inprocess":
+        return processor_sources(options.processor)
+    if options.node:
+        return command_sources(options.node)
+    if options.package:
+        if options.workspace is None:
+            raise ConfigError(
+                "--watch with --package needs --workspace DIR: the colcon workspace whose "
+                "sources to watch and rebuild"
+            )
+        return package_sources(options.workspace, options.package)
+    return NodeSources()
+
+
+def scenario_sources(refs: Iterable[str]) -> NodeSources:
+    """The scenario files given by path (shipped names are not the user's to edit)."""
+    files = [_real(r) for r in refs if Path(os.path.expanduser(r)).is_file()]
+    watched = tuple(Watched(f.parent, names=frozenset({f.name})) for f in files)
+    shown = tuple(f"scenario file {f}" for f in files)
+    return NodeSources(watched, shown, None, frozenset(files))

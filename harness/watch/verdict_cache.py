@@ -1,0 +1,145 @@
+"""The last run's verdicts per scenario, for `run --failed-first` and `run --watch`.
+
+Every `run` leaves one small JSON file: scenario name -> "passed" or "failed".
+`--failed-first` (and the first run of `--watch`) reads it to put what
+failed first, as `pytest --ff` reads .pytest_cache.
+
+Where: in the user's cache folder (``$XDG_CACHE_HOME/fossbot-hil/last-run/``,
+by default ``~/.cache/fossbot-hil/last-run/``; ``$FOSSBOT_HIL_CACHE_DIR/last-run/``
+when that is set), one file per working folder
+and node under test, named by a hash of both. Not in the working folder as
+pytest does: the harness runs in a student's lab folder, often a git
+repository they hand in, or a folder they may not write; and not one file
+for all: the verdicts of another node (another ``--node``, package or
+workspace), or of the same command line run from another folder (whose
+relative paths name other files), say nothing of this one's. The newest
+files are kept (at most `KEPT_FILES`).
+
+The file only orders scenarios, never judges them: when it is missing,
+unreadable, of another format or written for another key, the scenarios
+run in their given order. It is written atomically (harness.atomic_write),
+so a run killed mid-write leaves the previous one.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import hashlib
+import json
+import os
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from harness.atomic_write import write_atomically
+
+if TYPE_CHECKING:
+    from harness.judge.records import RunResult
+    from harness.links.base import LinkOptions
+
+__all__ = ["VerdictCache", "cache_folder", "node_key", "verdict_cache"]
+
+FORMAT = 1
+CACHE_VARIABLE = "FOSSBOT_HIL_CACHE_DIR"
+KEPT_FILES = 200
+PASSED, FAILED = "passed", "failed"
+
+
+def cache_folder(env: Mapping[str, str] | None = None) -> Path:
+    """``$FOSSBOT_HIL_CACHE_DIR/last-run`` when set (a CI job's or a test suite's own),
+    else ``$XDG_CACHE_HOME/fossbot-hil/last-run`` (``~/.cache`` when unset or not
+    absolute), as the XDG base directory rules say."""
+    env = os.environ if env is None else env
+    own = env.get(CACHE_VARIABLE)
+    if own:
+        return Path(own) / "last-run"
+    base = env.get("XDG_CACHE_HOME", "")
+    if not os.path.isabs(base):  # unset, or relative (which the XDG rules say to ignore)
+        base = os.path.join(os.path.expanduser("~"), ".cache")
+    return Path(base) / "fossbot-hil" / "last-run"
+
+
+def node_key(link: str, options: LinkOptions, cwd: str | None = None) -> dict[str, object]:
+    """What names the node under test, and where the command ran (its relative paths)."""
+    workspace = os.path.abspath(options.workspace) if options.workspace else None
+    return {
+        "cwd": cwd if cwd is not None else os.getcwd(),
+        "link": link,
+        "node": options.node,
+        "package": options.package,
+        "executable": options.executable,
+        "workspace": workspace,
+        "processor": options.processor,
+        "board_commands": list(options.board_commands),
+    }
+
+
+@dataclass(frozen=True)
+class VerdictCache:
+    """The verdicts file of one working folder and node."""
+
+    path: Path
+    key: Mapping[str, object]
+
+    def verdicts(self) -> dict[str, str]:
+        """Scenario name -> "passed" or "failed"; empty when there is no usable file."""
+        try:
+            stored = json.loads(self.path.read_text(encoding="utf-8"))
+        except (OSError, ValueError):
+            return {}
+        if not isinstance(stored, dict) or stored.get("format") != FORMAT:
+            return {}
+        if stored.get("key") != dict(self.key):
+            return {}
+        verdicts = stored.get("verdicts")
+        if not isinstance(verdicts, dict):
+            return {}
+        return {
+            name: verdict
+            for name, verdict in verdicts.items()
+            if isinstance(name, str) and verdict in (PASSED, FAILED)
+        }
+
+    def failed(self) -> set[str]:
+        """The scenarios that failed when they last ran."""
+        return {name for name, verdict in self.verdicts().items() if verdict == FAILED}
+
+    def remember(self, results: Sequence[RunResult], *, interrupted: bool = False) -> None:
+        """Keep this run's verdicts, over the earlier ones of the same scenarios.
+
+        Not judged, so not kept: a scenario not run, and, when the run was
+        `interrupted`, the scenario it stopped in. A file that cannot be
+        written is no error: the order is a convenience.
+        """
+        judged = [r for r in results if not r.not_run]
+        if interrupted and judged:
+            judged = judged[:-1]
+        verdicts = self.verdicts()
+        for result in judged:
+            verdicts[result.scenario] = PASSED if result.ok else FAILED
+        content = {"format": FORMAT, "key": dict(self.key), "verdicts": verdicts}
+        data = json.dumps(content, indent=1, sort_keys=True).encode("utf-8") + b"\n"
+        with contextlib.suppress(OSError):
+            write_atomically(self.path, data)
+            _keep_newest(self.path.parent, KEPT_FILES)
+
+
+def _keep_newest(folder: Path, count: int) -> None:
+    """Remove all but the `count` most recently written verdict files."""
+    files = []
+    for path in folder.glob("*.json"):
+        with contextlib.suppress(OSError):
+            files.append((path.stat().st_mtime, path))
+    for _, path in sorted(files, reverse=True)[count:]:
+        with contextlib.suppress(OSError):
+            path.unlink()
+
+
+def verdict_cache(
+    link: str, options: LinkOptions, *, cwd: str | None = None, folder: Path | None = None
+) -> VerdictCache:
+    """The verdicts file for this node run from this folder."""
+    key = node_key(link, options, cwd)
+    digest = hashlib.sha256(json.dumps(key, sort_keys=True).encode("utf-8")).hexdigest()
+    return VerdictCache((folder or cache_folder()) / f"{digest[:24]}.json", key)
