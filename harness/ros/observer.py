@@ -31,6 +31,7 @@ from sensor_msgs.msg import LaserScan
 from std_msgs.msg import Bool, String
 
 from harness.lidar.scan import Scan
+from harness.ros.announcements import harness_announcements
 from harness.ros.domain import discovery_environment
 from harness.ros.messages import clock_message, scan_from_message, scan_message
 
@@ -75,16 +76,17 @@ class Observer:
         # rclpy's own handlers would shut the context down under our feet.
         # args=[]: not sys.argv, where the user's NAME:=VALUE items would be
         # taken for remappings of the harness's own node.
-        rclpy.init(
-            args=[],
-            context=self.context,
-            domain_id=domain_id,
-            signal_handler_options=SignalHandlerOptions.NO,
-        )
-        # No /rosout: the harness logs nothing there, and a suite has several
-        # of these nodes at once (one per domain), whose rosout publishers
-        # would clash by name within this process.
-        self.node = rclpy.create_node("fossbot_hil", context=self.context, enable_rosout=False)
+        with harness_announcements():  # a node that comes up late is matched at once
+            rclpy.init(
+                args=[],
+                context=self.context,
+                domain_id=domain_id,
+                signal_handler_options=SignalHandlerOptions.NO,
+            )
+            # No /rosout: the harness logs nothing there, and a suite has several
+            # of these nodes at once (one per domain), whose rosout publishers
+            # would clash by name within this process.
+            self.node = rclpy.create_node("fossbot_hil", context=self.context, enable_rosout=False)
         self.scan_topic, self.status_topic = scan_topic, status_topic
         self.warning_topic = warning_topic
         # Either we publish the scans (ros2 link) or a board's driver does and

@@ -31,6 +31,7 @@ TELLING_NODE = textwrap.dedent(
     MARK = "first"
     print("mark", MARK, "argv", sys.argv[1:], "cwd", os.getcwd(), file=sys.stderr)
     print("path0", sys.path[0], "file", __file__, "name", __name__, file=sys.stderr)
+    print("profile", os.environ.get("FASTRTPS_DEFAULT_PROFILES_FILE"), file=sys.stderr)
     try:
         while True:
             time.sleep(0.05)
@@ -66,6 +67,14 @@ def started(command: NodeCommand, env: dict[str, str] | None = None) -> NodeProc
 def test_a_script_is_forked_and_read_afresh_every_time(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
+    from harness.ros.domain import reserve_domain
+    from harness.ros.observer import Observer  # the harness's participant, before the node
+
+    domain = reserve_domain(None)
+    try:
+        Observer(domain.domain_id, scan_topic="/s", status_topic="/t", warning_topic="/w").close()
+    finally:
+        domain.release()
     script = tmp_path / "node.py"
     script.write_text(TELLING_NODE)
     work = tmp_path / "work"
@@ -81,6 +90,7 @@ def test_a_script_is_forked_and_read_afresh_every_time(
         assert "mark first argv ['extra', '--ros-args', '-p', 'x:=1']" in said
         assert f"cwd {work}" in said
         assert f"path0 {tmp_path} file {script} name __main__" in said
+        assert "profile None" in said  # the harness's own DDS profile is not the node's
         assert process.stop() == 0
     finally:
         process.stop()
