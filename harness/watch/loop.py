@@ -157,6 +157,6 @@ class WatchLoop:
         for result in results:
             if not result.not_run:
                 (self.failed.discard if result.ok else self.failed.add)(result.scenario)
-        self._judged = []
         for line in self.after(results):
             self.screen.note(line)
+        self._judged = []  # kept until written: Ctrl-C before this writes them again
