@@ -66,19 +66,22 @@ class LabWorkspace:
 
 
 def lab_package_source(harness_dir: Path | None = None) -> Path:
-    """node/fossbot_lidar_processing of the checkout the harness runs from.
+    """node/fossbot_lidar_processing of the checkout the harness runs from (an editable
+    install), else of the checkout the bench runs in (the working folder).
 
     `harness_dir` is the harness package's folder (default: the one imported).
-    An installed wheel has no node/ beside it: HarnessError says so.
+    An installed wheel run elsewhere has neither: HarnessError says so.
     """
     here = (harness_dir or Path(harness.__file__).parent).resolve()
-    source = here.parent / "node" / LAB_PACKAGE
-    if not (source / "package.xml").is_file() or not (source / "setup.py").is_file():
-        raise HarnessError(
-            f"the harness at {here} is installed without its repository (no node/{LAB_PACKAGE} "
-            "beside it): the workspace-node figures need a source checkout (pip install -e)"
-        )
-    return source
+    for root in (here.parent, Path.cwd()):
+        source = root / "node" / LAB_PACKAGE
+        if (source / "package.xml").is_file() and (source / "setup.py").is_file():
+            return source
+    raise HarnessError(
+        f"the harness at {here} is installed without its repository (no node/{LAB_PACKAGE} "
+        "beside it or in the working folder): the workspace-node figures need a source "
+        "checkout (run the bench there, or pip install -e)"
+    )
 
 
 def colcon_program() -> str:

@@ -24,13 +24,23 @@ from harness.errors import HarnessError
 REPO = Path(__file__).resolve().parents[2]
 
 
-def test_the_lab_package_is_found_beside_the_harness() -> None:
-    assert lab_package_source() == REPO / "node" / LAB_PACKAGE
+def test_the_lab_package_is_found_in_the_checkout(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.chdir(REPO)  # an installed wheel run in the checkout (as CI runs it)
+    installed = tmp_path / "site-packages" / "harness"
+    assert lab_package_source(installed).resolve() == REPO / "node" / LAB_PACKAGE
+    editable = REPO / "harness"  # an editable install, run anywhere
+    monkeypatch.chdir(tmp_path)
+    assert lab_package_source(editable) == REPO / "node" / LAB_PACKAGE
 
 
-def test_a_harness_without_its_repository_is_named(tmp_path: Path) -> None:
+def test_a_harness_without_its_repository_is_named(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
     installed = tmp_path / "site-packages" / "harness"  # a wheel: no node/ beside it
     installed.mkdir(parents=True)
+    monkeypatch.chdir(tmp_path)
     with pytest.raises(HarnessError, match="installed without its repository"):
         lab_package_source(installed)
 
