@@ -38,7 +38,7 @@ from harness.report.folder_lock import LOCK_NAME
 
 pytestmark = [pytest.mark.timeout(300), pytest.mark.slow]
 
-EXAMPLES = examples(240)
+EXAMPLES = examples(180)
 TINY = """\
 description: Three ticks beside a wall.
 obstacles:

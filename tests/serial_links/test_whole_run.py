@@ -203,12 +203,18 @@ def port_run(far_end: FarEnd, out: Path, *scenarios: str) -> subprocess.Popen[st
     )
 
 
-def test_v2_chain_runs_the_whole_suite_over_a_serial_port(far_end: FarEnd, tmp_path: Path) -> None:
+# Over --port, three scenarios in real time (about 25 s; the whole suite, about 80 s, runs
+# through the same chain as --board-command above): a wall ahead, one at the side, and
+# nothing in range (revolutions the agent's client skips) between them.
+PORT_SUITE = ("approach_wall", "out_of_range", "obstacle_at_side")
+
+
+def test_v2_chain_runs_a_suite_over_a_serial_port(far_end: FarEnd, tmp_path: Path) -> None:
     """--port: the v2's agent, bridge and a lab node on the far end of the cable read
     every scenario from one device session, nothing restarted."""
     chain = V2Chain(tmp_path)
     out = tmp_path / "report"
-    run = port_run(far_end, out)
+    run = port_run(far_end, out, *PORT_SUITE)
     far_end.start(
         run,
         chain.agent(far_end.cable.board_end),
@@ -218,7 +224,7 @@ def test_v2_chain_runs_the_whole_suite_over_a_serial_port(far_end: FarEnd, tmp_p
     )
     text = finished(run)
     assert run.returncode == 0, text + far_end.logs()
-    assert_whole_suite_passed(text, out)
+    assert_whole_suite_passed(text, out, count=len(PORT_SUITE))
     assert len(chain.openings()) == 2, chain.openings()
 
 
@@ -227,7 +233,8 @@ def test_bundled_driver_runs_the_whole_suite_over_a_serial_port(
 ) -> None:
     """The bundled board driver with its defaults (the v2 bridge's mapping) on the far
     end: one device across scenarios (two of them: the whole suite in real time is the
-    v2 chain's test above; the bundled driver's whole suite runs on the virtual board)."""
+    v2 chain's test with --board-command; the bundled driver's whole suite runs on the
+    virtual board)."""
     out = tmp_path / "report"
     run = port_run(far_end, out, "approach_wall", "rotate_beside_wall")
     far_end.start(run, bundled_driver(far_end.cable.board_end), REFERENCE_NODE)
