@@ -48,7 +48,7 @@ PURE = [
     "harness.ros.domain",
     "harness.ros.names",
     "harness.sim.motion",
-    "harness.nodes.sources",
+    "harness.watch.sources",
     "harness.nodes.python_script",
     "harness.nodes.colcon_hooks",
     "harness.watch.order",

@@ -3,9 +3,8 @@
 from __future__ import annotations
 
 import argparse
-from collections.abc import Callable, Sequence
-from dataclasses import replace
-from typing import TYPE_CHECKING, Any, TypeVar
+from collections.abc import Sequence
+from typing import TYPE_CHECKING
 
 from rich.console import Console
 
@@ -15,24 +14,22 @@ from harness.commands.arguments import (
     add_link_option,
     add_node_options,
     add_scenario_overrides,
-    check_link_options,
-    check_output_file,
-    check_status_regex,
     given,
-    judging_settings,
-    unchecked_link_options,
+)
+from harness.commands.run_steps import (
+    open_report,
+    prepared,
+    scenario_of,
+    settings_from,
+    write_report_file,
 )
 from harness.errors import ConfigError, Interrupted
 
 if TYPE_CHECKING:  # the rest is imported when a run starts (the parser is built for any command)
     from harness.judge.records import RunResult
-    from harness.links.base import LinkOptions
     from harness.report.baseline import Baseline, Comparison
-    from harness.report.outputs import ReportFolder
-    from harness.runner.settings import RunSettings
     from harness.scenario.schema import Scenario
 
-T = TypeVar("T")
 
 NAME = "run"
 HELP = "run scenarios and judge the node's answers"
@@ -128,30 +125,6 @@ def compared(results: Sequence[RunResult], baseline: Baseline) -> Comparison:
     return compare(baseline, [scenario_entry(stored(r), {}) for r in results])
 
 
-def selected(names: Sequence[str]) -> list[Scenario]:
-    """The named scenarios (all resolved before anything runs), or every shipped one."""
-    from harness.scenario.files import resolve_scenario, shipped_scenarios
-
-    return [resolve_scenario(n) for n in names] if names else shipped_scenarios()
-
-
-def settings_from(args: argparse.Namespace) -> RunSettings:
-    """The per-run overrides given on the command line."""
-    return replace(judging_settings(args), gui=args.gui)
-
-
-def open_report(out: str | None, *, animate: bool = False) -> ReportFolder | None:
-    """The `--out` folder, created now so a bad path fails before anything runs."""
-    if out is None:
-        return None
-    from harness.report.outputs import ReportFolder, artifact_writers
-
-    try:
-        return ReportFolder(out, artifact_writers(animate=animate))
-    except ConfigError as err:
-        raise ConfigError(f"--out {err}") from None
-
-
 def check_animate(args: argparse.Namespace) -> None:
     """`--animate` writes into the report folder, so it needs one."""
     if args.animate and args.out is None:
@@ -177,17 +150,6 @@ def check_watch(args: argparse.Namespace) -> None:
         raise ConfigError("--fail-on regression cannot go with --watch: a loop has no exit code")
 
 
-def scenario_of(scenarios: Sequence[Scenario]) -> Callable[[RunResult], Scenario | None]:
-    """The scenario each result ran: results come in the order of `scenarios`, one each."""
-    pending = iter(scenarios)
-
-    def lookup(result: RunResult) -> Scenario | None:
-        scenario = next(pending, None)
-        return scenario if scenario is not None and scenario.name == result.scenario else None
-
-    return lookup
-
-
 def run(args: argparse.Namespace, console: Console) -> int:
     from harness.nodes.forkserver import scope
 
@@ -201,23 +163,6 @@ def run(args: argparse.Namespace, console: Console) -> int:
 
             return watch(args, console)
         return _run(args, console, baseline)
-
-
-def prepared(args: argparse.Namespace) -> tuple[LinkOptions, list[Scenario]]:
-    """The checked link options and scenarios of a run, every check done before a report
-    folder exists. The node's fork server (if any) starts first: it takes a while, in
-    another process, while the checks run."""
-    from harness.links.base import link_class
-
-    link_class(args.link).prepare(unchecked_link_options(args))
-    options = check_link_options(args)
-    scenarios = selected(args.scenarios)
-    check_output_file("--junit-xml", args.junit_xml)
-    check_status_regex(args)
-    from harness.runner.settings import check_settings
-
-    check_settings(scenarios, settings_from(args))
-    return options, scenarios
 
 
 def _run(args: argparse.Namespace, console: Console, baseline: Baseline | None) -> int:
@@ -319,11 +264,3 @@ def ordered_by_last_run(
         line = "--failed-first: none of these failed last time (or no earlier run): given order"
     print_safe(console, line)
     return failed_first(scenarios, failed)
-
-
-def write_report_file(option: str, writer: Callable[..., T], *args: Any, **kwargs: Any) -> T:
-    """Run a report writer; a file system error is the user's to fix, in one line."""
-    try:
-        return writer(*args, **kwargs)
-    except OSError as err:
-        raise ConfigError(f"{option}: {err.strerror or err}") from None

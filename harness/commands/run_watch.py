@@ -2,7 +2,7 @@
 
 Everything `run` checks is checked once, before the first run (exit 2 as
 `run`). What is watched: the node's files and the scenario files given by
-path (harness.nodes.sources); with nothing to watch (the bundled node and
+path (harness.watch.sources); with nothing to watch (the bundled node and
 shipped scenarios only) the command exits 2. The scenarios are read again
 when one of their files changes. After each run: the verdict cache (for
 the next run's order and for `--failed-first`), and `--out` / `--junit-xml`
@@ -21,7 +21,7 @@ from typing import TYPE_CHECKING
 from rich.console import Console
 
 from harness.commands.arguments import unchecked_link_options
-from harness.commands.run import (
+from harness.commands.run_steps import (
     open_report,
     prepared,
     scenario_of,
@@ -36,8 +36,8 @@ if TYPE_CHECKING:
 
     from harness.judge.records import RunResult, TickRecord
     from harness.links.base import LinkOptions
-    from harness.nodes.sources import NodeSources
     from harness.scenario.schema import Scenario
+    from harness.watch.sources import NodeSources
 
 __all__ = ["watch", "watch_sources"]
 
@@ -45,7 +45,7 @@ __all__ = ["watch", "watch_sources"]
 def watch_sources(args: argparse.Namespace, options: LinkOptions) -> NodeSources:
     """The node's files and the scenario files given by path; ConfigError when there are
     none to watch."""
-    from harness.nodes.sources import node_sources, scenario_sources
+    from harness.watch.sources import node_sources, scenario_sources
 
     sources = node_sources(args.link, options).plus(scenario_sources(args.scenarios))
     if not sources.watched:

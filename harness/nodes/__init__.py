@@ -11,8 +11,6 @@
   scripts, from ``warm_python``); ``python_script`` decides which commands
   it may serve, so a forked node is what its command would have started;
 - ``colcon_hooks``: the environment sourcing a colcon workspace would give;
-- ``sources``: the node's own files (what ``run --watch`` watches) and
-  whether a change to them needs a ``colcon build``;
 - ``quick_exit``: ending a process without the interpreter's teardown.
 
 No rclpy here: a node's ROS graph is ``harness.ros``'s.

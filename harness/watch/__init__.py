@@ -10,8 +10,9 @@
   elsewhere;
 - ``loop``: run, wait for a change, (build,) run again, until Ctrl-C.
 
-What to watch for a node, and when a change needs a build, is
-``harness.nodes.sources``.
+- ``sources`` (pure): what to watch for a node (its script, a workspace
+  package's sources, a processor file, scenario files), and whether a change
+  needs a ``colcon build``.
 """
 
 from harness import lazy_exports

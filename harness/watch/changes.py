@@ -21,7 +21,7 @@ from pathlib import Path
 from types import TracebackType
 
 from harness.errors import HarnessError, one_line
-from harness.nodes.sources import Watched
+from harness.watch.sources import Watched
 
 __all__ = ["ChangeFeed", "Changes"]
 

@@ -22,10 +22,10 @@ from typing import TYPE_CHECKING
 
 from harness.errors import HarnessError, Interrupted
 from harness.judge.records import RunResult, TickRecord
-from harness.nodes.sources import Build, NodeSources
 from harness.watch.changes import ChangeFeed, Changes
 from harness.watch.order import failed_first
 from harness.watch.screen import WatchScreen
+from harness.watch.sources import Build, NodeSources
 
 if TYPE_CHECKING:
     from harness.scenario.schema import Scenario

@@ -18,7 +18,7 @@ from pathlib import Path
 
 from harness.grading.build import EVENT_HANDLERS, build_error, colcon_executable
 from harness.grading.process import run_bounded
-from harness.nodes.sources import Build
+from harness.watch.sources import Build
 
 __all__ = ["BUILD_TIMEOUT_S", "BuildOutcome", "build_log", "rebuild"]
 

@@ -14,7 +14,7 @@ import pytest
 
 from harness.errors import ConfigError
 from harness.links.base import LinkOptions
-from harness.nodes.sources import (
+from harness.watch.sources import (
     Build,
     find_package,
     node_sources,
