@@ -529,7 +529,7 @@ def test_generated_scenarios_run_or_are_refused(
         record_property(key, value)
     with capsys.disabled():
         print(f"\n[scenario properties, in process] {dict(stats)}\n  hostile: {dict(kinds)}")
-    assert stats["generated"] >= 500
+    assert stats["generated"] >= IN_PROCESS_EXAMPLES * 0.95  # hypothesis may stop a little short
     assert stats["ran"] >= 50 and stats["refused at load"] >= 100, dict(stats)
     for kind in HOSTILE_KINDS:  # each hostile form is generated, and refused at least sometimes
         assert kinds[f"{kind}: refused"] >= 5, dict(kinds)
