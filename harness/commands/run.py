@@ -21,6 +21,7 @@ from harness.commands.run_steps import (
     prepared,
     scenario_of,
     settings_from,
+    write_junit_file,
     write_report_file,
 )
 from harness.errors import ConfigError, Interrupted
@@ -229,16 +230,7 @@ def _run(args: argparse.Namespace, console: Console, baseline: Baseline | None) 
         )
         console.print(f"report: {index}", highlight=False, markup=False, soft_wrap=True)
     if args.junit_xml:
-        from harness.report.junit import write_junit
-
-        artifacts = [s.paths for s in report.scenarios] if report is not None else None
-        write_report_file(
-            f"--junit-xml {args.junit_xml}",
-            write_junit,
-            args.junit_xml,
-            results,
-            artifacts=artifacts,
-        )
+        write_junit_file(args.junit_xml, results, report)
     if interrupted is not None:
         judged = sum(1 for r in results if not r.not_run)
         summary = f"{judged} of {len(scenarios)} scenarios judged, the last one in part"

@@ -85,3 +85,11 @@ def write_report_file(option: str, writer: Callable[..., T], *args: Any, **kwarg
         return writer(*args, **kwargs)
     except OSError as err:
         raise ConfigError(f"{option}: {err.strerror or err}") from None
+
+
+def write_junit_file(path: str, results: Sequence[RunResult], report: ReportFolder | None) -> None:
+    """`--junit-xml`: the run's verdicts, linking the report folder's files when there is one."""
+    from harness.report.junit import write_junit
+
+    artifacts = [s.paths for s in report.scenarios] if report is not None else None
+    write_report_file(f"--junit-xml {path}", write_junit, path, results, artifacts=artifacts)

@@ -27,6 +27,7 @@ from harness.commands.run_steps import (
     scenario_of,
     selected,
     settings_from,
+    write_junit_file,
     write_report_file,
 )
 from harness.errors import ConfigError
@@ -135,15 +136,6 @@ def write_reports(
             report.close()
         written.append(f"report: {index}")
     if args.junit_xml:
-        from harness.report.junit import write_junit
-
-        artifacts = [s.paths for s in report.scenarios] if report is not None else None
-        write_report_file(
-            f"--junit-xml {args.junit_xml}",
-            write_junit,
-            args.junit_xml,
-            results,
-            artifacts=artifacts,
-        )
+        write_junit_file(args.junit_xml, results, report)
         written.append(f"junit: {args.junit_xml}")
     return written
