@@ -486,9 +486,12 @@ def _pair_with_driver_scans(answers: Answers, scans: list[Heard]) -> None:
     a revolution late (its scan came with the next one) or split one in
     two, several came, often published back to back, before the node
     answered any. The node answers scans in order, so the i-th status
-    answers the i-th scan; a Bool goes with the status published nearest
-    to it (a node publishes both in one callback). The newest scan is this
-    tick's; the earlier ones go with their answers into
+    answers the i-th scan. With as many Bools as statuses the i-th Bool
+    goes with the i-th status too; otherwise (a Bool published only on
+    change) each goes with the status published nearest to it. Nearness
+    alone misleads when callbacks run back to back on a loaded machine:
+    the next scan's Bool can come closer to the previous status than to
+    its own. The newest scan is this tick's; the earlier ones go with their answers into
     ``answers.earlier``, each judged on its own.
     """
     if len(scans) < 2:
@@ -498,14 +501,17 @@ def _pair_with_driver_scans(answers: Answers, scans: list[Heard]) -> None:
     statuses = sorted(answers.statuses, key=lambda r: r.source_ns)
     for i, item in enumerate(statuses):
         groups[min(i, len(groups) - 1)].statuses.append(item)
-    for item in answers.warnings:
+    warnings = sorted(answers.warnings, key=lambda r: r.source_ns)
+    for i, item in enumerate(warnings):
         if not statuses:
-            groups[-1].warnings.append(item)
-            continue
-        nearest = min(
-            range(len(statuses)), key=lambda i: abs(statuses[i].source_ns - item.source_ns)
-        )
-        groups[min(nearest, len(groups) - 1)].warnings.append(item)
+            status = len(groups) - 1
+        elif len(warnings) == len(statuses):
+            status = i
+        else:
+            status = min(
+                range(len(statuses)), key=lambda j: abs(statuses[j].source_ns - item.source_ns)
+            )
+        groups[min(status, len(groups) - 1)].warnings.append(item)
     answers.statuses, answers.warnings = groups[-1].statuses, groups[-1].warnings
     answers.seen = seen[-1]
     answers.earlier = list(zip(seen[:-1], groups[:-1], strict=True))

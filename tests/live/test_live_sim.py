@@ -113,8 +113,15 @@ def driver() -> Iterator[tuple[subprocess.Popen[str], Callable[..., None], Seen]
 
         try:
             # Up, and hearing us: commands sent before discovery matched would be lost.
-            drive(None, 20.0, until=lambda: len(seen.odom) > 5 and cmd.get_subscription_count() > 0)
-            assert seen.odom and cmd.get_subscription_count() > 0, "the simulator never came up"
+            def up() -> bool:
+                heard = len(seen.odom) > 5 and bool(seen.nearest)
+                return heard and cmd.get_subscription_count() > 0
+
+            drive(None, 20.0, until=up)
+            assert up(), (
+                f"the simulator never came up: {len(seen.odom)} odometry messages, "
+                f"{len(seen.nearest)} scans, {cmd.get_subscription_count()} /cmd_vel subscribers"
+            )
             yield sim, drive, seen
         finally:
             if sim.poll() is None:

@@ -268,6 +268,51 @@ def test_answers_are_paired_with_driver_scans_in_order() -> None:
 
 
 @pytest.mark.ros
+def test_back_to_back_callbacks_keep_each_bool_with_its_own_status() -> None:
+    """Bool before status, callbacks back to back on a loaded machine: the second Bool
+    comes 1 us after the first status and 40 us before its own. As many Bools as statuses:
+    they pair in order, not by nearness."""
+    from harness.links.board import _pair_with_driver_scans
+    from harness.ros.observer import Heard
+
+    late, own = driver_scan(0.508), driver_scan(0.486)
+    scans = [Heard("scan", late, 1_000, 0.0), Heard("scan", own, 1_010, 0.0)]
+    answers = Answers(
+        statuses=[
+            Received("Min distance: 0.508 m", 0.01, source_ns=2_000),
+            Received("Min distance: 0.486 m", 0.02, source_ns=2_041),
+        ],
+        warnings=[Received(False, 0.01, source_ns=1_999), Received(True, 0.02, source_ns=2_001)],
+    )
+    _pair_with_driver_scans(answers, scans)
+    assert [r.value for r in answers.warnings] == [True]
+    ((_, first),) = answers.earlier
+    assert [r.value for r in first.warnings] == [False]
+
+
+@pytest.mark.ros
+def test_a_bool_published_only_on_change_goes_with_the_nearest_status() -> None:
+    """Two statuses, one Bool (published on change, after the second status): it is the
+    second scan's answer; the first scan has none."""
+    from harness.links.board import _pair_with_driver_scans
+    from harness.ros.observer import Heard
+
+    late, own = driver_scan(0.508), driver_scan(0.486)
+    scans = [Heard("scan", late, 1_000, 0.0), Heard("scan", own, 1_010, 0.0)]
+    answers = Answers(
+        statuses=[
+            Received("Min distance: 0.508 m", 0.01, source_ns=2_000),
+            Received("Min distance: 0.486 m", 0.02, source_ns=3_000),
+        ],
+        warnings=[Received(True, 0.02, source_ns=3_001)],
+    )
+    _pair_with_driver_scans(answers, scans)
+    assert [r.value for r in answers.warnings] == [True]
+    ((_, first),) = answers.earlier
+    assert first.warnings == []
+
+
+@pytest.mark.ros
 @pytest.mark.timeout(90)
 def test_a_revolution_made_late_by_the_line_is_judged_with_its_own_answers() -> None:
     """ldlidar, 0.5 % of bytes lost, seed 47: the line eats tick 73's closing packet, so
