@@ -17,7 +17,7 @@ from pathlib import Path
 
 import pytest
 from command_line import fossbot_hil
-from watch_process import save, verdict_lines
+from watch_process import save, save_by_rename, verdict_lines
 
 from harness.scenario.files import shipped_dir
 
@@ -81,7 +81,9 @@ def test_a_save_during_a_run_is_run_next(tmp_path: Path, start_watch) -> None:
     processor(tmp_path, delay=0.026)
     watch.expect(r"^run 2: changed proc.py")
     watch.expect(r"^PASS +approach_wall")  # drive_past_10m runs for seconds more
-    processor(tmp_path, delay=0.025)
+    # drive_past_10m may be loading proc.py this very moment: a save in place could
+    # hand it half a file; a rename hands it the old text or the new one.
+    save_by_rename(tmp_path / "proc.py", PROCESSOR.format(threshold=RIGHT, delay=0.025))
     rest = watch.expect(r"^run 3: changed proc.py")
     assert rest[0].startswith("PASS    drive_past_10m") and rest[1].startswith("2 of 2"), rest
     assert not any("watching for changes" in line for line in rest), rest  # run 3 came at once

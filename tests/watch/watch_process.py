@@ -142,6 +142,14 @@ def save(path: Path, text: str) -> None:
     path.write_text(text)
 
 
+def save_by_rename(path: Path, text: str) -> None:
+    """Save as editors that write a new file and rename it over the old one: a reader
+    never sees half a file. For saves while a run may be loading the file."""
+    new = path.with_name(f".{path.name}.new")
+    new.write_text(text)
+    os.replace(new, path)
+
+
 def verdict_lines(lines: Sequence[str]) -> list[str]:
     """The scenario names of the PASS / FAIL / ERROR lines, in order."""
     return [
