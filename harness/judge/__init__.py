@@ -6,7 +6,9 @@
   the verdict with its explanation;
 - ``records``: what one run produced, tick by tick (``RunResult``);
 - ``alignment``: whether the board's /scan is the truth turned or mirrored,
-  fitted over a run (``run_alignment``), and the likely fix.
+  fitted over a run (``run_alignment``), and the likely fix;
+- ``reading_coverage``: which kinds of readings a suite's delivered scans
+  carry (``coverage_of``), and what it never delivers (``gaps``).
 
 Pure: numpy only, no rclpy, no pybullet. Add a check to the ``Oracle``; teach
 ``status`` a new way students write their status.
@@ -26,6 +28,10 @@ _EXPORTS = {
     "Alignment": "alignment",
     "fit_alignment": "alignment",
     "run_alignment": "alignment",
+    "ReadingCoverage": "reading_coverage",
+    "coverage_of": "reading_coverage",
+    "coverage_by_scenario": "reading_coverage",
+    "gaps": "reading_coverage",
 }
 __all__ = sorted(_EXPORTS)
 __getattr__ = lazy_exports(__name__, _EXPORTS)

@@ -22,6 +22,14 @@ __all__ = ["index_html"]
 
 DIAGNOSTIC_LINES = 15
 CHANGE_HEAD = ["change", "scenario", "faults", "then", "now", "why"]
+READING_NAMES = {  # summary.json's coverage cases, as the page names them
+    "nan": "NaN",
+    "pos_inf": "+inf",
+    "neg_inf": "-inf",
+    "zero": "0.0",
+    "below_range_min": "below range_min (0 < r < range_min)",
+    "above_range_max": "above range_max (finite)",
+}
 
 _STYLE = """
 body { font: 14px/1.4 system-ui, sans-serif; margin: 1.5em auto; max-width: 60em; color: #222; }
@@ -148,10 +156,49 @@ def _baseline(comparison: Mapping[str, Any]) -> list[str]:
     return out
 
 
+def _coverage(coverage: Mapping[str, Any]) -> list[str]:
+    """The readings the delivered scans carried (harness.judge.reading_coverage), and gaps."""
+    total = coverage["total"]
+    out = [
+        "<h2>Readings the suite delivered</h2>",
+        f"<p>Scans the node received, {total['scans']} in all, that hold each kind of reading:</p>",
+        "<table>",
+        "<tr><th>reading<th>beside a valid return<th>without one</tr>",
+    ]
+    for case, n in total["cases"].items():
+        out.append(
+            f"<tr><td>{_text(READING_NAMES.get(case, case))}"
+            f'<td class="n">{n["beside_valid"]}<td class="n">{n["without_valid"]}</tr>'
+        )
+    near, margin = coverage["near_threshold_m"], coverage["angle_near_pi_rad"]
+    others = [
+        (
+            f"scans whose nearest valid return lies outside the threshold band, within {near:g} m"
+            " of its edge",
+            total["near_threshold"],
+        ),
+        (
+            f"scans whose nearest valid return lies within {margin:g} rad of +pi or -pi",
+            total["angle_near_pi"],
+        ),
+        ("scans with angle_min 0", total["angle_min_zero"]),
+        ("scans with angle_min -pi", total["angle_min_minus_pi"]),
+        ("times a due warning stopped being due later in its run", total["warning_clears"]),
+    ]
+    out.extend(f'<tr><td>{_text(what)}<td class="n" colspan="2">{n}</tr>' for what, n in others)
+    out.append("</table>")
+    if coverage["gaps"]:
+        out.append("<p>What the suite never delivered:</p>")
+        out.append('<p class="note">' + "<br>".join(_text(g) for g in coverage["gaps"]) + "</p>")
+    else:
+        out.append("<p>The suite delivered every kind of reading above.</p>")
+    return out
+
+
 def index_html(summary: Mapping[str, Any], *, diagnostics: Sequence[str] = ()) -> bytes:
     """The page for a run summary (see harness.report.summary.run_summary), with the
-    comparison harness.report.baseline.with_comparison added, when there is one, and
-    the alignment of the board's /scan, when it has one."""
+    comparison harness.report.baseline.with_comparison added, when there is one, the
+    alignment of the board's /scan, when it has one, and the readings delivered."""
     entries = summary["scenarios"]
     headline = passed_line(summary["passed"], summary["total"])
     head = ["scenario", "link", "ticks", "failed", "verdict", "time s", "seed", "threshold"]
@@ -177,6 +224,8 @@ def index_html(summary: Mapping[str, Any], *, diagnostics: Sequence[str] = ()) -
         lines.extend(_alignment(summary["alignment"]))
     if "baseline" in summary:
         lines.extend(_baseline(summary["baseline"]))
+    if summary.get("coverage"):
+        lines.extend(_coverage(summary["coverage"]))
     for i, e in enumerate(entries):
         lines.extend(_section(i, e, diagnostics[i] if i < len(diagnostics) else ""))
     lines += ["</body>", "</html>", ""]

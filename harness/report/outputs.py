@@ -31,7 +31,13 @@ from harness.errors import ConfigError
 from harness.judge.records import RunResult
 from harness.report.folder_lock import lock_folder
 from harness.report.previous_run import clear_previous_run
-from harness.report.summary import json_bytes, run_summary, scenario_details, scenario_entry
+from harness.report.summary import (
+    coverage_entry,
+    json_bytes,
+    run_summary,
+    scenario_details,
+    scenario_entry,
+)
 from harness.safe_text import DIAGNOSTICS_LIMIT, for_storage
 
 if TYPE_CHECKING:  # pydantic only when a scenario is at hand
@@ -249,14 +255,20 @@ class ReportFolder:
         from harness.report.junit import junit_xml
 
         done = self.scenarios
+        results = [s.result for s in done]
         entries = [scenario_entry(s.result, self._names(s, relative_to=self.root)) for s in done]
-        summary = run_summary(entries, wall_s, alignment=alignment, alignment_mode=alignment_mode)
+        summary = run_summary(
+            entries,
+            wall_s,
+            alignment=alignment,
+            alignment_mode=alignment_mode,
+            coverage=coverage_entry(results),
+        )
         if baseline is not None:
             from harness.report.baseline import compare, with_comparison
 
             summary = with_comparison(summary, compare(baseline, entries))
         write_atomically(self.root / SUMMARY, json_bytes(summary))
-        results = [s.result for s in done]
         xml = junit_xml(results, artifacts=[s.paths for s in done], base=self.root)
         write_atomically(self.root / JUNIT, xml)
         page = index_html(summary, diagnostics=[s.result.diagnostics for s in done])

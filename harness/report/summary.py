@@ -24,6 +24,7 @@ __all__ = [
     "FORMAT",
     "alignment_entry",
     "alignment_fails",
+    "coverage_entry",
     "json_bytes",
     "run_summary",
     "scenario_details",
@@ -162,12 +163,34 @@ def alignment_entry(alignment: Alignment | None, mode: str = "warn") -> dict[str
     }
 
 
+def coverage_entry(results: Sequence[RunResult]) -> dict[str, Any]:
+    """summary.json's `coverage`: which kinds of readings the delivered scans carried,
+    in total and per scenario, and what the suite never delivered (`gaps`)."""
+    from harness.judge.reading_coverage import (
+        ANGLE_MARGIN_RAD,
+        NEAR_THRESHOLD_M,
+        coverage_by_scenario,
+        coverage_of,
+        gaps,
+    )
+
+    total = coverage_of(results)
+    return {
+        "near_threshold_m": NEAR_THRESHOLD_M,
+        "angle_near_pi_rad": ANGLE_MARGIN_RAD,
+        "total": total.as_dict(),
+        "scenarios": {name: c.as_dict() for name, c in coverage_by_scenario(results).items()},
+        "gaps": gaps(total),
+    }
+
+
 def run_summary(
     entries: Sequence[dict[str, Any]],
     wall_s: float | None = None,
     *,
     alignment: Alignment | None = None,
     alignment_mode: str = "warn",
+    coverage: dict[str, Any] | None = None,
 ) -> dict[str, Any]:
     """summary.json: totals first (what CI checks), then every scenario.
 
@@ -175,6 +198,7 @@ def run_summary(
     what each scenario cost. `alignment`, the fit of the board's /scan
     against the truth (serial links); with `alignment_mode` "fail" a
     misaligned one makes the run not `ok`, as it makes the exit code 1.
+    `coverage`, the readings the suite delivered (`coverage_entry`).
     """
     passed = sum(1 for e in entries if e["ok"])
     return {
@@ -186,6 +210,7 @@ def run_summary(
         "failed": len(entries) - passed,
         "wall_s": round(wall_s if wall_s is not None else sum(e["total_s"] for e in entries), 3),
         "alignment": alignment_entry(alignment, alignment_mode),
+        "coverage": coverage,
         "scenarios": list(entries),
     }
 
