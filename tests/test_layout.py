@@ -21,7 +21,7 @@ DOCS = ROOT / "docs" / "architecture.md"
 NOT_CODE = {"reference", "board_driver", "robot_models", "scenarios"}
 
 # What every layer may use, at the root of the package.
-GROUND = {"__init__", "errors", "safe_text", "holder_lock", "atomic_write"}
+GROUND = {"__init__", "errors", "safe_text", "holder_lock", "atomic_write", "user_cache"}
 
 # Bottom to top; a package imports only from layers below its own.
 LAYERS: list[set[str]] = [
@@ -32,7 +32,7 @@ LAYERS: list[set[str]] = [
     {"links", "report"},
     {"runner"},
     {"bench", "grading", "live", "campaign"},
-    {"watch"},
+    {"watch", "audit"},
     {"commands"},
     {"pytest_plugin", "cli"},
 ]
@@ -53,6 +53,9 @@ PURE = [
     "harness.nodes.colcon_hooks",
     "harness.watch.order",
     "harness.watch.verdict_cache",
+    "harness.audit.mutants",
+    "harness.audit.matrix",
+    "harness.user_cache",
 ]
 
 

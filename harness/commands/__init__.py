@@ -19,6 +19,7 @@ COMMAND_MODULES = (
     "replay",
     "grade",
     "sweep",
+    "audit",
     "bench",
 )
 

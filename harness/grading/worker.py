@@ -26,7 +26,7 @@ from harness.errors import ConfigError
 from harness.judge.records import RunResult
 from harness.report.summary import verdict_of
 
-__all__ = ["result_entry", "write_job"]
+__all__ = ["interrupt_on_sigterm", "link_options_from", "result_entry", "run_settings_from", "write_job"]
 
 
 def result_entry(result: RunResult) -> dict[str, Any]:
@@ -74,7 +74,7 @@ def _write_results(path: Path, entries: list[dict[str, Any]], **state: Any) -> N
     write_atomically(path, json.dumps(data, indent=2).encode())
 
 
-def _options(data: dict[str, Any]) -> Any:
+def link_options_from(data: dict[str, Any]) -> Any:
     from harness.links.base import LinkOptions
 
     known = {f.name for f in fields(LinkOptions)}
@@ -83,7 +83,7 @@ def _options(data: dict[str, Any]) -> Any:
     return LinkOptions(**values)
 
 
-def _settings(data: dict[str, Any]) -> Any:
+def run_settings_from(data: dict[str, Any]) -> Any:
     from harness.runner.settings import RunSettings
 
     known = {f.name for f in fields(RunSettings)}
@@ -140,8 +140,8 @@ class _Suite:
             run_suite(
                 chosen,
                 job["link"],
-                _options(job["options"]),
-                _settings(job["settings"]),
+                link_options_from(job["options"]),
+                run_settings_from(job["settings"]),
                 on_result=self.keep,
             )
         except ConfigError as err:  # e.g. the node command cannot be resolved
@@ -158,7 +158,7 @@ class _Suite:
         return 0
 
 
-def _interrupt_on_sigterm() -> None:
+def interrupt_on_sigterm() -> None:
     def handler(signum: int, frame: object) -> None:
         raise KeyboardInterrupt
 
@@ -169,7 +169,7 @@ def main(argv: list[str]) -> int:
     if len(argv) != 1:
         print("usage: python -m harness.grading.worker JOB.json", file=sys.stderr)
         return 2
-    _interrupt_on_sigterm()
+    interrupt_on_sigterm()
     job = json.loads(Path(argv[0]).read_text(encoding="utf-8"))
     return run_job(job)
 

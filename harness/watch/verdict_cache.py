@@ -33,6 +33,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from harness.atomic_write import write_atomically
+from harness.user_cache import cache_root
 
 if TYPE_CHECKING:
     from harness.judge.records import RunResult
@@ -41,23 +42,13 @@ if TYPE_CHECKING:
 __all__ = ["VerdictCache", "cache_folder", "node_key", "verdict_cache"]
 
 FORMAT = 1
-CACHE_VARIABLE = "FOSSBOT_HIL_CACHE_DIR"
 KEPT_FILES = 200
 PASSED, FAILED = "passed", "failed"
 
 
 def cache_folder(env: Mapping[str, str] | None = None) -> Path:
-    """``$FOSSBOT_HIL_CACHE_DIR/last-run`` when set (a CI job's or a test suite's own),
-    else ``$XDG_CACHE_HOME/fossbot-hil/last-run`` (``~/.cache`` when unset or not
-    absolute), as the XDG base directory rules say."""
-    env = os.environ if env is None else env
-    own = env.get(CACHE_VARIABLE)
-    if own:
-        return Path(own) / "last-run"
-    base = env.get("XDG_CACHE_HOME", "")
-    if not os.path.isabs(base):  # unset, or relative (which the XDG rules say to ignore)
-        base = os.path.join(os.path.expanduser("~"), ".cache")
-    return Path(base) / "fossbot-hil" / "last-run"
+    """``last-run`` in the user's cache folder (``harness.user_cache``)."""
+    return cache_root(env) / "last-run"
 
 
 def node_key(link: str, options: LinkOptions, cwd: str | None = None) -> dict[str, object]:

@@ -1,0 +1,118 @@
+"""What an audit says: the kill matrix on the terminal, and the one JSON object of --json."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from rich.console import Console
+from rich.table import Table
+
+from harness.audit.matrix import KillMatrix
+from harness.audit.mutants import mutant_named
+from harness.audit.suite_audit import AuditOutcome
+
+__all__ = ["audit_json", "print_audit"]
+
+MARKS = {"killed": "x", "survived": ".", "flip": "~"}
+CASES = ("nan", "pos_inf", "neg_inf", "zero", "below_range_min", "above_range_max")
+COUNTS = (
+    ("near_threshold", "minimum near the threshold, outside the band"),
+    ("angle_near_pi", "minimum's angle near +-pi"),
+    ("angle_min_zero", "angle_min 0"),
+    ("angle_min_minus_pi", "angle_min -pi"),
+    ("warning_clears", "a due warning that must clear"),
+)
+
+
+def audit_json(outcome: AuditOutcome, *, repeat: int, seeds: list[int | None]) -> dict[str, Any]:
+    """`mutants` (name, mistake, killed_by), `survivors`, `coverage`, `flips`, and the rest."""
+    matrix = outcome.matrix
+    killed, total = matrix.score
+    return {
+        "scenarios": list(matrix.scenarios),
+        "repeat": repeat,
+        "seeds": seeds,
+        "mutants": [
+            {
+                "name": name,
+                "mistake": mutant_named(name).mistake,
+                "killed_by": list(matrix.killed_by[name]),
+                "first_failure": matrix.why.get(name, ""),
+            }
+            for name in matrix.mutants
+        ],
+        "survivors": list(matrix.survivors),
+        "score": {"killed": killed, "mutants": total},
+        "coverage": outcome.coverage,
+        "coverage_gaps": outcome.coverage_gaps,
+        "flips": [flip.as_dict() for flip in matrix.flips],
+        "correct_node_failed": matrix.unsound,
+        "unit_errors": matrix.unit_errors,
+    }
+
+
+def _say(console: Console, text: str = "") -> None:
+    console.print(text, markup=False, highlight=False)
+
+
+def _matrix_table(matrix: KillMatrix) -> Table:
+    table = Table(box=None, pad_edge=False, header_style="bold")
+    table.add_column("mistake", no_wrap=True)
+    for i, _ in enumerate(matrix.scenarios, start=1):
+        table.add_column(str(i), justify="center")
+    table.add_column("killed by", justify="right")
+    for name in matrix.mutants:
+        marks = [MARKS[matrix.cells[name, s]] for s in matrix.scenarios]
+        count = len(matrix.killed_by[name])
+        table.add_row(name, *marks, str(count) if count else "SURVIVED")
+    return table
+
+
+def _coverage_lines(coverage: dict[str, Any]) -> list[str]:
+    if not coverage:
+        return ["(the correct node's run gave no coverage)"]
+    cases = coverage.get("cases", {})
+    lines = [f"scans delivered: {coverage.get('scans', 0)}"]
+    width = max(len(c) for c in CASES)
+    lines.append(f"  {'reading':<{width}}  beside a valid return  without one")
+    for case in CASES:
+        counts = cases.get(case, {})
+        beside, without = counts.get("beside_valid", 0), counts.get("without_valid", 0)
+        lines.append(f"  {case:<{width}}  {beside:>22}  {without:>11}")
+    for key, words in COUNTS:
+        lines.append(f"  {words}: {coverage.get(key, 0)}")
+    return lines
+
+
+def print_audit(console: Console, outcome: AuditOutcome) -> None:
+    """The matrix (x killed, . survived, ~ verdict flips with the seed), then survivors,
+    coverage, flips, and the score."""
+    matrix = outcome.matrix
+    _say(console)
+    _say(console, "scenarios: " + ", ".join(f"{i} {s}" for i, s in enumerate(matrix.scenarios, 1)))
+    console.print(_matrix_table(matrix))
+    _say(console, "x killed in every seed, . passed, ~ the verdict changed with the seed")
+    for scenario, why in matrix.unsound.items():
+        _say(console, f"the correct node fails {scenario}, so it kills nothing: {why}")
+    for name, why in matrix.unit_errors.items():
+        _say(console, f"{name}: did not finish: {why}")
+    if matrix.survivors:
+        _say(console)
+        _say(console, "mistakes no scenario catches, and what would catch them:")
+        for name in matrix.survivors:
+            mutant = mutant_named(name)
+            _say(console, f"  {name}: {mutant.mistake}; caught by {mutant.caught_by}")
+    if matrix.flips:
+        _say(console)
+        _say(console, "verdicts that changed with the seed:")
+        for flip in matrix.flips:
+            _say(console, f"  {flip.mutant} in {flip.scenario}: {' '.join(flip.verdicts)}")
+    _say(console)
+    _say(console, "readings the suite delivered (the correct node's run):")
+    for line in _coverage_lines(outcome.coverage):
+        _say(console, line)
+    for gap in outcome.coverage_gaps:
+        _say(console, f"  gap: {gap}")
+    killed, total = matrix.score
+    _say(console)
+    _say(console, f"score: the suite catches {killed} of {total} mistakes")
