@@ -90,6 +90,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         metavar="S",
         help="longest one student's scenario suite may take (default 900)",
     )
+    parser.add_argument(
+        "--no-audit",
+        action="store_true",
+        help="do not check which typical mistakes the scenarios let pass (an audit of the "
+        "scenarios runs once after the class and is kept in the user's cache; see "
+        "fossbot-hil audit)",
+    )
     add_cluster_options(parser, unit="students")
     add_node_options(parser)
     _adapt_node_options(parser)
@@ -272,6 +279,7 @@ def run(args: argparse.Namespace, console: Console) -> int:
 
             grades = grade_class(found.students, config, client, on_graded=graded)
         wall_s = time.monotonic() - started
+        audit_line = None if args.no_audit else _audit(console, client, scenarios, config, out)
         meta = [
             ("scenarios", ", ".join(names)),
             ("link", args.link),
@@ -292,4 +300,63 @@ def run(args: argparse.Namespace, console: Console) -> int:
             markup=False,
             highlight=False,
         )
+        if audit_line:
+            console.print(audit_line, markup=False, highlight=False)
         return 0
+
+
+def _audit(
+    console: Console, client: object, scenarios: list[Scenario], config: object, out: Path
+) -> str | None:
+    """Which typical mistakes these scenarios let pass (harness.audit), from the cache or
+    run now on the class's cluster; the warning line naming them, or None. An audit that
+    cannot be made is said, never a reason to fail the grading."""
+    import json
+    from dataclasses import replace
+
+    from harness.atomic_write import write_atomically
+    from harness.audit.known import known_audit, survivors_warning
+    from harness.audit.task import AuditConfig
+    from harness.grading.grade import GradeConfig
+
+    assert isinstance(config, GradeConfig)
+    audit = AuditConfig(
+        scenarios=config.scenarios,
+        scenario_refs=config.scenario_refs,
+        link=config.link,
+        options=replace(config.options, node=None, package=None, executable=None),
+        settings=config.settings,
+        seeds=(config.settings.seed,),
+        units_dir=out.resolve() / "audit",
+    )
+    console.print(
+        "checking which typical mistakes these scenarios catch (fossbot-hil audit)...",
+        markup=False,
+        highlight=False,
+    )
+    try:
+        data, cached = known_audit(client, audit, scenarios)
+    except Exception as err:  # noqa: BLE001 - the grades are written; the audit is advice
+        return f"the audit of the scenarios could not be made: {type(err).__name__}: {err}"
+    write_atomically(out / "audit.json", json.dumps(data, indent=2).encode())
+    words = " ".join(_scenario_words(scenarios))
+    warning = survivors_warning(data, words)
+    if warning is None:
+        killed = len(data.get("mutants", []))
+        return f"these scenarios catch all {killed} typical mistakes{' (cached)' if cached else ''}"
+    return warning
+
+
+def _scenario_words(scenarios: list[Scenario]) -> list[str]:
+    """How a command line names each scenario: a shipped one by name, others by file."""
+    import shlex
+
+    from harness.scenario.files import shipped_dir
+
+    shipped = shipped_dir().resolve()
+    return [
+        s.name
+        if not s.source or Path(s.source).resolve().parent == shipped
+        else shlex.quote(s.source)
+        for s in scenarios
+    ]
