@@ -40,6 +40,8 @@ class LinkOptions:
     scan_topic: str = "/scan"
     status_topic: str = "/lidar_status"
     warning_topic: str = "/obstacle_warning"
+    # The node's parameters that name its scan, status and warning topics (the lab's).
+    topic_params: tuple[str, str, str] = ("lidar_topic", "lidar_status_topic", "warning_topic")
     realtime: bool = False
     port: str | None = None  # serial links: a real adapter wired to a board (None: virtual board)
     scan_rate_hz: float = 10.0  # the scenario's LIDAR rate (the runner fills it in)
@@ -56,6 +58,9 @@ class Link(ABC):
 
     name: ClassVar[str]
     serial_line: ClassVar[bool] = False  # scans travel as device bytes on a serial line
+    # A scenario's node_topics are set through the node's topic parameters (the harness
+    # publishes the scans itself, so it can publish them on any topic).
+    sets_node_topics: ClassVar[bool] = False
 
     def __init__(self, options: LinkOptions) -> None:
         self.options = options

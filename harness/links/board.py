@@ -71,6 +71,8 @@ def board_options(options: LinkOptions) -> LinkOptions:
 class BoardLink(Ros2Link):
     """A LIDAR device emulated on a serial line, read by the board's own driver."""
 
+    sets_node_topics = False  # the board's driver publishes the scan topic for the run
+
     profile: ClassVar[DeviceProfile]
     serial_line = True
     publishes_scans = False  # the board's driver publishes /scan; the harness listens

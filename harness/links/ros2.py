@@ -99,6 +99,7 @@ class Ros2Link(Link):
     """Drive a ROS 2 node process through its scan topic; watch status and warning."""
 
     publishes_scans = True  # the harness publishes /scan (a board link listens instead)
+    sets_node_topics = True
     starts_ahead = True  # each link has its own domain, so several can be up at once
 
     def __init__(self, options: LinkOptions) -> None:

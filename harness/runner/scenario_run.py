@@ -142,11 +142,42 @@ def closed(result: RunResult, link: Link, waited: float) -> None:
 
 
 def scenario_options(
-    scenario: Scenario, options: LinkOptions, settings: RunSettings
+    scenario: Scenario, options: LinkOptions, settings: RunSettings, link_name: str = ""
 ) -> LinkOptions:
-    """The link options for one scenario: its threshold and its LIDAR's rate."""
+    """The link options for one scenario: its threshold, its LIDAR's rate and, on a link
+    that publishes the scans itself, the node's topics it names (`node_topic_options`)."""
     threshold = effective_threshold(scenario, settings)
-    return replace(options, threshold=threshold, scan_rate_hz=scenario.lidar_spec.rate_hz)
+    options = replace(options, threshold=threshold, scan_rate_hz=scenario.lidar_spec.rate_hz)
+    if link_name and link_class(link_name).sets_node_topics:
+        options = node_topic_options(scenario, options)
+    return options
+
+
+def node_topic_options(scenario: Scenario, options: LinkOptions) -> LinkOptions:
+    """`options` with the scenario's node_topics, each set through the node's topic
+    parameter, when the run left the topics to the lab's defaults: a user who named
+    topics or topic parameters of their own (a node with other names) keeps them."""
+    wanted = scenario.node_topics
+    if wanted is None:
+        return options
+    defaults = LinkOptions()
+    own_topics = (options.scan_topic, options.status_topic, options.warning_topic) != (
+        defaults.scan_topic,
+        defaults.status_topic,
+        defaults.warning_topic,
+    )
+    given = {item.split(":=", 1)[0] for item in options.params}
+    if own_topics or given & set(options.topic_params):
+        return options
+    scan_param, status_param, warning_param = options.topic_params
+    topics = {
+        "scan_topic": (scan_param, wanted.scan),
+        "status_topic": (status_param, wanted.status),
+        "warning_topic": (warning_param, wanted.warning),
+    }
+    chosen = {field: topic for field, (_, topic) in topics.items() if topic is not None}
+    params = tuple(f"{param}:={topic}" for param, topic in topics.values() if topic is not None)
+    return replace(options, **chosen, params=(*options.params, *params))
 
 
 def run_mount(scenarios: Sequence[Scenario], options: LinkOptions) -> LinkOptions:
@@ -202,7 +233,7 @@ def run(
         options = run_mount([scenario], options)
     return with_link(
         link_name,
-        scenario_options(scenario, options, settings),
+        scenario_options(scenario, options, settings, link_name),
         lambda link: run_scenario(scenario, link, settings, on_tick=on_tick),
         not_started_as(scenario, link_name, settings),
     )

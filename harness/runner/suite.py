@@ -64,11 +64,11 @@ def run_suite(
     cls.prepare(options)
     if cls.serial_line:  # one device on one robot serves the whole run
         options = run_mount(scenarios, options)
-    first = scenario_options(scenarios[0], options, settings)
+    first = scenario_options(scenarios[0], options, settings, link_name)
     with fork_servers(), _explicit_domain(link_name, options), cls.run_session(first) as session:
 
         def make(index: int) -> Link:
-            link_options = scenario_options(scenarios[index], options, settings)
+            link_options = scenario_options(scenarios[index], options, settings, link_name)
             return create_link(link_name, link_options, session)
 
         pipeline = LinkPipeline(make, len(scenarios), overlap=_links_overlap(link_name, options))

@@ -26,6 +26,7 @@ from pydantic import (
 )
 
 from harness.lidar.spec import PRESETS, LidarSpec, preset
+from harness.ros.names import InvalidName, resolve_topic
 from harness.safe_text import shown
 from harness.scenario.footprint import Outline, disc, rectangle
 from harness.scenario.limits import (
@@ -316,6 +317,32 @@ class Motion(_Strict):
     segments: list[Segment] = Field(min_length=1, max_length=1000)
 
 
+class NodeTopics(_Strict):
+    """The topics a scenario asks the node to use, through its topic parameters: a lab
+    with a second robot, or a namespaced one, names them so. Unset ones keep the run's."""
+
+    scan: str | None = None
+    status: str | None = None
+    warning: str | None = None
+
+    @field_validator("scan", "status", "warning")
+    @classmethod
+    def _topic(cls, value: str | None) -> str | None:
+        if value is None:
+            return None
+        try:
+            return resolve_topic(value)
+        except InvalidName as err:
+            raise ValueError(str(err)) from None
+
+    @model_validator(mode="after")
+    def _distinct(self) -> NodeTopics:
+        named = [t for t in (self.scan, self.status, self.warning) if t is not None]
+        if len(set(named)) != len(named):
+            raise ValueError("scan, status and warning must be different topics")
+        return self
+
+
 class Scenario(_Strict):
     """One scripted run of the robot through a world."""
 
@@ -329,6 +356,7 @@ class Scenario(_Strict):
         default_factory=list, max_length=50
     )
     threshold: Range = 0.5
+    node_topics: NodeTopics | None = None  # ros2 link: the node's topics, set by parameter
     # "required": the node must publish warning False whenever nothing is within the
     # threshold; "optional" (the lab's rule): a Bool only when close is fine too.
     warning_when_clear: Literal["optional", "required"] = "optional"
