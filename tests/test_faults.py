@@ -16,6 +16,7 @@ from harness.faults.sensor import (
     RETURN_INTENSITY,
     Convention,
     Dropouts,
+    FarReturns,
     FaultProfile,
     Noise,
     Spurious,
@@ -157,6 +158,24 @@ def test_spurious_rate_and_values() -> None:
     assert np.all(scan.intensities[ghost] == RETURN_INTENSITY)
 
 
+def test_far_returns_only_on_no_return_beams_beyond_range_max() -> None:
+    """Raw distances past range_max replace about `rate` of the no-return beams only, stay
+    within [1.02, 1.25) * range_max, invalid, and are not re-encoded by the convention."""
+    t = np.full(BIG.samples, np.inf)
+    t[:5000] = 1.0
+    scan = emit(FaultProfile((FarReturns(0.1),), convention="nan"), t, BIG, seed=5)
+    r = scan.ranges
+    far = np.isfinite(r) & (r > np.float32(BIG.range_max))
+    assert not far[:5000].any()  # valid returns are left alone
+    assert 0.08 < far[5000:].mean() < 0.12
+    top = np.float32(1.25 * BIG.range_max)
+    assert np.all((r[far] >= np.float32(1.02 * BIG.range_max)) & (r[far] <= top))
+    assert not scan.valid_mask()[far].any()
+    assert np.isnan(r[5000:][~far[5000:]]).all()  # the other no-return beams: NaN convention
+    again = emit(FaultProfile((FarReturns(0.1),), convention="nan"), t, BIG, seed=5)
+    assert again.to_bytes() == scan.to_bytes()
+
+
 @pytest.mark.parametrize(
     "convention, no_return, too_close",
     [
@@ -249,8 +268,9 @@ def test_fault_order_is_canonical() -> None:
         (
             ["clean", {"type": "nosie"}],
             r"faults\[1\]: unknown fault type 'nosie' "
-            r"\(known: convention, delay, drop, dropouts, duplicate, line_corruption, line_drops, "
-            r"line_noise, noise, rate_drift, reorder, spurious, stale_stamps\)",
+            r"\(known: convention, delay, drop, dropouts, duplicate, far_returns, "
+            r"line_corruption, line_drops, line_noise, noise, rate_drift, reorder, spurious, "
+            r"stale_stamps\)",
         ),
         ([{"sigma": 0.1}], r"faults\[0\]: missing 'type'"),
         ([{"type": "dropouts", "rate": 1.5}], r"faults\[0\]\.rate: must be in \[0, 1\]"),

@@ -48,6 +48,7 @@ __all__ = [
     "DROPOUT_VALUES",
     "Convention",
     "Dropouts",
+    "FarReturns",
     "Fault",
     "FaultProfile",
     "Noise",
@@ -145,6 +146,27 @@ class Spurious:
 
 
 @dataclass(frozen=True)
+class FarReturns:
+    """Finite readings beyond range_max on a fraction of the no-return beams.
+
+    A device measures past the range_max its driver publishes (the
+    datasheet's), and drivers that pass its raw distances through publish
+    them: values drawn from [1.02, 1.25) * range_max, invalid by REP-117, a
+    trap for nodes that do not check range_max.
+    """
+
+    rate: float
+    kind: ClassVar[str] = "far_returns"
+    params: ClassVar[tuple[str, ...]] = ("rate",)
+
+    def __post_init__(self) -> None:
+        _check_rate(self.rate, "far_returns rate")
+
+    def describe(self) -> str:
+        return f"{self.rate:.0%} of no-return beams read a raw distance beyond range_max"
+
+
+@dataclass(frozen=True)
 class Convention:
     """How the driver writes 'no return' and 'too close' (see ``CONVENTIONS``)."""
 
@@ -160,12 +182,13 @@ class Convention:
         return f"{self.name} convention (no return {no_return}, too close {too_close})"
 
 
-Fault = Noise | Dropouts | Spurious
-_Item = Noise | Dropouts | Spurious | Convention | LinkFault
-_FAULT_ORDER: tuple[str, ...] = ("noise", "dropouts", "spurious")
+Fault = Noise | Dropouts | Spurious | FarReturns
+_Item = Noise | Dropouts | Spurious | FarReturns | Convention | LinkFault
+_FAULT_ORDER: tuple[str, ...] = ("noise", "dropouts", "spurious", "far_returns")
 _KINDS: dict[str, type[Any]] = {
     "convention": Convention,
     "dropouts": Dropouts,
+    "far_returns": FarReturns,
     "noise": Noise,
     "spurious": Spurious,
     **LINK_KINDS,
@@ -257,6 +280,14 @@ class FaultProfile:
             v32[hit] = ghost[hit]
             cls[hit] = _GHOST  # a return, but an invalid one
 
+        far = self._get("far_returns")
+        if far is not None:
+            u = rng.random(n)
+            beyond = rng.uniform(1.02, 1.25, n) * spec.range_max
+            hit = (cls == _NO_RETURN) & (u < far.rate)
+            v32[hit] = beyond[hit]
+            cls[hit] = _GHOST  # a return, but an invalid one
+
         no_return, too_close, _ = CONVENTIONS[self.convention]
         v32[cls == _NO_RETURN] = _encoded(no_return, spec.range_max)
         v32[cls == _TOO_CLOSE] = _encoded(too_close, spec.range_max)
@@ -279,6 +310,9 @@ _NAMED: dict[str, tuple[str, tuple[_Item, ...]]] = {
     "dropouts_zero": _named("5% of valid returns lost as 0.0", Dropouts(0.05, "zero")),
     "dropouts_inf": _named("5% of valid returns lost as +inf", Dropouts(0.05, "inf")),
     "spurious_close": _named("2% of beams read a ghost below range_min", Spurious(0.02)),
+    "beyond_range_max": _named(
+        "5% of no-return beams read a raw distance beyond range_max", FarReturns(0.05)
+    ),
     "driver_rep117": _named("REP-117: +inf no return, -inf too close", Convention("rep117")),
     "driver_rplidar_ros": _named(
         "rplidar_ros / FOSSBot v2 bridge: device distance 0 (no return or too close) as +inf",
@@ -329,7 +363,8 @@ def _compose(items: Sequence[_Item], name: str) -> FaultProfile:
     link_types = (Delay, Drop, Duplicate, Reorder, RateDrift, StaleStamps)
     line_types = (LineCorruption, LineDrops, LineNoise)
     link = tuple(f for f in by_kind.values() if isinstance(f, link_types + line_types))
-    faults = tuple(f for f in by_kind.values() if isinstance(f, (Noise, Dropouts, Spurious)))
+    scan_types = (Noise, Dropouts, Spurious, FarReturns)
+    faults = tuple(f for f in by_kind.values() if isinstance(f, scan_types))
     return FaultProfile(faults=faults, convention=convention.name, name=name, link=LinkFaults(link))
 
 
