@@ -32,6 +32,9 @@ class Mutant:
     name: str  # snake_case; the name in the CLI, the kill matrix and --json
     mistake: str  # one line: what the node does wrong, in a student's terms
     caught_by: str  # one line: the kind of scenario that kills it
+    # Its runs wait out per-scan deadlines (silence costs seconds a scenario): the audit
+    # starts these first, so the slowest are not left for last.
+    slow: bool = False
 
 
 MUTANTS: tuple[Mutant, ...] = (
@@ -129,11 +132,13 @@ MUTANTS: tuple[Mutant, ...] = (
         "silent_when_clear",
         "publishes no status and no Bool when nothing valid is in range",
         "a scan with nothing in range",
+        slow=True,
     ),
     Mutant(
         "status_only_on_change",
         "publishes the status only when its text changed (the Bool every scan)",
         "two consecutive scans with the same answer (standing still, nothing in range)",
+        slow=True,
     ),
     Mutant(
         "status_twice",
@@ -149,11 +154,13 @@ MUTANTS: tuple[Mutant, ...] = (
         "slow_callback",
         "takes 1.5 s per scan before answering",
         "any run: the answers miss the per-scan deadline",
+        slow=True,
     ),
     Mutant(
         "goes_silent",
         "stops answering after its 10th scan",
         "a run of more than 10 scans",
+        slow=True,
     ),
     # -- units and configuration
     Mutant(

@@ -13,7 +13,7 @@ from collections.abc import Callable, Sequence
 from typing import Any
 
 from harness.audit.matrix import KillMatrix, kill_matrix
-from harness.audit.mutants import CONTROL, mutant_command
+from harness.audit.mutants import CONTROL, mutant_command, mutant_named
 from harness.audit.task import AuditConfig, AuditUnit, UnitResult, run_unit
 
 __all__ = ["AuditOutcome", "audit_suite", "audit_units"]
@@ -58,6 +58,8 @@ def audit_suite(
     from harness.cluster.window import Window
 
     units = audit_units(mutants)
+    order = sorted(range(len(units)), key=lambda i: (i > 0, not _slow(units[i].name)))
+    queued = [units[i] for i in order]  # the control, the slow ones, then the rest
     done: dict[int, UnitResult] = {}
     stop = ClusterFlag()
 
@@ -65,12 +67,12 @@ def audit_suite(
         key = f"audit-{unit.name}-{uuid.uuid4().hex[:8]}"
         return client.submit(run_unit, unit, config, stop, key=key, pure=False)
 
-    window = Window(client, units, submit)
+    window = Window(client, queued, submit)
     try:
         for index, future in window:
-            done[index] = _outcome(future, units[index])
+            done[order[index]] = _outcome(future, queued[index])
             if on_unit is not None:
-                on_unit(done[index], len(window.running))
+                on_unit(done[order[index]], len(window.running))
     except BaseException:
         with contextlib.suppress(Exception):  # the scheduler may be what went away
             stop.set()
@@ -82,6 +84,10 @@ def audit_suite(
     control, mutant_results = results[0], results[1:]
     matrix = kill_matrix(config.scenarios, mutant_results, control)
     return AuditOutcome(matrix, control, mutant_results)
+
+
+def _slow(name: str) -> bool:
+    return name != CONTROL and mutant_named(name).slow
 
 
 def _outcome(future: Any, unit: AuditUnit) -> UnitResult:

@@ -26,7 +26,13 @@ from harness.errors import ConfigError
 from harness.judge.records import RunResult
 from harness.report.summary import verdict_of
 
-__all__ = ["interrupt_on_sigterm", "link_options_from", "result_entry", "run_settings_from", "write_job"]
+__all__ = [
+    "interrupt_on_sigterm",
+    "link_options_from",
+    "result_entry",
+    "run_settings_from",
+    "write_job",
+]
 
 
 def result_entry(result: RunResult) -> dict[str, Any]:
