@@ -62,8 +62,8 @@ def run_through(
     """Judge the workload's chained frames through an opened `link`, timed.
 
     The first scan is exchanged once as a warm-up before the clock starts
-    (judge_frames warms up again: one more exchange, inside the timing, as
-    in every run). The clock stops at the last judged tick; `at_end` is
+    (judge_frames then sends it as its first tick: one more exchange, inside
+    the timing, as in every run). The clock stops at the last judged tick; `at_end` is
     called then, e.g. to read the node's CPU time. The link's diagnostics
     are not asked for (they stop a node process), so the link can run the
     workload again.

@@ -30,6 +30,7 @@ class Answers:
     waited: float = 0.0  # seconds the link waited for this scan's answers
     timed_out: bool = False  # the per-scan deadline passed without a status
     problem: str | None = None  # link-level failure, e.g. "node exited with code 1: ..."
+    crashed: bool = False  # `problem` is the software under test having exited (or crashed)
     late: list[Received] = field(default_factory=list)  # answers to earlier scans, by tick
     seen: Scan | None = None  # the scan the node received, when a device and driver made it
     lost: str | None = None  # why the node never got this scan (e.g. damaged on the line)
@@ -60,6 +61,23 @@ class Answers:
     @property
     def extra_scans(self) -> int:
         return len(self.earlier)
+
+    def first_answer_only(self) -> None:
+        """Several copies of one scan went out (a repeat, a resent first scan) and the node
+        answered more than one: its first status (and the Bools published nearest to it)
+        answer this tick; the later ones answer the copies, kept as late answers of no
+        tick, never judged."""
+        statuses = sorted(self.statuses, key=lambda r: r.source_ns)
+        if not statuses:
+            return
+        first, rest = statuses[0], statuses[1:]
+        self.statuses = [first]
+        kept = []
+        for item in self.warnings:
+            nearest = min(statuses, key=lambda r: abs(r.source_ns - item.source_ns))
+            (kept if nearest is first else rest).append(item)
+        self.warnings = kept
+        self.late += [replace(r, tick=None) for r in rest]
 
     def take_late(self, late: list[Received], tick: int) -> list[Received]:
         """Adopt the late answers that belong to `tick`; return the others.

@@ -228,8 +228,12 @@ class Oracle:
         """
         exp = self.expect(scan)
         failures: list[str] = []
-        if answers.problem:
-            failures.append(f"link problem: {clip(answers.problem)}")
+        if answers.problem:  # a node that died says how, with its last words: that is all
+            failures.append(
+                clip(answers.problem)
+                if answers.crashed
+                else f"link problem: {clip(answers.problem)}"
+            )
 
         texts = [str(r.value) for r in answers.statuses]
         claim: StatusClaim | None = None
@@ -247,7 +251,7 @@ class Oracle:
                     else ""
                 )
                 failures.append(f"no status within the deadline ({answers.waited:.2f} s){late}")
-            else:
+            elif not answers.crashed:
                 failures.append("no status arrived")
         else:
             if len(texts) > 1:
@@ -300,6 +304,15 @@ class Oracle:
             text += " = range_max, so 'no obstacle' is accepted too"
         band = f" ± {_num(self.band)} band" if exp.warning is None else ""
         return f"{text}; {thr}{band}"
+
+    def claim_failures(self, scan: Scan, exp: Expectation, claim: StatusClaim) -> list[str]:
+        """What is wrong with `claim` as the status for `scan` (empty: it passes); the
+        run's hints ask this of answers against other ticks' scans."""
+        return self._judge_claim(scan, exp, claim)
+
+    def warning_failures(self, exp: Expectation, got: bool | None) -> list[str]:
+        """What is wrong with the Bool `got` for a scan expecting `exp` (empty: it passes)."""
+        return self._judge_warning(exp, got)
 
     def _judge_claim(self, scan: Scan, exp: Expectation, claim: StatusClaim) -> list[str]:
         quoted = _quoted(claim.text)
@@ -373,15 +386,23 @@ def _distance_hint(scan: Scan, expected: float, claimed: float, tol: float) -> s
 
 
 def _angle_hint(scan: Scan, truths: list[float], claimed: float, decimals: int | None) -> str:
-    """Spot degrees and index-for-angle mistakes."""
+    """Spot degrees, a forgotten angle_min and index-for-angle mistakes."""
     if not math.isfinite(claimed):
         return ""
     tol = Oracle.angle_tolerance(scan, decimals)
     for a in truths:
         if _is_degrees(claimed, a, tol, decimals):
             return f" (looks like degrees: {_num(a, 4)} rad is {math.degrees(a):.1f}°)"
+    indices = _indices_of(scan, truths)
+    if abs(scan.angle_min) > tol and any(
+        abs(claimed - i * scan.angle_increment) <= tol for i in indices
+    ):
+        return (
+            " (the angle looks measured from beam 0, without angle_min "
+            f"({_num(scan.angle_min)} rad here))"
+        )
     index_tol = 1 + half_unit(decimals)
-    if any(abs(claimed - i) <= index_tol for i in _indices_of(scan, truths)):
+    if any(abs(claimed - i) <= index_tol for i in indices):
         return " (looks like the beam index, not its angle)"
     if any(abs(_wrap(claimed - a)) <= scan.angle_increment * 1.5 for a in truths):
         return " (right direction, but outside [-2*pi, 2*pi])"

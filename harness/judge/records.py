@@ -7,7 +7,7 @@ from dataclasses import dataclass, field
 from harness.faults.link import ON_TIME, Delivery
 from harness.judge.answers import Answers
 from harness.judge.oracle import Verdict
-from harness.judge.run_hints import threshold_hint
+from harness.judge.run_hints import run_hint
 from harness.lidar.mount import LidarMount
 from harness.lidar.scan import Scan
 
@@ -41,6 +41,9 @@ class RunResult:
     records: list[TickRecord] = field(default_factory=list)
     error: str | None = None
     diagnostics: str = ""  # e.g. the node's last stderr lines, shown on failure
+    # How the software under test is wired, true of the whole run (e.g. its warning on
+    # another topic, and the option that names it): reports print each once.
+    notes: list[str] = field(default_factory=list)
     wall_s: float = 0.0  # the run itself: simulating, exchanging, judging
     startup_s: float = 0.0  # waiting for the software under test to come up (in series)
     stop_s: float = 0.0  # waiting for it to stop, after the run (in series)
@@ -83,7 +86,14 @@ class RunResult:
         with what the whole run suggests about its cause."""
         failed = self.failed_ticks
         if failed:
-            hint = threshold_hint([r.verdict for r in self.records], self.threshold)
+            hint = run_hint(
+                [r.verdict for r in self.records],
+                self.threshold,
+                scans=[
+                    r.answers.seen if r.answers.seen is not None else r.scan for r in self.records
+                ],
+                noise_sigma=self.noise_sigma,
+            )
             more = f" ({hint})" if hint else ""
             return f"{self.scenario}: {failed[0].verdict.explanation}{more}"
         if self.error is not None:

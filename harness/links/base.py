@@ -93,7 +93,14 @@ class Link(ABC):
         until it is ready."""
 
     def warm_up(self, scan: Scan) -> None:  # noqa: B027 - optional hook
-        """Before tick 0: make sure answers to `scan` can reach us (answers discarded)."""
+        """Make sure answers to `scan` can reach us (answers discarded): an untimed first
+        exchange for the benchmarks, and before a run whose first scan may be ignored."""
+
+    def send_first(self, scan: Scan, tick: int, *, clock: float | None = None) -> None:
+        """Deliver the run's first scan, as `send` does; its answers are collected and
+        judged like any other's. A link whose software may miss a scan sent while it
+        comes up (a ROS graph still matching) resends it until answered, bounded."""
+        self.send(scan, tick, clock=clock)
 
     @abstractmethod
     def send(self, scan: Scan, tick: int, *, clock: float | None = None) -> None:
@@ -130,6 +137,12 @@ class Link(ABC):
     def diagnostics(self) -> str:
         """Extra text for failure reports (e.g. the node's last stderr lines)."""
         return ""
+
+    def notices(self) -> list[str]:
+        """After the run, before `diagnostics`: notes on how the software under test is
+        wired that hold for the whole run (e.g. its warning on another topic, and the
+        option that names it); reports print each once."""
+        return []
 
     def stop(self) -> None:  # noqa: B027 - optional hook
         """Ask everything this link started to stop, without waiting (`close` waits)."""

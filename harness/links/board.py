@@ -26,6 +26,7 @@ when the harness was late) are told apart the same way and not judged.
 
 from __future__ import annotations
 
+import copy
 import os
 import time
 from dataclasses import replace
@@ -52,6 +53,8 @@ LOST_IN_A_ROW = 5  # line faults: this many revolutions without a driver scan is
 # (the FOSSBot v2's agent) yields none of 5 or fewer.
 SPARSE_RETURNS = 5
 SPARSE_WAIT_S = 0.25  # at least this long for the board's scan of such a revolution
+IDLE_ANSWER_S = 1.0  # before the first tick: for the node to answer the idle stream (each wait)
+STREAM_QUIET_REVOLUTIONS = 3  # no board scan of the idle stream in this many: none is coming
 
 
 def board_options(options: LinkOptions) -> LinkOptions:
@@ -76,6 +79,10 @@ class BoardLink(Ros2Link):
     profile: ClassVar[DeviceProfile]
     serial_line = True
     publishes_scans = False  # the board's driver publishes /scan; the harness listens
+    # A revolution the node did not answer in time never reached it (its subscription
+    # was still matching), and the device must not be kept waiting while the node
+    # answers nothing: the driver gives up on a silent line.
+    copies_queue = False
     starts_ahead = False  # one line, one board at a time
 
     def __init__(self, options: LinkOptions, session: BoardSession | None = None) -> None:
@@ -96,6 +103,7 @@ class BoardLink(Ros2Link):
         self._heard_scans: list[Heard] = []
         self._repeat_at: int | None = None  # the first repeat's scan in this exchange, if any
         self._line_damage: LineDamage | None = None
+        self._first_damage: LineDamage | None = None  # as it was before the first scan's copy
 
     @classmethod
     def run_session(cls, options: LinkOptions) -> BoardSession:
@@ -204,15 +212,16 @@ class BoardLink(Ros2Link):
         return None if self.physical else super().node_gone(when)
 
     def damage_line(self, damage: LineDamage) -> None:
-        """Line faults: the device's revolutions reach the driver damaged from now on
-        (until this scenario ends).
+        """Line faults: the device's revolutions reach the driver damaged from the next
+        push on (until this scenario ends); the idle stream before it never is.
 
         A revolution the driver then publishes no scan of is lost, not a
         broken link: the node had nothing to answer.
         """
         assert self.server is not None, "open() the link first"
-        self.server.damage = damage
         self._line_damage = damage
+        if self._pushed:
+            self.server.damage = damage
 
     # -- delivery ---------------------------------------------------------
     def _deliver(self, scan: Scan, tick: int, *, clock: float | None = None) -> int:
@@ -220,13 +229,12 @@ class BoardLink(Ros2Link):
         assert self.observer is not None and self.server is not None
         obs = self.observer
         obs.publish_clock(scan.stamp if clock is None else clock)
-        rate = 1.0 / scan.scan_time if scan.scan_time > 0 else self.options.scan_rate_hz
+        rate = self._rate(scan)
         samples = self.profile.revolution(self.device, scan, rate, scan.range_max, mount=self.mount)
         returns = sum(1 for sample in samples if sample.distance_mm > 0)
         self._seen, self._delivery_problem, self._lost = None, None, None
         if not self._pushed:  # this scenario's first revolution: the idle stream ends
-            self._pushed = True
-            self._after_idle_stream(rate)
+            self._idle_over(rate)
         written_ns = self._push(samples, tick, rate)
         if written_ns is None:
             return time.time_ns()
@@ -281,6 +289,75 @@ class BoardLink(Ros2Link):
         super().warm_up(scan)
         assert self.server is not None
         self.server.align_stream()
+
+    def send_first(self, scan: Scan, tick: int, *, clock: float | None = None) -> None:
+        """As the ros2 link's, once the node has answered what the device streamed while
+        it came up (those answers are not judged); then, as after a warm-up, the stream
+        ends on a whole start marker, so the later revolutions are the same bytes however
+        many copies of the first it took."""
+        self._end_idle_stream(scan)
+        super().send_first(scan, tick, clock=clock)
+        assert self.server is not None
+        self.server.align_stream()
+
+    def _copy(self, n: int) -> None:
+        """Each copy of the first scan is damaged as the first was (the same draws), so
+        the line's damage from then on does not depend on how many copies it took."""
+        assert self.server is not None
+        if self._line_damage is None:
+            return
+        if n == 0:
+            self._first_damage = copy.deepcopy(self._line_damage)
+        elif self._first_damage is not None:
+            self._line_damage = copy.deepcopy(self._first_damage)
+            self.server.damage = self._line_damage
+
+    def _end_idle_stream(self, scan: Scan) -> None:
+        """Before the first tick: wait (bounded) until the node answers one of the idle
+        stream's scans, so its subscription has matched the board's publisher and the
+        first scan reaches it; stop the idle stream; let the node answer the last scan
+        it made; forget those answers, so none is taken for the first tick's.
+
+        Unlike the ros2 link's node, a board's has heard scans before the first tick:
+        the device streams from the moment the session opens. A node silent when
+        nothing is in range may answer none of an empty room's: each wait is bounded,
+        and none is made when the board publishes no scan of the stream (a driver
+        skipping sparse revolutions).
+        """
+        assert self.observer is not None
+        if self._pushed:
+            return
+        obs = self.observer
+        rate = self._rate(scan)
+        began = time.perf_counter()
+
+        def answering() -> bool:
+            if obs.heard_since("status", 1):
+                return True  # it answered a scan of the stream
+            quiet = not any(h.kind == "scan" for h in obs.inbox)
+            return quiet and time.perf_counter() - began > STREAM_QUIET_REVOLUTIONS / rate
+
+        self._wait_for(answering, IDLE_ANSWER_S)
+        answered = obs.heard_since("status", 1)
+        self._idle_over(rate)
+        idle = [h.source_ns for h in obs.inbox if h.kind == "scan"]
+        if idle and answered:
+            self._wait_for(lambda: obs.heard_since("status", max(idle)), IDLE_ANSWER_S)
+            self._wait_for(lambda: False, self._grace())  # its Bool, if any
+        obs.drain()
+        obs.inbox.clear()
+
+    def _idle_over(self, rate: float) -> None:
+        """End the session's idle stream (this scenario's first push comes next); line
+        damage acts from then on."""
+        assert self.server is not None
+        self._pushed = True
+        self._after_idle_stream(rate)
+        if self._line_damage is not None:
+            self.server.damage = self._line_damage
+
+    def _rate(self, scan: Scan) -> float:
+        return 1.0 / scan.scan_time if scan.scan_time > 0 else self.options.scan_rate_hz
 
     def _reached_node(self) -> bool:
         return self._lost is None  # a revolution the board published no scan of: lost
@@ -418,7 +495,7 @@ class BoardLink(Ros2Link):
         answers = super().collect(scan, tick, may_be_ignored=may_be_ignored)
         _pair_with_driver_scans(answers, self._heard_scans)
         if self._repeat_at is not None:  # answers to the device's repeats answer no tick
-            _first_answer_only(answers)
+            answers.first_answer_only()
             self._sends = [*self._sends, (None, self._repeat_at)]
         if answers.seen is None:
             answers.seen = self._seen
@@ -462,23 +539,6 @@ class BoardLink(Ros2Link):
         if self.session is not None and self._own_session:
             notes.append(self.session.stop_note())
         return "\n".join(n for n in notes if n)
-
-
-def _first_answer_only(answers: Answers) -> None:
-    """The device sent this tick's revolution again while the node worked on it: the
-    node's first status (and the Bools published nearest to it) answer this tick; the
-    later ones answer the repeats, kept as late answers of no tick, never judged."""
-    statuses = sorted(answers.statuses, key=lambda r: r.source_ns)
-    if not statuses:
-        return
-    first, rest = statuses[0], statuses[1:]
-    answers.statuses = [first]
-    kept = []
-    for item in answers.warnings:
-        nearest = min(statuses, key=lambda r: abs(r.source_ns - item.source_ns))
-        (kept if nearest is first else rest).append(item)
-    answers.warnings = kept
-    answers.late += [replace(r, tick=None) for r in rest]
 
 
 def _pair_with_driver_scans(answers: Answers, scans: list[Heard]) -> None:

@@ -14,6 +14,12 @@ While the node comes up, the harness publishes /clock (time 0), so a node
 that waits for a clock before it subscribes to the scans can start; the
 first scan's /clock is time 0 as well.
 
+The node's first scan is the run's first tick (``send_first``): resent until
+it is answered, since a scan or an answer sent while the graph is still
+matching may be lost, and its answer judged like any other. So the first
+answer a node gives is judged, and a node that publishes only when its
+status changes has nothing to hold back at tick 0.
+
 A hostile node gets a verdict, not a hang (docs/hostile_nodes.md): a wrong
 message type on a topic is named from the ROS graph at once, a flood of
 messages ends the run, and when the run is over the node is stopped (and
@@ -49,13 +55,17 @@ if TYPE_CHECKING:  # numpy and rclpy are imported when the first link starts, af
 POLL_S = 0.05  # longest single spin; liveness of the node is checked this often
 MIN_GRACE_S = 0.002  # wait for a Bool after the String while the order is unknown
 STOPPED_AFTER = 3  # consecutive missed deadlines end the run
-WARM_UP_RETRY_S = 0.5  # resend the warm-up scan this often until it is answered
+WARM_UP_RETRY_S = 0.5  # resend the first scan (or a warm-up scan) this often until answered
+FIRST_RETRY_MAX_S = 2.0  # the first scan's resends back off up to this interval
 CATCH_UP_S = 2.0  # after a missed deadline, wait this long (at least) for the late answer
 FLOOD_SCANS = 5  # a flood is judged over this many recent scans, in which a topic carried
 FLOOD_PER_SCAN = 5  # more than this many messages a scan,
 FLOOD_MIN = 30  # this many at least,
 FLOOD_RATE_HZ = 200.0  # and this many a second (a 10 Hz timer during long waits is no flood)
 LOUD_BYTES = 1 << 20  # a node that wrote more than this is told how much, in the diagnostics
+SCAN_TYPE = "sensor_msgs/msg/LaserScan"
+STRING_TYPE = "std_msgs/msg/String"
+BOOL_TYPE = "std_msgs/msg/Bool"
 
 
 def node_command(options: LinkOptions) -> NodeCommand:
@@ -99,6 +109,9 @@ class Ros2Link(Link):
     """Drive a ROS 2 node process through its scan topic; watch status and warning."""
 
     publishes_scans = True  # the harness publishes /scan (a board link listens instead)
+    # A copy of the first scan the node did not answer in time may still be queued in
+    # it (a slow first callback), to be answered before the next scan.
+    copies_queue = True
     sets_node_topics = True
     starts_ahead = True  # each link has its own domain, so several can be up at once
 
@@ -117,9 +130,14 @@ class Ros2Link(Link):
         self._bool_first_seen = 0
         self._bool_after_gap = 0.0  # longest String -> Bool gap seen, seconds
         self._silent_scans = 0
+        self._silent_empty = 0  # of those, scans with no valid return
+        self._silent_bools = 0  # Bools the node published for them (so it is not stuck)
+        self._answered_empty = False  # the node answered a scan with no valid return
+        self._copies = 1  # copies of the scan just sent (the first one is resent until answered)
         self._alive_until = 0.0  # perf_counter until which the node counts as running
         self._counted = (0, 0)  # statuses and Bools heard, all told, when the last collect ended
         self._warmed_up = False
+        self._notes: list[str] | None = None  # notices(), taken once
         # (statuses, Bools, seconds) of each recent exchange, for flood checks
         self._recent: deque[tuple[int, int, float]] = deque(maxlen=FLOOD_SCANS)
         self.startup_s = 0.0
@@ -231,6 +249,7 @@ class Ros2Link(Link):
             f"{opts.ready_timeout:g} s: the harness waited for it to subscribe to "
             f"{opts.scan_topic} and publish {opts.status_topic}, but {reason} "
             f"({self.observer.graph_summary()})"
+            + self._topic_hints(reads=reads, publishes=publishes)
         )
 
     def _check_types(self, *, named_only: bool = False) -> None:
@@ -276,8 +295,94 @@ class Ros2Link(Link):
         """Did the scan `_deliver` just sent reach the node? (A board may drop one.)"""
         return True
 
+    def send_first(self, scan: Scan, tick: int, *, clock: float | None = None) -> None:
+        """Send the run's first scan until the node answers a copy (bounded by the ready
+        timeout); `collect` then takes that answer as this tick's.
+
+        Ready means our endpoints matched the node's; whether its endpoints
+        matched ours is known only once an answer came, so a scan or answer
+        sent before may be lost: the scan goes again after WARM_UP_RETRY_S,
+        then twice as long each time (up to FIRST_RETRY_MAX_S), so a node slow
+        on its first scan is not sent many. The node sees nothing but this
+        scan before its first answer, which is judged. A node that dies
+        meanwhile is left for `collect` to report, at this tick.
+        """
+        assert self.observer is not None
+        obs, opts = self.observer, self.options
+        if obs.node.count_publishers(opts.warning_topic) > 0:  # its first Bool must reach us
+            self._wait_for(lambda: obs.warning_publishers() > 0, WARM_UP_RETRY_S)
+        self._counted = (obs.heard["status"], obs.heard["warning"])
+        first_at = time.perf_counter()
+        deadline = first_at + opts.ready_timeout
+        first_ns = time.time_ns()
+        copies, retry = 0, WARM_UP_RETRY_S
+        while True:
+            if copies:  # what answers an earlier copy answers no tick
+                self._sends[-1] = (None, self._sends[-1][1])
+            self._started_at = None  # real time counts from the copy that is answered
+            self._copy(copies)
+            self.send(scan, tick, clock=clock)
+            copies += 1
+            if not self._reached_node():
+                break  # no answer can come (a board that published no scan of it)
+            outcome = self._wait_for(self._answered, min(retry, deadline - time.perf_counter()))
+            retry = min(2 * retry, FIRST_RETRY_MAX_S)
+            if outcome != "timeout":
+                break  # answered; or the node is gone, which collect reports at this tick
+            self._check_types()
+            if time.perf_counter() >= deadline:
+                raise LinkError(self._never_answered(scan, copies))
+        self._copies = copies
+        if copies > 1 and self.copies_queue:
+            # A node slow on its first scan has the other copies queued: let it answer
+            # them (each about as long as the first took) before the next scan goes out,
+            # or their answers would be taken for that scan's.
+            took = time.perf_counter() - first_at
+            self._wait_for(
+                lambda: self._statuses_since(first_ns) >= copies,
+                min(max(WARM_UP_RETRY_S, copies * took), opts.ready_timeout),
+            )
+        self._wait_for(
+            lambda: not obs.wrong_types() or bool(obs.wrong_types(named_only=True)),
+            WARM_UP_RETRY_S,
+        )
+        if self.node_gone() is None:
+            self._check_types()
+        self._warmed_up = True
+
+    def _copy(self, n: int) -> None:
+        """Hook: copy `n` (0 first) of the first scan is about to go out."""
+
+    def _statuses_since(self, source_ns: int) -> int:
+        assert self.observer is not None
+        return sum(
+            1 for h in self.observer.inbox if h.kind == "status" and h.source_ns >= source_ns
+        )
+
+    def _never_answered(self, scan: Scan, copies: int) -> str:
+        """Why the node's first answer never came: silent on a scan with nothing in range,
+        or silent altogether."""
+        from harness.judge.oracle import summarise_scan
+
+        opts = self.options
+        if not scan.valid_mask().any():
+            return (
+                f"node {self.command.description} is running and subscribed to "
+                f"{opts.scan_topic} but published nothing on {opts.status_topic} for "
+                f"{copies} scans (the first scan, sent {copies} times over "
+                f"{opts.ready_timeout:g} s), none of which had a valid return "
+                f"({summarise_scan(scan)}): a status is expected when nothing is in range "
+                'too (e.g. "no obstacle")'
+            )
+        return (
+            f"node {self.command.description} never answered a scan within "
+            f"{opts.ready_timeout:g} s (it subscribes to {opts.scan_topic} and publishes "
+            f"{opts.status_topic}, but no status arrived)"
+        )
+
     def warm_up(self, scan: Scan) -> None:
-        """Exchange the first scan until the node's answer reaches us, then forget it.
+        """Exchange a scan until the node's answer reaches us, then forget it (the
+        benchmarks' untimed first exchange, and a run whose first scan a node may ignore).
 
         Our subscriptions matching the node's publishers does not mean its
         publishers have matched us yet: its first answers could be lost.
@@ -286,8 +391,10 @@ class Ros2Link(Link):
         assert self.observer is not None
         obs, opts = self.observer, self.options
         deadline = time.perf_counter() + opts.ready_timeout
+        copies = 0
         while True:
             sent_ns = self._deliver(scan, -1)
+            copies += 1
             if not self._reached_node():
                 break  # no answer can come (a board that published no scan of it)
 
@@ -303,11 +410,7 @@ class Ros2Link(Link):
             # one swapped for best-effort, say): what can never be heard is said now.
             self._check_types()
             if time.perf_counter() >= deadline:
-                raise LinkError(
-                    f"node {self.command.description} never answered a scan within "
-                    f"{opts.ready_timeout:g} s (it subscribes to {opts.scan_topic} and publishes "
-                    f"{opts.status_topic}, but no status arrived)"
-                )
+                raise LinkError(self._never_answered(scan, copies))
         if obs.node.count_publishers(opts.warning_topic) > 0:
             self._wait_for(lambda: obs.warning_publishers() > 0, WARM_UP_RETRY_S)
         # By now the node's other publishers are known too; give discovery a
@@ -370,13 +473,88 @@ class Ros2Link(Link):
         if obs is None or not obs.usable:
             return []
         notes = [f"wrong message type: {w}" for w in obs.wrong_types()]
-        silent = not obs.heard["warning"] and not obs.warning_publishers()
-        if self._warmed_up and not notes and silent:
-            notes.append(
-                f"no Bool came on {self.options.warning_topic} all run; the graph: "
-                f"{obs.node_topics()}"
+        return notes or self.notices()
+
+    def notices(self) -> list[str]:
+        """A warning that never came on the warning topic: on which topic the node
+        publishes its Bool instead, and the option that names it (else the graph).
+        Taken once, before `diagnostics` stops the node; the diagnostics repeat it."""
+        if self._notes is not None:
+            return list(self._notes)
+        obs, opts = self.observer, self.options
+        self._notes = []
+        if obs is None or not obs.usable or not self._warmed_up or obs.wrong_types():
+            return []
+        if obs.heard["warning"] or obs.warning_publishers():
+            return []
+        elsewhere = self._topics_elsewhere(BOOL_TYPE, opts.warning_topic, publishers=True)
+        if len(elsewhere) == 1:
+            self._notes.append(
+                f"the node publishes a Bool on {elsewhere[0]}, not {opts.warning_topic}: pass "
+                f"--warning-topic {elsewhere[0]} if that is the lab's name"
             )
-        return notes
+        elif elsewhere:
+            self._notes.append(
+                f"the node publishes Bools on {', '.join(elsewhere)}, not {opts.warning_topic}: "
+                "pass --warning-topic with the lab's name"
+            )
+        else:
+            self._notes.append(
+                f"no Bool came on {opts.warning_topic} all run; the graph: {obs.node_topics()}"
+            )
+        return list(self._notes)
+
+    def _topics_elsewhere(self, type_name: str, topic: str, *, publishers: bool) -> list[str]:
+        """Topics other than `topic` that another node publishes (or subscribes to) as
+        `type_name`: where a node with another topic name sends (or reads) it."""
+        assert self.observer is not None
+        node = self.observer.node
+        me = (node.get_name(), node.get_namespace())
+        found = []
+        for name, types in node.get_topic_names_and_types():
+            if name == topic or type_name not in types:
+                continue
+            infos = (
+                node.get_publishers_info_by_topic(name)
+                if publishers
+                else node.get_subscriptions_info_by_topic(name)
+            )
+            if any((i.node_name, i.node_namespace) != me for i in infos):
+                found.append(name)
+        return sorted(found)
+
+    def _topic_hints(self, *, reads: bool, publishes: bool) -> str:
+        """For a node never ready: the scan or status topic it uses instead, and the option
+        that names it ('' when there is none to name)."""
+        opts = self.options
+        hints = []
+        for missing, type_name, topic, option, what, publishers in (
+            (
+                not reads,
+                SCAN_TYPE,
+                opts.scan_topic,
+                "--scan-topic",
+                "subscribes to a LaserScan",
+                False,
+            ),
+            (
+                not publishes,
+                STRING_TYPE,
+                opts.status_topic,
+                "--status-topic",
+                "publishes a String",
+                True,
+            ),
+        ):
+            if not missing:
+                continue
+            others = self._topics_elsewhere(type_name, topic, publishers=publishers)
+            if len(others) == 1:
+                hints.append(
+                    f"it {what} on {others[0]}, not {topic}: pass {option} {others[0]} "
+                    "if that is the lab's name"
+                )
+        return "".join(f"; {h}" for h in hints)
 
     # -- lockstep ---------------------------------------------------------
     def send(self, scan: Scan, tick: int, *, clock: float | None = None) -> None:
@@ -416,6 +594,14 @@ class Ros2Link(Link):
         if self._bool_first_seen and not self._bool_after_gap:
             return 0.0
         return min(max(MIN_GRACE_S, 4 * self._bool_after_gap), self.options.scan_timeout)
+
+    def _node_exited(self) -> bool:
+        """Has the node under test itself (not a board's software) exited?"""
+        return self.process is not None and self.process.returncode() is not None
+
+    def _crash_summary(self) -> str:
+        assert self.process is not None
+        return self.process.crash_summary("on this scan")
 
     def node_gone(self, when: str = "") -> str | None:
         """Why a process this link started is no longer running, or None if all run
@@ -474,12 +660,18 @@ class Ros2Link(Link):
                 outcome = self._wait_for(status_in, max(CATCH_UP_S, 3 * timeout))
                 outcome = None if outcome == "timeout" else outcome
         answers.problem = outcome
+        if outcome is not None and self._node_exited():
+            answers.problem = f"node {self.command.description} {self._crash_summary()}"
+            answers.crashed = True
         if status_in():
             self._wait_for(warning_in, self._grace())
             self._settle_answers()
             obs.drain()
         self._sort(answers, obs.inbox, mine)
         obs.inbox.clear()
+        if self._copies > 1:  # the first scan went more than once: one answer is this tick's
+            answers.first_answer_only()
+        self._copies = 1
         if answers.timed_out:  # whatever came after the deadline is late, not an answer
             answers.late += [
                 Received(r.value, r.after, tick) for r in (*answers.statuses, *answers.warnings)
@@ -489,7 +681,7 @@ class Ros2Link(Link):
         else:
             answers.waited = time.perf_counter() - self._sent_at
         if not (may_be_ignored and answers.timed_out):  # a node may skip such a scan
-            self._watch_silence(answers, tick)
+            self._watch_silence(answers, tick, empty=not scan.valid_mask().any())
         self._watch_flood(answers)
         return answers
 
@@ -580,12 +772,18 @@ class Ros2Link(Link):
         self.observer.inbox.clear()
         return late
 
-    def _watch_silence(self, answers: Answers, tick: int) -> None:
-        """End the run when the node misses its deadline on several scans in a row."""
+    def _watch_silence(self, answers: Answers, tick: int, *, empty: bool = False) -> None:
+        """End the run when the node misses its deadline on several scans in a row
+        (`empty`: this scan had no valid return)."""
         if not answers.timed_out:
-            self._silent_scans = 0
+            self._silent_scans = self._silent_empty = self._silent_bools = 0
+            self._answered_empty = self._answered_empty or (empty and bool(answers.statuses))
             return
         self._silent_scans += 1
+        self._silent_empty += empty
+        self._silent_bools += sum(
+            1 for r in answers.late if r.tick == tick and isinstance(r.value, bool)
+        )
         if self._silent_scans < STOPPED_AFTER or answers.problem is not None:
             return
         deadline = f"the {self.options.scan_timeout:g} s deadline"
@@ -594,6 +792,20 @@ class Ros2Link(Link):
             answers.problem = (
                 f"node answers too late: {self._silent_scans} scans in a row missed {deadline} "
                 f"(the last answer came after {came_late[0].after:.2f} s)"
+            )
+        elif self._silent_empty == self._silent_scans and not self._answered_empty:
+            answers.problem = (
+                f"node {self.command.description} is running and subscribed to "
+                f"{self.options.scan_topic} but published nothing on {self.options.status_topic} "
+                f"for {self._silent_scans} scans in a row, none of which had a valid return: a "
+                'status is expected when nothing is in range too (e.g. "no obstacle")'
+            )
+        elif self._silent_bools:
+            answers.problem = (
+                f"node stopped answering: no status on {self.options.status_topic} for "
+                f"{self._silent_scans} scans in a row, though it published "
+                f"{self.options.warning_topic} for them (it is running and not stuck in a "
+                "callback: its status is not published for every scan)"
             )
         else:
             answers.problem = (

@@ -15,6 +15,7 @@ from __future__ import annotations
 import atexit
 import contextlib
 import os
+import re
 import select
 import signal
 import subprocess
@@ -129,6 +130,33 @@ class OutputTail:
     def join(self, timeout: float) -> None:
         """Wait (bounded) for end of file: every process holding the pipe has exited."""
         self._thread.join(timeout)
+
+
+_FRAME = re.compile(r'^\s*File "(?P<file>[^"]+)", line (?P<line>\d+), in (?P<func>.+)$')
+_CARETS = re.compile(r"^\s*[\^~]+\s*$")
+
+
+def last_error(stderr: str) -> str:
+    """What a crashed node's stderr says went wrong, in one line.
+
+    A Python traceback gives its exception line and where it was raised
+    (``ValueError: min() arg is an empty sequence (node.py line 85, in
+    on_scan: best = min(valid))``); other output gives its last three lines
+    joined with " | ". Empty when nothing was written.
+    """
+    lines = [line.rstrip() for line in stderr.splitlines() if line.strip()]
+    frames = [i for i, line in enumerate(lines) if _FRAME.match(line)]
+    if frames:
+        at = frames[-1]
+        after = [line for line in lines[at + 1 :] if not _CARETS.match(line)]
+        code = after[0].strip() if after and after[0].startswith(" ") else ""
+        error = next((line for line in after if not line.startswith(" ")), "")
+        if error:
+            frame = _FRAME.match(lines[at])
+            assert frame is not None
+            where = f"{Path(frame['file']).name} line {frame['line']}, in {frame['func']}"
+            return f"{error} ({where}{': ' + code if code else ''})"
+    return " | ".join(lines[-3:])
 
 
 def signal_name(number: int) -> str:
@@ -330,6 +358,25 @@ class NodeProcess:
             words.append("(finished on its own: a node must keep running until it is stopped)")
         last = self.tail("stderr", 3).replace("\n", " | ")
         return " ".join(w for w in words if w) + (f"; last stderr: {last}" if last else "")
+
+    def crash_summary(self, when: str = "") -> str:
+        """How the node ended and why, for the tick it died on: "crashed <when>: it exited
+        with code 1; last stderr: ValueError: ... (node.py line 85, in on_scan: ...)"."""
+        code = self.returncode()
+        if code is None:
+            return "is still running"
+        at = f" {when}" if when else ""
+        if code < 0:
+            how = f"crashed{at}: it was killed by {signal_name(-code)}"
+        elif code:
+            how = f"crashed{at}: it exited with code {code}"
+        else:
+            how = (
+                "exited with code 0 (finished on its own: a node must keep running until it is "
+                "stopped)"
+            )
+        last = last_error(self.tail("stderr"))
+        return how + (f"; last stderr: {last}" if last else "")
 
     def stop_note(self) -> str:
         """What stopping took beyond a plain SIGINT: signals ignored, processes left behind."""

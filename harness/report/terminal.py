@@ -109,19 +109,25 @@ def print_results(
         more = len(r.failed_ticks) - 1
         if more > 0:
             console.print(f"  ({more} more failed tick{'s' if more > 1 else ''})", highlight=False)
-        if r.error and r.failed_ticks and r.error not in (r.first_failure or ""):
+        if r.error and r.failed_ticks and not _told(r.error, r.first_failure or ""):
             print_safe(console, f"  run ended: {r.error}")
-        if r.diagnostics in shown:
+        diagnostics = without_notes(r.diagnostics, r.notes)
+        if diagnostics in shown:
             console.print("  (node output as above)", highlight=False)
-        elif r.diagnostics:
-            shown.add(r.diagnostics)
-            lines = for_terminal(clip(r.diagnostics, DIAGNOSTICS_LIMIT)).rstrip().split("\n")
+        elif diagnostics:
+            shown.add(diagnostics)
+            lines = for_terminal(clip(diagnostics, DIAGNOSTICS_LIMIT)).rstrip().split("\n")
             print_safe(console, "  " + "\n  ".join(lines[-DIAGNOSTIC_LINES:]), limit=None)
     not_run = [r for r in failed if r.not_run]
     if not_run:
         console.print()
         reason = (not_run[0].error or "").removeprefix("not run: ")
         print_safe(console, f"{len(not_run)} not run: {reason}")
+    notes = run_notes(results)
+    if notes:
+        console.print()
+    for note in notes:
+        print_safe(console, f"note: {note}", style="yellow")
     total = len(results)
     passed = total - len(failed)
     console.print()
@@ -139,6 +145,25 @@ def print_results(
         console.print(gaps, highlight=False, markup=False)
     if alignment is not None:
         print_alignment(console, alignment, mode=alignment_mode)
+
+
+def _told(error: str, first_failure: str) -> bool:
+    """Does the first failure already say what ended the run (its tick's failure is the
+    error, e.g. the node's crash)?"""
+    _, _, what = error.partition(": ")
+    return error in first_failure or bool(what) and what in first_failure
+
+
+def without_notes(diagnostics: str, notes: Sequence[str]) -> str:
+    """The diagnostics without the run's notes, which are printed once for the run."""
+    if not notes:
+        return diagnostics
+    return "\n".join(line for line in diagnostics.split("\n") if line not in notes)
+
+
+def run_notes(results: Sequence[RunResult]) -> list[str]:
+    """Each note of the run once (a node's warning on another topic, say), in order."""
+    return list(dict.fromkeys(note for r in results for note in r.notes))
 
 
 def node_start_lines(results: Sequence[RunResult]) -> list[str]:

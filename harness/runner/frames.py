@@ -114,7 +114,7 @@ def judge_frames(
         pending.clear()
         return late
 
-    warmed = False
+    started = False
     planned = iter(plan_deliveries(frames, link_faults, result.seed))
     current: Frame | None = None  # the frame being delivered, for an interruption's message
     try:
@@ -130,14 +130,15 @@ def judge_frames(
             if delivery.stamp_age_s:
                 scan = replace(scan, stamp=max(0.0, frame.t - delivery.stamp_age_s))
             try:
-                if not warmed:
-                    link.warm_up(frame.scan)
-                    warmed = True
-                    if link_faults.on_line:  # after the warm-up, whose retries vary in number
-                        link.damage_line(LineDamage(link_faults, result.seed))
                 if delivery.delay_s:
                     link.hold(delivery.delay_s)
-                link.send(scan, frame.tick, clock=frame.t)
+                if started:
+                    link.send(scan, frame.tick, clock=frame.t)
+                else:
+                    if link_faults.on_line:  # from the first scan on (each copy alike)
+                        link.damage_line(LineDamage(link_faults, result.seed))
+                    _send_first(link, frame, scan, delivery)
+                    started = True
                 # While the node works on this scan, judge the ticks that are
                 # complete and simulate the next one.
                 judge_ready()
@@ -157,8 +158,21 @@ def judge_frames(
         judge_ready()  # complete ticks only; those still waiting for answers are not judged
         raise _interrupted(err, result, current) from None
     if diagnose:
+        result.notes = link.notices()  # before the diagnostics, which stop the node
         result.diagnostics = link.diagnostics()
     return result
+
+
+def _send_first(link: Link, frame: Frame, scan: Scan, delivery: Delivery) -> None:
+    """The run's first scan: sent (resent until answered, where a link may lose it) and
+    judged, so the node's first answer is judged. One a careful node may ignore (a
+    stale stamp) cannot show that the node is up: a warm-up exchange of the scan as
+    taken goes first, its answers not judged."""
+    if delivery.may_be_ignored:
+        link.warm_up(frame.scan)
+        link.send(scan, frame.tick, clock=frame.t)
+    else:
+        link.send_first(scan, frame.tick, clock=frame.t)
 
 
 def _interrupted(err: KeyboardInterrupt, result: RunResult, frame: Frame | None) -> Interrupted:

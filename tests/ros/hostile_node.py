@@ -105,7 +105,7 @@ def crash_mid_run(pids: Path | None) -> Node:
 
 
 def crash_on_first_scan(pids: Path | None) -> Node:
-    """Ready, then raises in the callback of the very first scan (the harness's warm-up)."""
+    """Ready, then raises in the callback of the very first scan (tick 0's)."""
     node = Answering()
 
     def crash(stamp: float) -> None:

@@ -32,6 +32,9 @@ VARIANTS = {
     "answers_twice",
     "unparseable",
     "goes_silent",
+    "first_answer_wrong",
+    "status_on_change",
+    "silent_when_clear",
 }
 
 
@@ -104,6 +107,15 @@ class LidarNode(Node):
             warning = best < self.threshold
         if self.variant == "unparseable":
             status.data = "obstacle: yes-ish"
+        if self.variant == "first_answer_wrong" and self.scans == 1:
+            status.data = "Min distance: 0.000 m, angle: 0.000 rad"  # a value not yet computed
+        if self.variant == "silent_when_clear" and index is None:
+            return
+        if self.variant == "status_on_change":
+            if status.data == getattr(self, "last_status", None):
+                self.warning_pub.publish(Bool(data=warning))
+                return
+            self.last_status = status.data
         self.status_pub.publish(status)
         if self.variant == "answers_twice":
             self.status_pub.publish(status)

@@ -119,23 +119,25 @@ def test_crash_mid_run(pids: Path) -> None:
     says(
         done,
         "hostile_wall: t=0.20 s tick 2: ",
-        "exited with code 1; last stderr:",
+        "crashed on this scan: it exited with code 1; last stderr:",
         "RuntimeError: hostile: crash in the callback of the scan stamped 0.2 s",
     )
     assert survivors(pids) == []
 
 
-def test_crash_while_warming_up_names_the_node_once(pids: Path) -> None:
-    """Raises on the first scan: 'node CMD exited with code 1 while warming up', CMD once."""
+def test_crash_on_the_first_scan_is_tick_0s_failure_naming_the_node_once(pids: Path) -> None:
+    """Raises on the first scan, which is tick 0's: tick 0 fails with 'node CMD crashed on
+    this scan', its exit code and the exception, CMD once."""
     done = hostile_cli("crash_on_first_scan", pids)
     assert done.returncode == 1, explanation(done)
     command = node("crash_on_first_scan", pids)
     says(
         done,
-        f"hostile_wall: t=0.00 s tick 0: node {command} exited with code 1 while warming up; "
-        "last stderr:",
-        "RuntimeError: hostile: crash in the callback of the first scan",
+        "hostile_wall: t=0.00 s tick 0: ",
+        f"node {command} crashed on this scan: it exited with code 1; last stderr: "
+        "RuntimeError: hostile: crash in the callback of the first scan (hostile_node.py line",
     )
+    assert "link problem" not in done.stdout and "run ended" not in done.stdout
     first = next(line for line in done.stdout.splitlines() if line.startswith("hostile_wall:"))
     assert first.count(command) == 1, first
     assert survivors(pids) == []

@@ -85,8 +85,8 @@ def test_node_that_stops_answering_ends_the_run() -> None:
     """A node that goes silent mid-run: a bounded wait, then a clear end."""
     done = fossbot_hil("run", "approach_wall", "--timeout", "0.3", "--node", student("goes_silent"))
     assert done.returncode == 1
-    # The node answers 10 scans: the warm-up scan and ticks 0-8.
-    assert "tick 9: " in done.stdout and "no status within the deadline" in done.stdout
+    # The node answers 10 scans: ticks 0-9 (the first scan is tick 0's, judged).
+    assert "tick 10: " in done.stdout and "no status within the deadline" in done.stdout
     assert "node stopped answering: no status on /lidar_status for 3 scans" in done.stdout
 
 

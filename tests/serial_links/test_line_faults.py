@@ -315,13 +315,13 @@ def test_a_bool_published_only_on_change_goes_with_the_nearest_status() -> None:
 @pytest.mark.ros
 @pytest.mark.timeout(90)
 def test_a_revolution_made_late_by_the_line_is_judged_with_its_own_answers() -> None:
-    """ldlidar, 0.5 % of bytes lost, seed 47: the line eats tick 73's closing packet, so
-    its scan comes with tick 74's; the reference node still passes every tick."""
-    done = run_on_line("ldlidar", ["line_drops(rate=0.005)"], seed=47)
+    """ldlidar, 0.5 % of bytes lost, seed 44: the line eats tick 19's closing packet, so
+    its scan comes with tick 20's; the reference node still passes every tick."""
+    done = run_on_line("ldlidar", ["line_drops(rate=0.005)"], seed=44)
     assert done.result.ok, done.describe()
-    assert done.lost == [73], done.describe()
+    assert done.lost == [19], done.describe()
     late = [r for r in done.result.records if r.answers.earlier]
-    assert [r.tick for r in late] == [74], done.describe()
+    assert [r.tick for r in late] == [20], done.describe()
     assert len(late[0].answers.earlier[0][1].statuses) == 1  # the node answered the late scan
 
 
