@@ -30,7 +30,8 @@ class Answers:
     waited: float = 0.0  # seconds the link waited for this scan's answers
     timed_out: bool = False  # the per-scan deadline passed without a status
     problem: str | None = None  # link-level failure, e.g. "node exited with code 1: ..."
-    crashed: bool = False  # `problem` is the software under test having exited (or crashed)
+    crashed: bool = False  # `problem` is the software under test's own: it exited, crashed,
+    # or (a processing function) raised or hung; not the link's
     late: list[Received] = field(default_factory=list)  # answers to earlier scans, by tick
     seen: Scan | None = None  # the scan the node received, when a device and driver made it
     lost: str | None = None  # why the node never got this scan (e.g. damaged on the line)

@@ -90,8 +90,8 @@ class InprocessLink(Link):
     def collect(self, scan: Scan, tick: int, *, may_be_ignored: bool = False) -> Answers:
         assert self._child is not None, "open() the link first"
         outcome = self._child.outcome(self.options.scan_timeout)
-        if outcome.problem is not None:
-            return Answers(problem=outcome.problem)
+        if outcome.problem is not None:  # raised, hung, exited: the function's, not the link's
+            return Answers(problem=outcome.problem, crashed=True)
         after = outcome.seconds
         answers = Answers(statuses=[Received(outcome.status or "", after)], waited=after)
         if outcome.warning is not None:
