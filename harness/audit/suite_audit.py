@@ -14,11 +14,13 @@ from typing import Any
 
 from harness.audit.matrix import KillMatrix, kill_matrix
 from harness.audit.mutants import CONTROL, mutant_command, mutant_named
-from harness.audit.task import AuditConfig, AuditUnit, UnitResult, run_unit
+from harness.audit.task import AuditConfig, AuditUnit, UnitResult, run_batch
 
-__all__ = ["AuditOutcome", "audit_suite", "audit_units"]
+__all__ = ["AuditOutcome", "audit_suite", "audit_units", "batches"]
 
 STOP_WAIT_S = 30.0  # on Ctrl-C: for running units to stop their nodes
+BATCHES_PER_THREAD = 2  # batches per worker thread: start-up shared, the load still even
+SLOW_COST = 6.0  # a mistake that waits out deadlines costs about six quick ones
 
 
 class AuditOutcome:
@@ -41,7 +43,7 @@ class AuditOutcome:
 
 
 def audit_units(names: Sequence[str]) -> list[AuditUnit]:
-    """The correct control first (its coverage is wanted early), then the mutants."""
+    """The correct control, then the mutants, each a node command."""
     return [AuditUnit(name, mutant_command(name)) for name in (CONTROL, *names)]
 
 
@@ -52,27 +54,29 @@ def audit_suite(
     *,
     on_unit: Callable[[UnitResult, int], None] | None = None,
 ) -> AuditOutcome:
-    """Run the control and `mutants` through the suite on `client`'s cluster; `on_unit`
-    gets each unit's result as it comes, with how many units are running then."""
+    """Run the control and `mutants` through the suite on `client`'s cluster, in batches
+    (`batches`); `on_unit` gets each unit's result as its batch ends, with how many
+    batches are running then."""
     from harness.cluster.flag import ClusterFlag
-    from harness.cluster.window import Window
+    from harness.cluster.window import Window, cluster_threads
 
     units = audit_units(mutants)
-    order = sorted(range(len(units)), key=lambda i: (i > 0, not _slow(units[i].name)))
-    queued = [units[i] for i in order]  # the control, the slow ones, then the rest
-    done: dict[int, UnitResult] = {}
+    queued = batches(units, BATCHES_PER_THREAD * cluster_threads(client))
+    done: dict[str, UnitResult] = {}
     stop = ClusterFlag()
 
-    def submit(unit: AuditUnit) -> Any:
-        key = f"audit-{unit.name}-{uuid.uuid4().hex[:8]}"
-        return client.submit(run_unit, unit, config, stop, key=key, pure=False)
+    def submit(batch: tuple[AuditUnit, ...]) -> Any:
+        number = queued.index(batch) + 1
+        key = f"audit-batch-{number}-{uuid.uuid4().hex[:8]}"
+        return client.submit(run_batch, batch, config, number, stop, key=key, pure=False)
 
     window = Window(client, queued, submit)
     try:
         for index, future in window:
-            done[order[index]] = _outcome(future, queued[index])
-            if on_unit is not None:
-                on_unit(done[order[index]], len(window.running))
+            for outcome in _outcomes(future, queued[index]):
+                done[outcome.name] = outcome
+                if on_unit is not None:
+                    on_unit(outcome, len(window.running))
     except BaseException:
         with contextlib.suppress(Exception):  # the scheduler may be what went away
             stop.set()
@@ -80,21 +84,41 @@ def audit_suite(
 
             wait_for(list(window.running), timeout=STOP_WAIT_S)
         raise
-    results = [done[i] for i in range(len(units))]
+    results = [done[unit.name] for unit in units]
     control, mutant_results = results[0], results[1:]
     matrix = kill_matrix(config.scenarios, mutant_results, control)
     return AuditOutcome(matrix, control, mutant_results)
 
 
-def _slow(name: str) -> bool:
-    return name != CONTROL and mutant_named(name).slow
+def batches(units: Sequence[AuditUnit], count: int) -> list[tuple[AuditUnit, ...]]:
+    """`units` in at most `count` batches of about equal cost, the costliest first: a
+    mistake whose runs wait out deadlines costs several quick ones. One batch shares one
+    worker process and its warm Python, so the fewer batches, the less start-up; enough
+    of them keep every worker busy to the end."""
+    count = max(1, min(count, len(units)))
+    loads = [0.0] * count
+    chosen: list[list[AuditUnit]] = [[] for _ in range(count)]
+    for unit in sorted(units, key=lambda u: -_cost(u.name)):  # stable: control, then order
+        lightest = loads.index(min(loads))
+        chosen[lightest].append(unit)
+        loads[lightest] += _cost(unit.name)
+    ranked = sorted(range(count), key=lambda i: -loads[i])
+    return [tuple(chosen[i]) for i in ranked if chosen[i]]
 
 
-def _outcome(future: Any, unit: AuditUnit) -> UnitResult:
-    """The unit's result; one lost to the cluster is a result too (it killed nothing)."""
+def _cost(name: str) -> float:
+    """How long a unit's runs take, relative to a quick one's."""
+    if name == CONTROL:
+        return 1.0
+    return SLOW_COST if mutant_named(name).slow else 1.0
+
+
+def _outcomes(future: Any, batch: tuple[AuditUnit, ...]) -> list[UnitResult]:
+    """The batch's results; a batch lost to the cluster is results too (it killed nothing)."""
     try:
-        outcome = future.result()
+        outcomes = future.result()
     except Exception as err:  # noqa: BLE001 - lost to the cluster, not to the node
-        return UnitResult(unit.name, error=f"lost to the cluster: {type(err).__name__}: {err}")
-    assert isinstance(outcome, UnitResult)
-    return outcome
+        why = f"lost to the cluster: {type(err).__name__}: {err}"
+        return [UnitResult(unit.name, error=why) for unit in batch]
+    assert isinstance(outcomes, list)
+    return outcomes

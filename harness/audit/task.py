@@ -1,8 +1,9 @@
-"""One audit unit as a Dask task: a mutant (or the correct control) through the suite.
+"""A batch of audit units as a Dask task: mutants (or the correct control) through the suite.
 
 The task runs ``harness.audit.worker`` as a bounded child process (as
 ``grade`` runs a student's suite), so the nodes start by fork from the
-child's main thread and a mutant that crashes or hangs ends only its unit.
+child's main thread (its warm Python started once for the batch, not once
+per mutant), and a mutant that crashes or hangs ends only its own runs.
 Everything it needs travels with it, so any worker can take it.
 """
 
@@ -19,7 +20,7 @@ from harness.audit.mutants import CONTROL
 from harness.links.base import LinkOptions
 from harness.runner.settings import RunSettings
 
-__all__ = ["AuditConfig", "AuditUnit", "UnitResult", "run_unit"]
+__all__ = ["AuditConfig", "AuditUnit", "UnitResult", "run_batch"]
 
 MAX_LOG_BYTES = 8 * 1024 * 1024
 SECONDS_PER_SCENARIO = 90.0  # a unit's bound: each suite's runs end at their own deadlines
@@ -35,11 +36,11 @@ class AuditConfig:
     options: LinkOptions
     settings: RunSettings
     seeds: tuple[int | None, ...]  # one suite per seed; None: each scenario's own
-    units_dir: Path  # one folder per unit: job.json, results.json, run.log
+    units_dir: Path  # one folder per batch: job.json, results.json, run.log
 
-    @property
-    def unit_timeout(self) -> float:
-        return SECONDS_PER_SCENARIO * len(self.scenarios) * len(self.seeds) + 30.0
+    def batch_timeout(self, units: int) -> float:
+        """A batch's bound: generous per scenario run, as each run ends at its deadlines."""
+        return SECONDS_PER_SCENARIO * len(self.scenarios) * len(self.seeds) * units + 30.0
 
 
 @dataclass(frozen=True)
@@ -75,31 +76,35 @@ class UnitResult:
         return ""
 
 
-def run_unit(unit: AuditUnit, config: AuditConfig, cancel: Any = None) -> UnitResult:
-    """Run `unit` through every seed's suite in a bounded worker process; never raises for
-    what the node does (that is the unit's result)."""
+def run_batch(
+    batch: tuple[AuditUnit, ...], config: AuditConfig, number: int, cancel: Any = None
+) -> list[UnitResult]:
+    """Run each unit of `batch` through every seed's suite in one bounded worker process;
+    never raises for what a node does (that is its unit's result)."""
     from harness.audit.worker import write_job
     from harness.grading.process import run_bounded
 
-    folder = config.units_dir / unit.name
+    folder = config.units_dir / f"batch-{number}"
     folder.mkdir(parents=True, exist_ok=True)
     results = folder / "results.json"
     results.unlink(missing_ok=True)
+    names = [unit.name for unit in batch]
     job = write_job(
         folder / "job.json",
-        command=unit.command,
+        commands={unit.name: unit.command for unit in batch},
         scenarios=list(config.scenario_refs),
         link=config.link,
         options=config.options,
         settings=config.settings,
         seeds=list(config.seeds),
-        coverage=unit.name == CONTROL,
+        coverage=CONTROL if CONTROL in names else None,
         results=results,
     )
+    timeout = config.batch_timeout(len(batch))
     finished = run_bounded(
         [sys.executable, "-m", "harness.audit.worker", str(job)],
         log=folder / "run.log",
-        timeout=config.unit_timeout,
+        timeout=timeout,
         max_log_bytes=MAX_LOG_BYTES,
         cwd=folder,
         cancel=cancel or threading.Event(),
@@ -108,15 +113,20 @@ def run_unit(unit: AuditUnit, config: AuditConfig, cancel: Any = None) -> UnitRe
         data = json.loads(results.read_text(encoding="utf-8"))
     except (OSError, ValueError):
         data = {}
-    outcome = UnitResult(unit.name, list(data.get("runs", [])), wall_s=finished.wall_s)
-    if data.get("error"):
-        outcome.error = str(data["error"])
-    elif not data.get("finished"):
-        if finished.timed_out:
-            outcome.error = f"stopped after {config.unit_timeout:g} s"
-        elif finished.cancelled:
-            outcome.error = "interrupted"
-        else:
-            code = finished.returncode
-            outcome.error = finished.start_error or f"the audit worker ended (exit code {code})"
-    return outcome
+    units = data.get("units", {}) if isinstance(data, dict) else {}
+    if finished.timed_out:
+        why = f"stopped after {timeout:g} s"
+    elif finished.cancelled:
+        why = "interrupted"
+    else:
+        why = finished.start_error or f"the audit worker ended (exit code {finished.returncode})"
+    outcomes = []
+    for name in names:
+        unit = units.get(name, {})
+        outcome = UnitResult(name, list(unit.get("runs", [])), wall_s=finished.wall_s)
+        if unit.get("error"):
+            outcome.error = str(unit["error"])
+        elif not unit.get("finished"):
+            outcome.error = why
+        outcomes.append(outcome)
+    return outcomes

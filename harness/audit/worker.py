@@ -1,12 +1,14 @@
-"""One mutant through the audited suite, once per seed: ``python -m harness.audit.worker JOB``.
+"""A batch of mutants through the audited suite, each once per seed:
+``python -m harness.audit.worker JOB``.
 
 Its own process, as a student's suite in ``grade`` is: its main thread may
-start the nodes by fork from a warm Python (a Dask worker's thread may not),
-and a node that takes its process down takes only this mutant's unit with it.
-JOB is a JSON file (``write_job``) naming the node command, the scenarios,
-the link, the LinkOptions and RunSettings fields, the seeds, and where
+start the nodes by fork from a warm Python (a Dask worker's thread may not;
+the warm Python is started once for the batch), and a node that takes its
+process down takes only this batch with it. JOB is a JSON file
+(``write_job``) naming each mutant's node command, the scenarios, the link,
+the LinkOptions and RunSettings fields, the seeds, and where
 ``results.json`` goes; it is rewritten (atomically) after every suite, so a
-unit stopped at its time limit still tells what it judged.
+batch stopped at its time limit still tells what it judged.
 """
 
 from __future__ import annotations
@@ -29,18 +31,19 @@ FAILURE_CHARS = 600  # of each scenario's first failure kept in results.json
 def write_job(
     path: Path,
     *,
-    command: str,
+    commands: dict[str, str],
     scenarios: list[str],
     link: str,
     options: Any,
     settings: Any,
     seeds: list[int | None],
-    coverage: bool,
+    coverage: str | None,
     results: Path,
 ) -> Path:
-    """Write a job file for this worker: LinkOptions and RunSettings as their fields."""
+    """Write a job file for this worker: each mutant's node command by name, LinkOptions and
+    RunSettings as their fields, and which unit's runs give the reading coverage."""
     job = {
-        "command": command,
+        "commands": commands,
         "scenarios": scenarios,
         "link": link,
         "options": asdict(options),
@@ -65,39 +68,46 @@ def _entry(result: Any) -> dict[str, Any]:
 
 
 def run_job(job: dict[str, Any]) -> int:
-    """Run the suite once per seed; results.json tells the outcome, the exit code only if
-    the worker itself broke."""
+    """Run each unit's suite once per seed; results.json tells the outcome, the exit code
+    only if the worker itself broke."""
     from harness.grading.worker import link_options_from, run_settings_from
     from harness.judge.reading_coverage import coverage_of, gaps
     from harness.runner.suite import run_suite
     from harness.scenario.files import resolve_scenario
 
     results_path = Path(job["results"])
-    runs: list[dict[str, Any]] = []
+    units: dict[str, dict[str, Any]] = {}
 
-    def write(finished: bool, error: str | None = None) -> None:
-        data = {"runs": runs, "finished": finished, "error": error}
-        write_atomically(results_path, json.dumps(data, indent=2).encode())
+    def write() -> None:
+        write_atomically(results_path, json.dumps({"units": units}, indent=2).encode())
 
-    options = replace(link_options_from(job["options"]), node=job["command"])
     base = run_settings_from(job["settings"])
     try:
         chosen = [resolve_scenario(ref) for ref in job["scenarios"]]
-        for seed in job["seeds"]:
-            results = run_suite(chosen, job["link"], options, replace(base, seed=seed))
-            run: dict[str, Any] = {"seed": seed, "results": [_entry(r) for r in results]}
-            if job.get("coverage"):
-                coverage = coverage_of(results)
-                run["coverage"], run["coverage_gaps"] = coverage.as_dict(), gaps(coverage)
-            runs.append(run)
-            write(finished=False)
+        for name, command in job["commands"].items():
+            unit: dict[str, Any] = {"runs": [], "finished": False, "error": None}
+            units[name] = unit
+            options = replace(link_options_from(job["options"]), node=command)
+            for seed in job["seeds"]:
+                results = run_suite(chosen, job["link"], options, replace(base, seed=seed))
+                run: dict[str, Any] = {"seed": seed, "results": [_entry(r) for r in results]}
+                if job.get("coverage") == name:
+                    coverage = coverage_of(results)
+                    run["coverage"], run["coverage_gaps"] = coverage.as_dict(), gaps(coverage)
+                unit["runs"].append(run)
+                write()
+            unit["finished"] = True
+            write()
     except ConfigError as err:
-        write(finished=False, error=str(err))
+        for unit in units.values():
+            unit["error"] = unit["error"] or (None if unit["finished"] else str(err))
+        write()
         return 0
     except KeyboardInterrupt:  # SIGTERM from the command: links closed, nodes stopped
-        write(finished=False, error="stopped")
+        for unit in units.values():
+            unit["error"] = None if unit["finished"] else "stopped"
+        write()
         return 1
-    write(finished=True)
     return 0
 
 
