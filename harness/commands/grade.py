@@ -300,8 +300,8 @@ def run(args: argparse.Namespace, console: Console) -> int:
             markup=False,
             highlight=False,
         )
-        if audit_line:
-            console.print(audit_line, markup=False, highlight=False)
+        if audit_line:  # one line, however long: scripts look for it
+            console.print(audit_line, markup=False, highlight=False, soft_wrap=True)
         return 0
 
 
