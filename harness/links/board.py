@@ -104,6 +104,7 @@ class BoardLink(Ros2Link):
         self._repeat_at: int | None = None  # the first repeat's scan in this exchange, if any
         self._line_damage: LineDamage | None = None
         self._first_damage: LineDamage | None = None  # as it was before the first scan's copy
+        self._after_idle = False  # the first exchange after the idle stream is next
 
     @classmethod
     def run_session(cls, options: LinkOptions) -> BoardSession:
@@ -296,6 +297,7 @@ class BoardLink(Ros2Link):
         ends on a whole start marker, so the later revolutions are the same bytes however
         many copies of the first it took."""
         self._end_idle_stream(scan)
+        self._after_idle = True
         super().send_first(scan, tick, clock=clock)
         assert self.server is not None
         self.server.align_stream()
@@ -493,6 +495,9 @@ class BoardLink(Ros2Link):
         assert self.observer is not None
         self._heard_scans = []
         answers = super().collect(scan, tick, may_be_ignored=may_be_ignored)
+        if self._after_idle:
+            self._after_idle = False
+            _set_aside_answers_to_the_idle_stream(answers, len(self._heard_scans))
         _pair_with_driver_scans(answers, self._heard_scans)
         if self._repeat_at is not None:  # answers to the device's repeats answer no tick
             answers.first_answer_only()
@@ -539,6 +544,26 @@ class BoardLink(Ros2Link):
         if self.session is not None and self._own_session:
             notes.append(self.session.stop_note())
         return "\n".join(n for n in notes if n)
+
+
+def _set_aside_answers_to_the_idle_stream(answers: Answers, scans: int) -> None:
+    """The first exchange after the idle stream: more statuses than the driver published
+    scans in it means the earliest answer revolutions streamed before (a driver lagging
+    on a loaded machine publishes them late, after the harness stopped waiting for
+    them). The node answers in order, so the last `scans` statuses (and the Bools nearest
+    to them) are this exchange's; the others are kept as late answers of no tick."""
+    statuses = sorted(answers.statuses, key=lambda r: r.source_ns)
+    extra = len(statuses) - max(1, scans)
+    if extra <= 0:
+        return
+    earlier, kept = statuses[:extra], statuses[extra:]
+    answers.statuses = kept
+    bools = []
+    for item in answers.warnings:
+        nearest = min(statuses, key=lambda r: abs(r.source_ns - item.source_ns))
+        (bools if nearest in kept else earlier).append(item)
+    answers.warnings = bools
+    answers.late += [replace(r, tick=None) for r in earlier]
 
 
 def _pair_with_driver_scans(answers: Answers, scans: list[Heard]) -> None:

@@ -291,6 +291,28 @@ def test_back_to_back_callbacks_keep_each_bool_with_its_own_status() -> None:
 
 
 @pytest.mark.ros
+def test_answers_to_the_idle_stream_published_late_are_set_aside() -> None:
+    """The first exchange after the idle stream: the driver published one scan in it, the
+    node answered three (two to idle revolutions a lagging driver published late): the
+    last status and its Bool are the tick's, the others late answers of no tick."""
+    from harness.links.board import _set_aside_answers_to_the_idle_stream
+
+    answers = Answers(
+        statuses=[
+            Received("No obstacle", 0.01, source_ns=1_000),
+            Received("No obstacle", 0.02, source_ns=2_000),
+            Received("Min distance: 1.462 m", 0.03, source_ns=3_000),
+        ],
+        warnings=[Received(False, 0.01, source_ns=999), Received(False, 0.03, source_ns=2_999)],
+    )
+    _set_aside_answers_to_the_idle_stream(answers, 1)
+    assert [r.value for r in answers.statuses] == ["Min distance: 1.462 m"]
+    assert [r.source_ns for r in answers.warnings] == [2_999]
+    assert sorted(r.source_ns for r in answers.late) == [999, 1_000, 2_000]
+    assert all(r.tick is None for r in answers.late)
+
+
+@pytest.mark.ros
 def test_a_bool_published_only_on_change_goes_with_the_nearest_status() -> None:
     """Two statuses, one Bool (published on change, after the second status): it is the
     second scan's answer; the first scan has none."""
