@@ -4,11 +4,11 @@ text and the run's notes, built by hand (pure), then through the inprocess link.
 from __future__ import annotations
 
 import io
-import math
 from pathlib import Path
 
 import numpy as np
 import pytest
+from gazebo_scans import INC, make_scan
 from rich.console import Console
 
 from harness.judge.answers import Answers, Received
@@ -23,26 +23,8 @@ from harness.runner.scenario_run import run_scenario
 from harness.runner.settings import RunSettings, effective_threshold
 from harness.scenario.files import resolve_scenario
 
-N = 360
-INC = 2 * math.pi / (N - 1)  # the gazebo preset: -pi..pi inclusive
 THRESHOLD = 0.5
 FUNCTIONS = Path(__file__).parent / "explained_functions.py"
-
-
-def make_scan(values: dict[int, float] | None = None) -> Scan:
-    r = np.full(N, math.inf, np.float32)
-    for i, v in (values or {}).items():
-        r[i] = v
-    return Scan(
-        angle_min=-math.pi,
-        angle_max=math.pi,
-        angle_increment=INC,
-        time_increment=0.1 / N,
-        scan_time=0.1,
-        range_min=0.12,
-        range_max=12.0,
-        ranges=r,
-    )
 
 
 def status_for(scan: Scan) -> tuple[str, bool]:

@@ -7,6 +7,7 @@ import re
 
 import numpy as np
 import pytest
+from gazebo_scans import INC, N, make_scan
 
 from harness.errors import ConfigError
 from harness.faults.sensor import NAMED_PROFILES
@@ -14,27 +15,6 @@ from harness.judge.answers import Answers, Received
 from harness.judge.oracle import Oracle, summarise_scan
 from harness.lidar.scan import Scan
 from harness.lidar.spec import PRESETS
-
-N = 360
-INC = 2 * math.pi / (N - 1)  # the gazebo preset: -pi..pi inclusive
-
-
-def make_scan(values: dict[int, float] | None = None, fill: float = math.inf, **kw) -> Scan:
-    """A gazebo-like scan: `fill` everywhere, `values` at given beams."""
-    r = np.full(N, fill, np.float32)
-    for i, v in (values or {}).items():
-        r[i] = v
-    fields = dict(
-        angle_min=-math.pi,
-        angle_max=math.pi,
-        angle_increment=INC,
-        time_increment=0.1 / N,
-        scan_time=0.1,
-        range_min=0.12,
-        range_max=12.0,
-    )
-    fields.update(kw)
-    return Scan(ranges=r, **fields)
 
 
 def angle(scan: Scan, i: int) -> float:

@@ -7,6 +7,7 @@ import math
 
 import numpy as np
 import pytest
+from gazebo_scans import N, make_scan
 
 from harness.faults.link import Delivery
 from harness.judge.answers import Answers
@@ -22,8 +23,6 @@ from harness.judge.reading_coverage import (
 from harness.judge.records import RunResult, TickRecord
 from harness.lidar.scan import Scan
 
-N = 360
-INC = 2 * math.pi / (N - 1)  # the gazebo preset: -pi..pi inclusive
 VALUE = {
     "nan": math.nan,
     "pos_inf": math.inf,
@@ -32,24 +31,6 @@ VALUE = {
     "below_range_min": 0.05,
     "above_range_max": 12.5,
 }
-
-
-def make_scan(values: dict[int, float] | None = None, fill: float = math.inf, **kw) -> Scan:
-    """A gazebo-like scan: `fill` everywhere, `values` at given beams."""
-    r = np.full(N, fill, np.float32)
-    for i, v in (values or {}).items():
-        r[i] = v
-    fields = dict(
-        angle_min=-math.pi,
-        angle_max=math.pi,
-        angle_increment=INC,
-        time_increment=0.1 / N,
-        scan_time=0.1,
-        range_min=0.12,
-        range_max=12.0,
-    )
-    fields.update(kw)
-    return Scan(ranges=r, **fields)
 
 
 def run_of(

@@ -105,6 +105,14 @@ def param(text: str) -> str:
         raise argparse.ArgumentTypeError(str(err)) from None
 
 
+def name_list(text: str) -> list[str]:
+    """A comma-separated list of names ("a,b"), at least one."""
+    names = [n.strip() for n in text.split(",") if n.strip()]
+    if not names:
+        raise argparse.ArgumentTypeError("give at least one name")
+    return names
+
+
 def given(option: str) -> Callable[[str], str]:
     """A value that must not be empty: '' would silently mean "not given"."""
 

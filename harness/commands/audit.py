@@ -23,6 +23,7 @@ from harness.commands.arguments import (
     add_link_option,
     check_status_regex,
     given,
+    name_list,
     whole_number,
 )
 from harness.commands.cluster_options import add_cluster_options, describe_cluster
@@ -35,13 +36,6 @@ NODE_LINKS = ("ros2", "rplidar", "ldlidar")
 REPEAT_SEED_BASE = 1000  # repeat k > 0 runs every scenario with seed 1000 + k
 
 
-def _names(text: str) -> list[str]:
-    names = [n.strip() for n in text.split(",") if n.strip()]
-    if not names:
-        raise argparse.ArgumentTypeError("give at least one name")
-    return names
-
-
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "scenarios",
@@ -51,7 +45,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument(
         "--mutant",
-        type=_names,
+        type=name_list,
         action="append",
         default=[],
         metavar="NAME[,NAME]",

@@ -17,6 +17,7 @@ from harness.commands.arguments import (
     check_link_options,
     check_status_regex,
     given,
+    name_list,
     whole_number,
 )
 from harness.commands.cluster_options import add_cluster_options, describe_cluster
@@ -34,16 +35,9 @@ HELP = "run one node through every combination of scenarios, faults, seeds and t
 MAX_RUNS = 100_000
 
 
-def _names(text: str) -> list[str]:
-    names = [n.strip() for n in text.split(",") if n.strip()]
-    if not names:
-        raise argparse.ArgumentTypeError("give at least one name")
-    return names
-
-
 def _thresholds(text: str) -> list[float]:
     values = []
-    for item in _names(text):
+    for item in name_list(text):
         try:
             value = float(item)
         except ValueError:
@@ -64,7 +58,7 @@ def _variation(text: str) -> tuple[str, list[float]]:
         known = ", ".join(VARIATIONS)
         raise argparse.ArgumentTypeError(f"give NAME=LEVEL[,LEVEL] with NAME one of {known}")
     values = []
-    for item in _names(levels):
+    for item in name_list(levels):
         try:
             value = float(item)
         except ValueError:
@@ -79,7 +73,7 @@ def _variation(text: str) -> tuple[str, list[float]]:
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--scenario",
-        type=_names,
+        type=name_list,
         metavar="NAME[,NAME]",
         help="scenarios (names or files; default: every shipped one)",
     )
