@@ -69,16 +69,22 @@ class Answers:
         answer this tick; the later ones answer the copies, kept as late answers of no
         tick, never judged."""
         statuses = sorted(self.statuses, key=lambda r: r.source_ns)
+        self.keep_only(statuses[:1])
+
+    def keep_only(self, kept: list[Received]) -> None:
+        """Only the statuses `kept` (and the Bools published nearest to them) answer this
+        tick; the others, and their Bools, become late answers of no tick."""
+        statuses = sorted(self.statuses, key=lambda r: r.source_ns)
         if not statuses:
             return
-        first, rest = statuses[0], statuses[1:]
-        self.statuses = [first]
-        kept = []
+        others = [r for r in statuses if r not in kept]
+        self.statuses = [r for r in statuses if r in kept]
+        bools = []
         for item in self.warnings:
             nearest = min(statuses, key=lambda r: abs(r.source_ns - item.source_ns))
-            (kept if nearest is first else rest).append(item)
-        self.warnings = kept
-        self.late += [replace(r, tick=None) for r in rest]
+            (bools if nearest in kept else others).append(item)
+        self.warnings = bools
+        self.late += [replace(r, tick=None) for r in others]
 
     def take_late(self, late: list[Received], tick: int) -> list[Received]:
         """Adopt the late answers that belong to `tick`; return the others.

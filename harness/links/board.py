@@ -554,16 +554,8 @@ def _set_aside_answers_to_the_idle_stream(answers: Answers, scans: int) -> None:
     to them) are this exchange's; the others are kept as late answers of no tick."""
     statuses = sorted(answers.statuses, key=lambda r: r.source_ns)
     extra = len(statuses) - max(1, scans)
-    if extra <= 0:
-        return
-    earlier, kept = statuses[:extra], statuses[extra:]
-    answers.statuses = kept
-    bools = []
-    for item in answers.warnings:
-        nearest = min(statuses, key=lambda r: abs(r.source_ns - item.source_ns))
-        (bools if nearest in kept else earlier).append(item)
-    answers.warnings = bools
-    answers.late += [replace(r, tick=None) for r in earlier]
+    if extra > 0:
+        answers.keep_only(statuses[extra:])
 
 
 def _pair_with_driver_scans(answers: Answers, scans: list[Heard]) -> None:
