@@ -1,7 +1,7 @@
 """`fossbot-hil audit` as an instructor runs it: real mutant nodes over a real ROS 2 graph,
 on the embedded Dask cluster, with small budgets (two or three mistakes, two or three
 scenarios). The full library through the default suite is in the issue notes and
-docs/audit.md: it takes about a minute on 2 cores."""
+docs/audit.md: it takes about 200 s on 2 cores."""
 
 from __future__ import annotations
 
