@@ -55,6 +55,7 @@ SPARSE_RETURNS = 5
 SPARSE_WAIT_S = 0.25  # at least this long for the board's scan of such a revolution
 IDLE_ANSWER_S = 1.0  # before the first tick: for the node to answer the idle stream (each wait)
 STREAM_QUIET_REVOLUTIONS = 3  # no board scan of the idle stream in this many: none is coming
+IDLE_QUIET_MAX_S = 2.0  # longest wait for a lagging driver's last idle revolutions
 
 
 def board_options(options: LinkOptions) -> LinkOptions:
@@ -342,6 +343,16 @@ class BoardLink(Ros2Link):
         self._wait_for(answering, IDLE_ANSWER_S)
         answered = obs.heard_since("status", 1)
         self._idle_over(rate)
+        # A driver that lags (a loaded machine: it clears its input buffer) still has
+        # idle revolutions to publish: wait, bounded, until it has been quiet for three
+        # revolutions, so the node answers them now, not during the first tick.
+        quiet_s = STREAM_QUIET_REVOLUTIONS / rate
+
+        def driver_quiet() -> bool:
+            last = max((h.arrived for h in obs.inbox if h.kind == "scan"), default=began)
+            return time.perf_counter() - last > quiet_s
+
+        self._wait_for(driver_quiet, IDLE_QUIET_MAX_S)
         idle = [h.source_ns for h in obs.inbox if h.kind == "scan"]
         if idle and answered:
             self._wait_for(lambda: obs.heard_since("status", max(idle)), IDLE_ANSWER_S)
