@@ -10,18 +10,11 @@ from rich.table import Table
 from harness.audit.matrix import KillMatrix
 from harness.audit.mutants import mutant_named
 from harness.audit.suite_audit import AuditOutcome
+from harness.judge.reading_coverage import CASE_NAMES, CASES, other_counts
 
 __all__ = ["audit_json", "print_audit"]
 
 MARKS = {"killed": "x", "survived": ".", "flip": "~"}
-CASES = ("nan", "pos_inf", "neg_inf", "zero", "below_range_min", "above_range_max")
-COUNTS = (
-    ("near_threshold", "minimum near the threshold, outside the band"),
-    ("angle_near_pi", "minimum's angle near +-pi"),
-    ("angle_min_zero", "angle_min 0"),
-    ("angle_min_minus_pi", "angle_min -pi"),
-    ("warning_clears", "a due warning that must clear"),
-)
 
 
 def audit_json(outcome: AuditOutcome, *, repeat: int, seeds: list[int | None]) -> dict[str, Any]:
@@ -71,16 +64,14 @@ def _matrix_table(matrix: KillMatrix) -> Table:
 def _coverage_lines(coverage: dict[str, Any]) -> list[str]:
     if not coverage:
         return ["(the correct node's run gave no coverage)"]
-    cases = coverage.get("cases", {})
-    lines = [f"scans delivered: {coverage.get('scans', 0)}"]
-    width = max(len(c) for c in CASES)
+    width = max(len(name) for name in CASE_NAMES.values())
+    lines = [f"scans delivered: {coverage['scans']}"]
     lines.append(f"  {'reading':<{width}}  beside a valid return  without one")
     for case in CASES:
-        counts = cases.get(case, {})
-        beside, without = counts.get("beside_valid", 0), counts.get("without_valid", 0)
-        lines.append(f"  {case:<{width}}  {beside:>22}  {without:>11}")
-    for key, words in COUNTS:
-        lines.append(f"  {words}: {coverage.get(key, 0)}")
+        counts = coverage["cases"][case]
+        beside, without = counts["beside_valid"], counts["without_valid"]
+        lines.append(f"  {CASE_NAMES[case]:<{width}}  {beside:>22}  {without:>11}")
+    lines.extend(f"  {words}: {count}" for words, count in other_counts(coverage))
     return lines
 
 

@@ -41,7 +41,7 @@ Per run, in the order the node received the scans:
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -61,9 +61,18 @@ __all__ = [
     "coverage_of",
     "delivered_scans",
     "gaps",
+    "other_counts",
 ]
 
 CASES = ("nan", "pos_inf", "neg_inf", "zero", "below_range_min", "above_range_max")
+CASE_NAMES = {  # each case as reports name it
+    "nan": "NaN",
+    "pos_inf": "+inf",
+    "neg_inf": "-inf",
+    "zero": "0.0",
+    "below_range_min": "below range_min (0 < r < range_min)",
+    "above_range_max": "above range_max (finite)",
+}
 NEAR_THRESHOLD_M = 0.1  # beyond the band's edge, either side of the threshold
 ANGLE_MARGIN_RAD = 0.2  # of +pi or -pi
 ANGLE_MIN_TOL = 1e-6  # angle_min 0 or -pi within this
@@ -290,3 +299,22 @@ def gaps(coverage: ReadingCoverage) -> list[str]:
         if not getattr(coverage, name):
             out.append(line)
     return out
+
+
+def other_counts(total: Mapping[str, Any]) -> list[tuple[str, int]]:
+    """The counts of an ``as_dict()`` beside the six cases, each with what it counts in
+    words, for reports."""
+    return [
+        (
+            f"scans whose nearest valid return lies outside the threshold band, within "
+            f"{NEAR_THRESHOLD_M:g} m of its edge",
+            total["near_threshold"],
+        ),
+        (
+            f"scans whose nearest valid return lies within {ANGLE_MARGIN_RAD:g} rad of +pi or -pi",
+            total["angle_near_pi"],
+        ),
+        ("scans with angle_min 0", total["angle_min_zero"]),
+        ("scans with angle_min -pi", total["angle_min_minus_pi"]),
+        ("times a due warning stopped being due later in its run", total["warning_clears"]),
+    ]

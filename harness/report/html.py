@@ -15,6 +15,7 @@ from html import escape
 from typing import Any
 from urllib.parse import quote
 
+from harness.judge.reading_coverage import CASE_NAMES, other_counts
 from harness.report.summary import passed_line
 from harness.safe_text import DIAGNOSTICS_LIMIT, TEXT_LIMIT, clip, for_html, visible
 
@@ -22,14 +23,6 @@ __all__ = ["index_html"]
 
 DIAGNOSTIC_LINES = 15
 CHANGE_HEAD = ["change", "scenario", "faults", "then", "now", "why"]
-READING_NAMES = {  # summary.json's coverage cases, as the page names them
-    "nan": "NaN",
-    "pos_inf": "+inf",
-    "neg_inf": "-inf",
-    "zero": "0.0",
-    "below_range_min": "below range_min (0 < r < range_min)",
-    "above_range_max": "above range_max (finite)",
-}
 
 _STYLE = """
 body { font: 14px/1.4 system-ui, sans-serif; margin: 1.5em auto; max-width: 60em; color: #222; }
@@ -167,25 +160,13 @@ def _coverage(coverage: Mapping[str, Any]) -> list[str]:
     ]
     for case, n in total["cases"].items():
         out.append(
-            f"<tr><td>{_text(READING_NAMES.get(case, case))}"
+            f"<tr><td>{_text(CASE_NAMES.get(case, case))}"
             f'<td class="n">{n["beside_valid"]}<td class="n">{n["without_valid"]}</tr>'
         )
-    near, margin = coverage["near_threshold_m"], coverage["angle_near_pi_rad"]
-    others = [
-        (
-            f"scans whose nearest valid return lies outside the threshold band, within {near:g} m"
-            " of its edge",
-            total["near_threshold"],
-        ),
-        (
-            f"scans whose nearest valid return lies within {margin:g} rad of +pi or -pi",
-            total["angle_near_pi"],
-        ),
-        ("scans with angle_min 0", total["angle_min_zero"]),
-        ("scans with angle_min -pi", total["angle_min_minus_pi"]),
-        ("times a due warning stopped being due later in its run", total["warning_clears"]),
-    ]
-    out.extend(f'<tr><td>{_text(what)}<td class="n" colspan="2">{n}</tr>' for what, n in others)
+    out.extend(
+        f'<tr><td>{_text(what)}<td class="n" colspan="2">{n}</tr>'
+        for what, n in other_counts(total)
+    )
     out.append("</table>")
     if coverage["gaps"]:
         out.append("<p>What the suite never delivered:</p>")

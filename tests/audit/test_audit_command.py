@@ -111,4 +111,4 @@ def test_a_suite_where_no_warning_clears_lets_the_latched_warning_pass(tmp_path:
     latched = next(line for line in out.splitlines() if line.startswith("  warning_latched:"))
     assert "moves away" in latched, latched
     assert "score: the suite catches 1 of 2 mistakes" in out
-    assert "a due warning that must clear: 0" in out
+    assert "times a due warning stopped being due later in its run: 0" in out
