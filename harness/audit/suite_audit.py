@@ -1,8 +1,8 @@
-"""Audit a suite on a Dask cluster: every mutant and the correct control, one task each.
+"""Audit a suite on a Dask cluster: every mutant and the correct control, in batches.
 
-The same path as ``grade``: units go to the cluster only as workers free up
-(``harness.cluster.window``), each runs in a bounded child process, and a
-stop flag reaches every running unit on Ctrl-C.
+The same path as ``grade``: batches go to the cluster only as workers free
+up (``harness.cluster.window``), each runs in a bounded child process, and a
+stop flag reaches every running batch on Ctrl-C.
 """
 
 from __future__ import annotations
@@ -26,10 +26,9 @@ SLOW_COST = 6.0  # a mistake that waits out deadlines costs about six quick ones
 class AuditOutcome:
     """The matrix, and the correct node's coverage of the suite (its first seed's)."""
 
-    def __init__(self, matrix: KillMatrix, control: UnitResult, units: list[UnitResult]) -> None:
+    def __init__(self, matrix: KillMatrix, control: UnitResult) -> None:
         self.matrix = matrix
         self.control = control
-        self.units = units
 
     @property
     def coverage(self) -> dict[str, Any]:
@@ -65,12 +64,11 @@ def audit_suite(
     done: dict[str, UnitResult] = {}
     stop = ClusterFlag()
 
-    def submit(batch: tuple[AuditUnit, ...]) -> Any:
-        number = queued.index(batch) + 1
-        key = f"audit-batch-{number}-{uuid.uuid4().hex[:8]}"
-        return client.submit(run_batch, batch, config, number, stop, key=key, pure=False)
+    def submit(index: int) -> Any:
+        key = f"audit-batch-{index + 1}-{uuid.uuid4().hex[:8]}"
+        return client.submit(run_batch, queued[index], config, index + 1, stop, key=key, pure=False)
 
-    window = Window(client, queued, submit)
+    window = Window(client, range(len(queued)), submit)
     try:
         for index, future in window:
             for outcome in _outcomes(future, queued[index]):
@@ -87,7 +85,7 @@ def audit_suite(
     results = [done[unit.name] for unit in units]
     control, mutant_results = results[0], results[1:]
     matrix = kill_matrix(config.scenarios, mutant_results, control)
-    return AuditOutcome(matrix, control, mutant_results)
+    return AuditOutcome(matrix, control)
 
 
 def batches(units: Sequence[AuditUnit], count: int) -> list[tuple[AuditUnit, ...]]:

@@ -58,7 +58,6 @@ class UnitResult:
     name: str
     runs: list[dict[str, Any]] = field(default_factory=list)  # results.json's "runs"
     error: str | None = None  # the unit did not finish: why
-    wall_s: float = 0.0
 
     def verdicts(self, scenario: str) -> list[str]:
         """The scenario's verdict in each seed's suite, in seed order ("NOT RUN" if absent)."""
@@ -113,8 +112,12 @@ def run_batch(
         data = json.loads(results.read_text(encoding="utf-8"))
     except (OSError, ValueError):
         data = {}
-    units = data.get("units", {}) if isinstance(data, dict) else {}
-    if finished.timed_out:
+    if not isinstance(data, dict):
+        data = {}
+    units = data.get("units", {})
+    if data.get("error"):  # the worker said why it stopped (a scenario it cannot resolve)
+        why = str(data["error"])
+    elif finished.timed_out:
         why = f"stopped after {timeout:g} s"
     elif finished.cancelled:
         why = "interrupted"
@@ -123,10 +126,8 @@ def run_batch(
     outcomes = []
     for name in names:
         unit = units.get(name, {})
-        outcome = UnitResult(name, list(unit.get("runs", [])), wall_s=finished.wall_s)
-        if unit.get("error"):
-            outcome.error = str(unit["error"])
-        elif not unit.get("finished"):
+        outcome = UnitResult(name, list(unit.get("runs", [])))
+        if not unit.get("finished"):
             outcome.error = why
         outcomes.append(outcome)
     return outcomes

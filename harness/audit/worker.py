@@ -78,18 +78,20 @@ def run_job(job: dict[str, Any]) -> int:
     results_path = Path(job["results"])
     units: dict[str, dict[str, Any]] = {}
 
-    def write() -> None:
-        write_atomically(results_path, json.dumps({"units": units}, indent=2).encode())
+    def write(error: str | None = None) -> None:
+        data = {"units": units, "error": error}  # a unit not finished: `error` says why
+        write_atomically(results_path, json.dumps(data, indent=2).encode())
 
+    options = link_options_from(job["options"])
     base = run_settings_from(job["settings"])
     try:
         chosen = [resolve_scenario(ref) for ref in job["scenarios"]]
         for name, command in job["commands"].items():
-            unit: dict[str, Any] = {"runs": [], "finished": False, "error": None}
+            unit: dict[str, Any] = {"runs": [], "finished": False}
             units[name] = unit
-            options = replace(link_options_from(job["options"]), node=command)
+            node = replace(options, node=command)
             for seed in job["seeds"]:
-                results = run_suite(chosen, job["link"], options, replace(base, seed=seed))
+                results = run_suite(chosen, job["link"], node, replace(base, seed=seed))
                 run: dict[str, Any] = {"seed": seed, "results": [_entry(r) for r in results]}
                 if job.get("coverage") == name:
                     coverage = coverage_of(results)
@@ -99,14 +101,10 @@ def run_job(job: dict[str, Any]) -> int:
             unit["finished"] = True
             write()
     except ConfigError as err:
-        for unit in units.values():
-            unit["error"] = unit["error"] or (None if unit["finished"] else str(err))
-        write()
+        write(str(err))
         return 0
     except KeyboardInterrupt:  # SIGTERM from the command: links closed, nodes stopped
-        for unit in units.values():
-            unit["error"] = None if unit["finished"] else "stopped"
-        write()
+        write("stopped")
         return 1
     return 0
 
