@@ -44,15 +44,22 @@ def reference_node() -> NodeCommand:
     )
 
 
-def shell_node(command: str, *, option: str = "--node") -> NodeCommand:
-    """A user's command line, e.g. ``python3 my_node.py``, split like a shell does;
-    errors name `option`, the option that gave it."""
+def split_command(command: str, *, option: str = "--node") -> list[str]:
+    """A user's command line split like a shell does, never empty; ConfigError names
+    `option`, the option that gave it."""
     try:
         argv = shlex.split(command)
     except ValueError as err:
         raise ConfigError(f"{option} {command!r}: {err}") from None
     if not argv:
         raise ConfigError(f"{option}: the command is empty")
+    return argv
+
+
+def shell_node(command: str, *, option: str = "--node") -> NodeCommand:
+    """A user's command line, e.g. ``python3 my_node.py``, split like a shell does;
+    errors name `option`, the option that gave it."""
+    argv = split_command(command, option=option)
     program = argv[0]
     if program.endswith(".py") and Path(program).is_file():  # as grade runs a script
         argv = [sys.executable, *argv]

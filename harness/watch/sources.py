@@ -25,7 +25,6 @@ not the user's to edit: it brings nothing to watch. No rclpy here.
 from __future__ import annotations
 
 import os
-import shlex
 import xml.etree.ElementTree as ET
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
@@ -33,7 +32,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from harness.errors import ConfigError
-from harness.nodes.command import python_script_of
+from harness.nodes.command import python_script_of, split_command
 from harness.nodes.setup_problems import is_python
 
 if TYPE_CHECKING:
@@ -181,12 +180,7 @@ def _file_sources(program: Path, shown: str) -> NodeSources:
 def command_sources(command: str, *, option: str = "--node") -> NodeSources:
     """The files a node command line runs: a script and the .py files beside it, or
     its program when that is a file; ConfigError when the command names none."""
-    try:
-        argv = shlex.split(command)
-    except ValueError as err:
-        raise ConfigError(f"{option} {command!r}: {err}") from None
-    if not argv:
-        raise ConfigError(f"{option}: the command is empty")
+    argv = split_command(command, option=option)
     program = argv[0]
     script = python_script_of(argv) if is_python(program) else None
     if script is None and is_python(program):  # -m or -c: no file on the command line
