@@ -35,6 +35,7 @@ from harness.holder_lock import HolderLock
 from harness.report.folder_lock import lock_folder
 
 if TYPE_CHECKING:  # imported when grading starts (the parser is built for any command)
+    from harness.grading.grade import GradeConfig
     from harness.scenario.schema import Scenario
 
 NAME = "grade"
@@ -306,7 +307,7 @@ def run(args: argparse.Namespace, console: Console) -> int:
 
 
 def _audit(
-    console: Console, client: object, scenarios: list[Scenario], config: object, out: Path
+    console: Console, client: object, scenarios: list[Scenario], config: GradeConfig, out: Path
 ) -> str | None:
     """Which typical mistakes these scenarios let pass (harness.audit), from the cache or
     run now on the class's cluster; the warning line naming them, or None. An audit that
@@ -317,9 +318,7 @@ def _audit(
     from harness.atomic_write import write_atomically
     from harness.audit.known import known_audit, survivors_warning
     from harness.audit.task import AuditConfig
-    from harness.grading.grade import GradeConfig
 
-    assert isinstance(config, GradeConfig)
     audit = AuditConfig(
         scenarios=config.scenarios,
         scenario_refs=config.scenario_refs,

@@ -220,6 +220,14 @@ def driver_scan(nearest_m: float) -> Scan:
     return Scan(0.0, 449 * step, step, 0.1 / 450, 0.1, 0.02, 12.0, ranges)
 
 
+def back_to_back_scans() -> tuple[Scan, Scan, list]:
+    """A late revolution's driver scan and this tick's, heard 10 ns apart."""
+    from harness.ros.observer import Heard
+
+    late, own = driver_scan(0.508), driver_scan(0.486)
+    return late, own, [Heard("scan", late, 1_000, 0.0), Heard("scan", own, 1_010, 0.0)]
+
+
 def test_each_answer_is_judged_against_the_driver_scan_it_answered() -> None:
     """Two driver scans in one exchange (a late revolution): each answer on its own scan."""
     late, own = driver_scan(0.508), driver_scan(0.486)
@@ -249,10 +257,8 @@ def test_answers_are_paired_with_driver_scans_in_order() -> None:
     """Scans published back to back: the i-th status answers the i-th scan, a Bool goes
     with the status published nearest to it."""
     from harness.links.board import _pair_with_driver_scans
-    from harness.ros.observer import Heard
 
-    late, own = driver_scan(0.508), driver_scan(0.486)
-    scans = [Heard("scan", late, 1_000, 0.0), Heard("scan", own, 1_010, 0.0)]
+    late, own, scans = back_to_back_scans()
     answers = Answers(
         statuses=[
             Received("Min distance: 0.508 m", 0.01, source_ns=2_000),
@@ -273,10 +279,8 @@ def test_back_to_back_callbacks_keep_each_bool_with_its_own_status() -> None:
     comes 1 us after the first status and 40 us before its own. As many Bools as statuses:
     they pair in order, not by nearness."""
     from harness.links.board import _pair_with_driver_scans
-    from harness.ros.observer import Heard
 
-    late, own = driver_scan(0.508), driver_scan(0.486)
-    scans = [Heard("scan", late, 1_000, 0.0), Heard("scan", own, 1_010, 0.0)]
+    late, own, scans = back_to_back_scans()
     answers = Answers(
         statuses=[
             Received("Min distance: 0.508 m", 0.01, source_ns=2_000),
@@ -317,10 +321,8 @@ def test_a_bool_published_only_on_change_goes_with_the_nearest_status() -> None:
     """Two statuses, one Bool (published on change, after the second status): it is the
     second scan's answer; the first scan has none."""
     from harness.links.board import _pair_with_driver_scans
-    from harness.ros.observer import Heard
 
-    late, own = driver_scan(0.508), driver_scan(0.486)
-    scans = [Heard("scan", late, 1_000, 0.0), Heard("scan", own, 1_010, 0.0)]
+    late, own, scans = back_to_back_scans()
     answers = Answers(
         statuses=[
             Received("Min distance: 0.508 m", 0.01, source_ns=2_000),
