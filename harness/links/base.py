@@ -33,6 +33,7 @@ class LinkOptions:
     package: str | None = None
     executable: str | None = None
     workspace: str | None = None
+    launch: tuple[str, str] | None = None  # (PACKAGE, FILE): start the node by `ros2 launch`
     params: tuple[str, ...] = ()  # NAME:=VALUE items passed to the node verbatim
     threshold_param: str | None = "threshold"  # node parameter that gets the threshold
     domain_id: int | None = None  # None: reserve a free one for this run

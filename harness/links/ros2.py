@@ -33,16 +33,18 @@ import contextlib
 import time
 from collections import deque
 from collections.abc import Callable, Iterable
+from pathlib import Path
 from typing import TYPE_CHECKING
 
 from harness.errors import ConfigError, LinkError
 from harness.judge.answers import Answers, Received
+from harness.launch_files.run_check import Asked, LaunchCheck
 from harness.links.base import Link, LinkOptions, register
 from harness.nodes.command import (
     NodeCommand,
+    node_arguments,
     package_node,
     reference_node,
-    ros_arguments,
     shell_node,
 )
 from harness.nodes.process import NodeProcess, prepare_start, start_would_wait
@@ -72,6 +74,12 @@ def node_command(options: LinkOptions) -> NodeCommand:
     """The node the options name: a command, a package in a workspace, or the reference."""
     if options.node and options.package:
         raise ConfigError("give either --node or --package/--executable, not both")
+    if options.launch:
+        if options.node or options.package or options.executable:
+            raise ConfigError("--launch starts the node itself: drop --node/--package/--executable")
+        from harness.launch_files.launch_command import launch_node
+
+        return launch_node(*options.launch, options.workspace)
     if options.node:
         return shell_node(options.node)
     if options.package or options.executable:
@@ -88,6 +96,19 @@ def node_parameters(options: LinkOptions) -> tuple[str, ...]:
     if name and not any(p.split(":=", 1)[0] == name for p in params):
         params = (f"{name}:={options.threshold!r}", *params)
     return params
+
+
+def launch_check(options: LinkOptions) -> LaunchCheck | None:
+    """The run's launch files (read, not run), when a package or `--launch` names them."""
+    if options.launch:
+        package, file = options.launch
+        passed = ["use_sim_time", *(p.split(":=", 1)[0] for p in node_parameters(options))]
+        return LaunchCheck.for_run(
+            package, None, options.workspace, launched=Path(file).name, passed=passed
+        )
+    if options.package and options.executable and not options.node:
+        return LaunchCheck.for_run(options.package, options.executable, options.workspace)
+    return None
 
 
 def harness_observer(options: LinkOptions, domain_id: int, *, publish_scans: bool) -> Observer:
@@ -115,9 +136,10 @@ class Ros2Link(Link):
     sets_node_topics = True
     starts_ahead = True  # each link has its own domain, so several can be up at once
 
-    def __init__(self, options: LinkOptions) -> None:
+    def __init__(self, options: LinkOptions, session: LaunchCheck | None = None) -> None:
         super().__init__(options)
         self.command = node_command(options)  # resolve now: bad input exits 2 early
+        self.launch_check = session  # the run's launch files, checked once a run
         self.process: NodeProcess | None = None
         self.observer: Observer | None = None
         self.domain: DomainReservation | None = None
@@ -145,6 +167,13 @@ class Ros2Link(Link):
         self._start_error: Exception | None = None
 
     # -- life cycle -------------------------------------------------------
+    @classmethod
+    def run_session(
+        cls, options: LinkOptions
+    ) -> contextlib.AbstractContextManager[LaunchCheck | None]:
+        """The package's launch files, read once for the run (harness.launch_files)."""
+        return contextlib.nullcontext(launch_check(options))
+
     @classmethod
     def prepare(cls, options: LinkOptions) -> None:
         """Start the fork server of the node, if it has one (its imports take a while)."""
@@ -274,7 +303,7 @@ class Ros2Link(Link):
     # overrides; the lockstep machinery below stays the same.
     def _start_processes(self, env: dict[str, str]) -> None:
         """Start the node under test."""
-        args = ros_arguments(node_parameters(self.options))
+        args = node_arguments(self.command, node_parameters(self.options))
         self.process = NodeProcess(self.command, args, env)
         self.process.start()
         self.node_start = f"{self.command.description}, {self.process.how}"
@@ -476,6 +505,33 @@ class Ros2Link(Link):
         return notes or self.notices()
 
     def notices(self) -> list[str]:
+        """How the node is wired (`_topic_notices`), then what its launch files get
+        wrong (`_launch_notices`)."""
+        return self._topic_notices() + self._launch_notices()
+
+    def _launch_notices(self) -> list[str]:
+        """The run's launch-file notes; the first scenario whose node is up at its end
+        asks the node which parameters it declares."""
+        check = self.launch_check
+        if check is None:
+            return []
+        obs = self.observer
+        up = obs is not None and obs.usable and self._warmed_up and not self._node_exited()
+        return check.notes(self._ask_parameters if up else None)
+
+    def _ask_parameters(self) -> Asked:
+        """(the node under test's name, the parameters it declares), or why not known."""
+        from harness.ros.parameters import declared_parameters, node_on
+
+        assert self.observer is not None
+        opts = self.options
+        node = node_on(self.observer.node, [(opts.status_topic, True), (opts.scan_topic, False)])
+        if node is None:
+            return f"no node publishes {opts.status_topic} or reads {opts.scan_topic}"
+        declared = declared_parameters(self.observer.context, node)
+        return declared if isinstance(declared, str) else (node.lstrip("/"), declared)
+
+    def _topic_notices(self) -> list[str]:
         """A warning that never came on the warning topic: on which topic the node
         publishes its Bool instead, and the option that names it (else the graph).
         Taken once, before `diagnostics` stops the node; the diagnostics repeat it."""

@@ -11,6 +11,7 @@
   scripts, from ``warm_python``); ``python_script`` decides which commands
   it may serve, so a forked node is what its command would have started;
 - ``colcon_hooks``: the environment sourcing a colcon workspace would give;
+- ``package_folder``: a package's source folder in a workspace, as colcon finds it;
 - ``quick_exit``: ending a process without the interpreter's teardown.
 
 No rclpy here: a node's ROS graph is ``harness.ros``'s.

@@ -3,7 +3,8 @@
 A user's command line (split as a shell does, checked before any run), a
 colcon workspace's package/executable as ``ros2 run`` would find it, or the
 bundled reference node (``python -m``, which the fork server may start).
-``ros_arguments`` appends the parameters after ``--ros-args``.
+``ros_arguments`` appends the parameters after ``--ros-args`` (``node_arguments``:
+or as launch arguments, for ``ros2 launch``).
 """
 
 from __future__ import annotations
@@ -32,6 +33,9 @@ class NodeCommand:
     description: str = ""
     # Set when argv is ``sys.executable -m MODULE``: the fork server may start it.
     module: str | None = None
+    # Set for ``ros2 launch PACKAGE FILE``: the launch arguments the file declares, which
+    # take the node's parameters (``node_arguments``).
+    launch_arguments: frozenset[str] | None = None
 
 
 def reference_node() -> NodeCommand:
@@ -92,7 +96,7 @@ def python_script_of(argv: Sequence[str]) -> str | None:
     return None
 
 
-def _prefixes(install: Path) -> list[Path]:
+def install_prefixes(install: Path) -> list[Path]:
     """Install prefixes of a colcon install folder (isolated or merged layout)."""
     if (install / AMENT_MARKERS).is_dir():
         return [install]
@@ -134,7 +138,7 @@ def package_node(package: str, executable: str, workspace: str | None) -> NodeCo
         if not root.is_dir():
             raise ConfigError(f"--workspace {workspace}: no such folder")
         install = root / "install" if (root / "install").is_dir() else root
-        prefixes = _prefixes(install)
+        prefixes = install_prefixes(install)
         where = f"workspace {install}"
         if not prefixes:
             raise ConfigError(
@@ -181,3 +185,14 @@ def ros_arguments(params: tuple[str, ...], *, use_sim_time: bool = True) -> list
     for item in params:
         args += ["-p", item]
     return args
+
+
+def node_arguments(
+    command: NodeCommand, params: tuple[str, ...], *, use_sim_time: bool = True
+) -> list[str]:
+    """The parameters as `command` takes them: after ``--ros-args``, or for ``ros2
+    launch`` as NAME:=VALUE launch arguments, those its file declares."""
+    if command.launch_arguments is None:
+        return ros_arguments(params, use_sim_time=use_sim_time)
+    items = ("use_sim_time:=true",) * use_sim_time + params
+    return [item for item in items if item.split(":=", 1)[0] in command.launch_arguments]

@@ -73,6 +73,7 @@ def scenario_entry(result: RunResult, files: Mapping[str, str | None]) -> dict[s
         "failed_ticks": [r.tick for r in failed],
         "first_failure": result.first_failure,
         "error": result.error,
+        "notes": list(result.notes),  # how the node is wired, its launch files: the run's
         "wall_s": round(result.wall_s, 3),  # the run itself
         "startup_s": round(result.startup_s, 3),  # waiting for the node to come up
         "stop_s": round(result.stop_s, 3),  # waiting for it to stop
@@ -209,6 +210,8 @@ def run_summary(
         "passed": passed,
         "failed": len(entries) - passed,
         "wall_s": round(wall_s if wall_s is not None else sum(e["total_s"] for e in entries), 3),
+        # Each scenario's notes once (the same wiring or launch file note in every one).
+        "notes": list(dict.fromkeys(n for e in entries for n in e.get("notes", ()))),
         "alignment": alignment_entry(alignment, alignment_mode),
         "coverage": coverage,
         "scenarios": list(entries),

@@ -25,7 +25,6 @@ not the user's to edit: it brings nothing to watch. No rclpy here.
 from __future__ import annotations
 
 import os
-import xml.etree.ElementTree as ET
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -33,6 +32,7 @@ from typing import TYPE_CHECKING
 
 from harness.errors import ConfigError
 from harness.nodes.command import python_script_of, split_command
+from harness.nodes.package_folder import WORKSPACE_OUTPUTS, find_package
 from harness.nodes.setup_problems import is_python
 
 if TYPE_CHECKING:
@@ -40,7 +40,6 @@ if TYPE_CHECKING:
 
 __all__ = ["Build", "NodeSources", "Watched", "node_sources", "scenario_sources"]
 
-WORKSPACE_OUTPUTS = ("build", "install", "log")  # colcon's folders in a workspace
 BUILD_FILES = frozenset({"setup.py", "setup.cfg", "package.xml"})
 RESOURCE_FOLDER = "resource"
 SKIPPED_FOLDERS = frozenset({"__pycache__", *WORKSPACE_OUTPUTS})
@@ -202,35 +201,6 @@ def command_sources(command: str, *, option: str = "--node") -> NodeSources:
         "program, not a file of yours); give the script's path, or use "
         "--workspace/--package/--executable"
     )
-
-
-def _package_name(package_xml: Path) -> str | None:
-    try:
-        name = ET.parse(package_xml).getroot().findtext("name")
-    except (OSError, ET.ParseError):
-        return None
-    return name.strip() if name else None
-
-
-def find_package(workspace: Path, package: str) -> Path | None:
-    """The folder under `workspace` whose package.xml names `package`, as colcon finds
-    it: not in the workspace's build/, install/ or log/, nor in hidden folders or
-    folders holding a COLCON_IGNORE; symlinked folders are followed (once each)."""
-    seen: set[Path] = set()
-    for folder, subfolders, files in os.walk(workspace, followlinks=True):
-        here = Path(folder)
-        real = _real(here)
-        if real in seen or "COLCON_IGNORE" in files:
-            subfolders[:] = []
-            continue
-        seen.add(real)
-        if "package.xml" in files and _package_name(here / "package.xml") == package:
-            return here
-        skip = WORKSPACE_OUTPUTS if here == workspace else ()
-        subfolders[:] = sorted(
-            d for d in subfolders if d not in skip and not _hidden(d) and d != "__pycache__"
-        )
-    return None
 
 
 def symlink_installed(workspace: Path, package: str) -> bool:
