@@ -1,10 +1,12 @@
-"""The progress bar of many tasks: done of all, running, failed, rate and time left."""
+"""The progress bar of many tasks: done of all, running, the ones that did not pass, rate
+and time left."""
 
 from __future__ import annotations
 
 from typing import Any
 
 from rich.console import Console
+from rich.markup import escape
 from rich.progress import (
     BarColumn,
     MofNCompleteColumn,
@@ -32,13 +34,20 @@ class RateColumn(ProgressColumn):
         return Text(f"{task.completed / elapsed:.2f} {self.unit}/s")
 
 
-def task_progress(console: Console, unit: str) -> Progress:
-    """A bar whose task carries the fields `running` and `failed` (see `add_task`)."""
+def task_progress(console: Console, unit: str, *, failed: str) -> Progress:
+    """A bar whose task carries the fields `running` and `failed` (see `add_task`).
+
+    `failed` says what the `failed` count counts, in the command's words
+    ("not all passed", "did not finish"): a bare "3 failed" reads as three
+    tasks that crashed when it may be three students with a failed scenario.
+    """
     return Progress(
         TextColumn("{task.description}"),
         BarColumn(),
         MofNCompleteColumn(),
-        TextColumn("{task.fields[running]} running, {task.fields[failed]} failed"),
+        TextColumn(
+            "{task.fields[running]} running, {task.fields[failed]} " + escape(failed),
+        ),
         RateColumn(unit),
         TimeElapsedColumn(),
         TextColumn("ETA"),

@@ -37,6 +37,8 @@ DEFAULT_LINK = "ros2"
 SERIAL_LINKS = ("rplidar", "ldlidar")
 NODE_OPTIONS = ("node", "package", "executable", "workspace")
 MAX_WAIT_S = 86400.0
+#: How every command shows a --faults value: a profile name or an inline fault, comma-separated.
+FAULTS_METAVAR = "FAULT[,FAULT]"
 
 
 def positive(kind: str, maximum: float = math.inf) -> Callable[[str], float]:
@@ -155,7 +157,7 @@ def add_scenario_overrides(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--seed", type=seed, help="override the scenarios' seed")
     parser.add_argument(
         "--faults",
-        metavar="NAME[,NAME]",
+        metavar=FAULTS_METAVAR,
         help="fault profiles or inline faults such as drop(rate=0.1), replacing the "
         "scenarios' own (see docs/faults.md)",
     )
@@ -186,17 +188,23 @@ def judging_settings(args: argparse.Namespace) -> RunSettings:
 
 
 def add_judging_options(
-    parser: argparse.ArgumentParser, *, deadline: bool = True, threshold: bool = True
+    parser: argparse.ArgumentParser,
+    *,
+    deadline: bool = True,
+    threshold: bool = True,
+    threshold_default: str = "the scenario's",
+    rule_default: str = "the scenario's, optional in every shipped one",
 ) -> None:
     """How answers are judged and waited for: threshold (unless a command has its own),
     status regex, the warning rule, and (lockstep commands, `deadline`) the per-scan
-    timeout."""
+    timeout. `threshold_default` and `rule_default` say where the defaults come from
+    (a replay has no scenario)."""
     if threshold:
         parser.add_argument(
             "--threshold",
             type=positive("threshold"),
             metavar="M",
-            help="the oracle's warning threshold in metres (default: the scenario's)",
+            help=f"the oracle's warning threshold in metres (default: {threshold_default})",
         )
     parser.add_argument(
         "--status-regex",
@@ -208,7 +216,7 @@ def add_judging_options(
         choices=WARNING_RULES,
         help="must the node publish warning False when nothing is within the threshold? "
         "optional (the lab's rule: a Bool only when close passes) or required "
-        "(default: the scenario's, optional in every shipped one)",
+        f"(default: {rule_default})",
     )
     if not deadline:
         return
@@ -221,11 +229,30 @@ def add_judging_options(
     )
 
 
+#: harness.ros.domain's FIRST_ID..LAST_ID (not imported: building the parser stays light).
+DOMAIN_HELP = (
+    "ROS_DOMAIN_ID (default: a free one in 1..101, reserved for each scenario; with --port, "
+    "the board's: the shell's ROS_DOMAIN_ID, else 0); an id is refused while another "
+    "fossbot-hil run on this machine holds it"
+)
+REALTIME_HELP = (
+    "send each scan at its time, at the sensor's rate, its answers due before the next "
+    "(default: lockstep, the next scan once the node answered)"
+)
+
+
 def add_node_options(
     parser: argparse.ArgumentParser,
     title: str = "node under test (ros2 link; default: the reference node)",
+    *,
+    domain_help: str = DOMAIN_HELP,
+    realtime_help: str = REALTIME_HELP,
 ) -> None:
-    """The node under test and its ROS graph (ros2 link and virtual boards)."""
+    """The node under test and its ROS graph (ros2 link and virtual boards).
+
+    A command whose --domain-id or --realtime works otherwise says so in
+    `domain_help` or `realtime_help` (argparse.SUPPRESS: refused, so not shown).
+    """
     node = parser.add_argument_group(title)
     node.add_argument(
         "--node",
@@ -290,7 +317,7 @@ def add_node_options(
         "--domain-id",
         type=domain_id,
         metavar="N",
-        help="ROS_DOMAIN_ID (default: a free one reserved for the run)",
+        help=domain_help,
     )
     node.add_argument(
         "--ros-network",
@@ -300,12 +327,16 @@ def add_node_options(
     node.add_argument(
         "--realtime",
         action="store_true",
-        help="send scans at the sensor's rate instead of lockstep",
+        help=realtime_help,
     )
 
 
 def add_link_option(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--link", default=DEFAULT_LINK, help=f"one of {', '.join(known_links())}")
+    parser.add_argument(
+        "--link",
+        default=DEFAULT_LINK,
+        help=f"one of {', '.join(known_links())} (default {DEFAULT_LINK})",
+    )
 
 
 def add_device_options(parser: argparse.ArgumentParser) -> None:
@@ -371,6 +402,7 @@ def unchecked_link_options(args: argparse.Namespace) -> LinkOptions:
         package=args.package,
         executable=args.executable,
         workspace=args.workspace,
+        launch=tuple(args.launch) if getattr(args, "launch", None) else None,
         params=tuple(args.param),
         threshold_param=args.threshold_param or None,
         scan_topic=args.scan_topic,

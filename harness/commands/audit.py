@@ -153,7 +153,7 @@ def run(args: argparse.Namespace, console: Console) -> int:
     started = time.monotonic()
     with (
         open_client(args.scheduler, args.workers, worker_wait=args.worker_wait) as client,
-        task_progress(shown, "nodes") as progress,
+        task_progress(shown, "nodes", failed="did not finish") as progress,
     ):
         bar = add_task(progress, "nodes", len(mutants) + 1)
 

@@ -13,14 +13,14 @@ import argparse
 
 from rich.console import Console
 
-from harness.commands.arguments import check_port, fault_list, lidar_mount, seed
+from harness.commands.arguments import FAULTS_METAVAR, check_port, fault_list, lidar_mount, seed
 
 NAME = "emulate"
 HELP = "serve a scenario's scans as a LIDAR device on a serial port"
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("device", choices=["rplidar", "ldlidar"])
+    parser.add_argument("device", choices=["rplidar", "ldlidar"], help="the LIDAR to emulate")
     parser.add_argument(
         "--scenario", required=True, metavar="NAME", help="shipped scenario name or scenario file"
     )
@@ -32,7 +32,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "its DTR/RTS calls succeed and reach the emulator, the motor following DTR)",
     )
     parser.add_argument("--seed", type=seed, help="override the scenario's seed")
-    parser.add_argument("--faults", metavar="NAME[,NAME]", help="fault profiles to apply")
+    parser.add_argument(
+        "--faults",
+        metavar=FAULTS_METAVAR,
+        help="fault profiles or inline faults such as drop(rate=0.1), replacing the scenario's "
+        "own; of the link faults, only rate_drift and line faults (see docs/faults.md)",
+    )
     parser.add_argument(
         "--lidar-mount",
         type=lidar_mount,

@@ -9,6 +9,11 @@ from rich.console import Console
 
 NAME = "list"
 HELP = "list the shipped scenarios"
+DESCRIPTION = (
+    "List the scenarios shipped with fossbot-hil, one line each: its name, the LIDAR it "
+    "simulates, its fault profiles and what it does. `run`, `emulate`, `sweep`, `grade` and "
+    "`audit` take these names, or the path of a scenario file of your own (docs/scenarios.md)."
+)
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

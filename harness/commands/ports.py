@@ -9,6 +9,12 @@ from rich.console import Console
 
 NAME = "ports"
 HELP = "list serial adapters (for --port): what each likely is, and whether you may open it"
+DESCRIPTION = (
+    "List this machine's serial ports, the ones a --port (of run, replay, emulate) could "
+    "name: each port's path, its USB vendor:product id, the chip it likely is (the RPLIDAR "
+    "A1's own adapter is a CP2102), and whether you may open it, with the fix when not "
+    "(docs/hil.md)."
+)
 
 NO_USB_ID = "-"
 

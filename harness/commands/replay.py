@@ -8,6 +8,7 @@ from typing import TYPE_CHECKING
 from rich.console import Console
 
 from harness.commands.arguments import (
+    FAULTS_METAVAR,
     add_device_options,
     add_judging_options,
     add_link_option,
@@ -36,21 +37,27 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--topic",
         metavar="T",
-        help="the LaserScan topic to replay (default /scan, or the only LaserScan topic; "
+        help="the LaserScan topic to replay (default: /scan, or the only LaserScan topic; "
         "a relative name means /NAME)",
     )
     add_link_option(parser)
-    add_judging_options(parser)
+    add_judging_options(  # a replay has no scenario: the recording says what it can
+        parser,
+        threshold_default="the recording's; a robot's rosbag2 has none, so give it",
+        rule_default="optional",
+    )
     parser.add_argument(
         "--junit-xml", type=given("--junit-xml"), metavar="FILE", help="write a JUnit XML report"
     )
     parser.add_argument(
         "--faults",
-        metavar="FAULT[,FAULT]",
+        metavar=FAULTS_METAVAR,
         help="link faults on the replayed scans, e.g. lossy_link,delay(mean=0.05) "
         "(see docs/faults.md); the scans themselves are sent as recorded",
     )
-    parser.add_argument("--seed", type=seed, help="seed of the link faults (default recorded)")
+    parser.add_argument(
+        "--seed", type=seed, help="seed of the link faults (default: the recording's)"
+    )
     parser.add_argument(
         "--record",
         type=given("--record"),

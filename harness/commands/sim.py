@@ -11,6 +11,7 @@ from typing import TYPE_CHECKING, Any
 from rich.console import Console
 
 from harness.commands.arguments import (
+    FAULTS_METAVAR,
     add_judging_options,
     add_node_options,
     check_output_file,
@@ -33,6 +34,11 @@ NAME = "sim"
 HELP = "run a world live: drive the robot over /cmd_vel or the keyboard, watch it, judge a node"
 DEFAULT_WORLD = "single_wall"
 FOXGLOVE_PORT = 8765  # the Foxglove app's default
+DOMAIN_HELP = (
+    "ROS_DOMAIN_ID of the live world (default: the shell's ROS_DOMAIN_ID, else 0, so ROS "
+    "tools in another terminal see the robot; refused while another fossbot-hil run on "
+    "this machine holds it)"
+)
 
 
 def foxglove_port(text: str) -> int | None:
@@ -85,27 +91,40 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--record",
         type=given("--record"),
-        metavar="PATH",
-        help="write the judged session as an MCAP recording: PATH.mcap, or WORLD.mcap in the "
-        "folder PATH (needs a node that answers)",
+        metavar="FILE.mcap|DIR",
+        help="write the judged session as an MCAP recording: to FILE.mcap, or to WORLD.mcap "
+        "in the folder DIR (any path not ending in .mcap is a folder, made if need be; needs "
+        "a node that answers)",
     )
     parser.add_argument(
-        "--animate",
-        type=given("--animate"),
+        "--animation",
+        type=given("--animation"),
         metavar="FILE",
-        help="write the judged session as an animated top-down view (.gif) to hand in",
+        help="write the judged session as an animated top-down view to hand in: FILE.gif "
+        "(or FILE.mp4 where ffmpeg is installed; needs a node that answers)",
+    )
+    parser.add_argument(  # the old name (run's --animate is a flag); kept so scripts still work
+        "--animate", dest="animation", type=given("--animate"), help=argparse.SUPPRESS
     )
     parser.add_argument(
         "--seed", type=seed, help="seed of the LIDAR's faults (default: the world's)"
     )
     parser.add_argument(
         "--faults",
-        metavar="NAME[,NAME]",
+        metavar=FAULTS_METAVAR,
         help="sensor fault profiles or inline faults (docs/faults.md); link faults are for `run`",
     )
-    add_judging_options(parser, deadline=False)  # live, nothing waits for the node
+    add_judging_options(  # live, nothing waits for the node
+        parser,
+        deadline=False,
+        threshold_default="the world's",
+        rule_default="the world's, optional in every shipped one",
+    )
     add_node_options(
-        parser, "node under test (default: none; a node started elsewhere is judged too)"
+        parser,
+        "node under test (default: none; a node started elsewhere is judged too)",
+        domain_help=DOMAIN_HELP,
+        realtime_help=argparse.SUPPRESS,  # refused: a live world always runs in real time
     )
 
 
@@ -121,7 +140,8 @@ def run(args: argparse.Namespace, console: Console) -> int:
     scenario = resolve_world(args.world)
     args.record = _recording_path(args.record, scenario.name)
     check_output_file("--record", args.record)
-    check_output_file("--animate", args.animate)
+    check_output_file("--animation", args.animation)
+    _check_animation_suffix(args.animation)
     node = bool(args.node or args.package or args.executable)
     settings = LiveSettings(
         rate=args.rate,
@@ -223,11 +243,26 @@ def _recording_path(path: str | None, world: str) -> str | None:
     return os.path.join(path, f"{safe_stem(world)}.mcap")
 
 
+ANIMATION_SUFFIXES = (".gif", ".mp4")  # what harness.report.animation writes
+
+
+def _check_animation_suffix(path: str | None) -> None:
+    """An --animation file it cannot write is a usage error now, not after the session."""
+    if path is not None and os.path.splitext(path)[1].lower() not in ANIMATION_SUFFIXES:
+        raise ConfigError(
+            f"--animation {shown(path)}: an animation is written as .gif (or .mp4 with ffmpeg)"
+        )
+
+
+EVIDENCE = (("--record", "record"), ("--animation", "animation"))  # option, dest
+
+
 def _evidence(
     console: Console, args: argparse.Namespace, scenario: Scenario, result: RunResult | None
 ) -> None:
-    """--record and --animate: what the lab asks students to hand in, from the judged session."""
-    wanted = [option for option in ("--record", "--animate") if getattr(args, option[2:])]
+    """--record and --animation: what the lab asks students to hand in, from the judged
+    session."""
+    wanted = [option for option, dest in EVIDENCE if getattr(args, dest)]
     if not wanted:
         return
     if result is None:
@@ -238,11 +273,11 @@ def _evidence(
 
         write_recording(args.record, result)
         say(console, f"recording: {args.record}")
-    if args.animate:
+    if args.animation:
         from harness.report.animation import write_animation
 
-        write_animation(result, scenario, args.animate)
-        say(console, f"animation: {args.animate}")
+        write_animation(result, scenario, args.animation)
+        say(console, f"animation: {args.animation}")
 
 
 def _domain(given_id: int | None) -> int:

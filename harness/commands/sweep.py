@@ -11,6 +11,7 @@ from rich.console import Console
 
 from harness.atomic_write import write_atomically
 from harness.commands.arguments import (
+    FAULTS_METAVAR,
     add_judging_options,
     add_link_option,
     add_node_options,
@@ -74,20 +75,29 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--scenario",
         type=name_list,
+        action="append",
+        default=[],
         metavar="NAME[,NAME]",
-        help="scenarios (names or files; default: every shipped one)",
+        help="scenario name or file (repeatable; default: every shipped one)",
     )
     parser.add_argument(
         "--faults",
-        metavar="A,B",
-        help="fault levels, one profile or inline fault each (default: each scenario's own)",
+        metavar=FAULTS_METAVAR,
+        help="fault levels: each item one level, a profile or an inline fault (default: each "
+        "scenario's own)",
     )
+    seed_count = whole_number("seed count", 1, 10_000)
     parser.add_argument(
-        "--seeds",
-        type=whole_number("seeds", 1, 10_000),
+        "--seed-count",
+        dest="seeds",
+        type=seed_count,
         default=1,
         metavar="N",
-        help="seeds 0..N-1 (default 1)",
+        help="run every combination with seeds 0..N-1, replacing the scenarios' own seeds "
+        "(default 1: seed 0 only); not one seed, as --seed of other commands",
+    )
+    parser.add_argument(  # the old name, kept so scripts still work
+        "--seeds", dest="seeds", type=seed_count, help=argparse.SUPPRESS
     )
     parser.add_argument(
         "--thresholds",
@@ -122,7 +132,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="also write DIR/results.parquet at the end (needs fossbot-hil[parquet])",
     )
     add_cluster_options(parser)
-    add_node_options(parser)
+    add_node_options(parser, domain_help=argparse.SUPPRESS)  # refused: each run reserves one
 
 
 def run(args: argparse.Namespace, console: Console) -> int:
@@ -195,8 +205,9 @@ def _levels(
     from harness.scenario.files import resolve_scenario, shipped_scenarios
     from harness.scenario.variations import varied
 
-    if args.scenario:
-        scenarios = [resolve_scenario(name) for name in args.scenario]
+    chosen = [name for item in args.scenario for name in item]
+    if chosen:
+        scenarios = [resolve_scenario(name) for name in chosen]
     else:
         scenarios = shipped_scenarios()
     variations = variation_levels(varied_levels)
@@ -207,7 +218,7 @@ def _levels(
         items = None if level == SCENARIO_FAULTS else [level]
         for threshold in thresholds:
             check_settings(scenarios, RunSettings(threshold=threshold, faults=items))
-    names = list(args.scenario) if args.scenario else [s.name for s in shipped_scenarios()]
+    names = chosen or [s.name for s in shipped_scenarios()]
     return names, faults, list(range(args.seeds)), thresholds, variations
 
 
@@ -244,7 +255,7 @@ def _run_all(
 
         window = Window(client, todo, submit)
         failed = 0
-        with task_progress(console, "runs") as progress:
+        with task_progress(console, "runs", failed="not passed") as progress:
             bar = add_task(progress, "runs", len(todo))
             for index, future in window:
                 row = _row_of(future, todo[index])

@@ -32,7 +32,7 @@ SWEEP = [
     "approach_wall,obstacle_at_side",
     "--faults",
     "clean,noisy",
-    "--seeds",
+    "--seed-count",
     "2",
     "--timeout",
     "5",  # a generous per-scan deadline: a busy machine must not turn into a late answer
@@ -145,7 +145,7 @@ def test_a_hanging_node_costs_only_its_runs(tmp_path: Path) -> None:
     """A node that never comes up and ignores SIGTERM: each run ends at its deadline."""
     out = tmp_path / "sweep"
     done = fossbot_hil(
-        *("sweep", "--scenario", "approach_wall", "--seeds", "2", "--workers", "2"),
+        *("sweep", "--scenario", "approach_wall", "--seed-count", "2", "--workers", "2"),
         *("--node", _node(tmp_path, HANGS), "--ready-timeout", "3", "--out", str(out)),
         timeout=240,
     )
@@ -205,14 +205,14 @@ def test_a_cluster_without_workers_is_refused_in_bounded_time(tmp_path: Path) ->
 @pytest.mark.parametrize(
     "args, message",
     [
-        (["--seeds", "0"], "--seeds"),
+        (["--seed-count", "0"], "--seed-count"),
         (["--thresholds", "0.3,-1"], "threshold"),
         (["--scenario", "no_such_scenario"], "unknown scenario"),
         (["--faults", "no_such_profile"], "no_such_profile"),
         (["--domain-id", "5"], "--domain-id"),
         (["--workers", "2", "--scheduler", "tcp://127.0.0.1:1"], "--workers"),
         (["--scheduler", "notanaddress"], "--scheduler notanaddress: cannot connect"),
-        (["--seeds", "ten"], "--seeds"),
+        (["--seeds", "ten"], "--seeds"),  # the old name: still parsed, still checked
         (["--worker-wait", "0"], "--worker-wait must be a positive number"),
         (["--vary", "spd=1"], "NAME one of start_dx, start_dy"),
         (["--vary", "speed=0"], "speed: a level is a number > 0"),

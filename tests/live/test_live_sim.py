@@ -173,7 +173,7 @@ def test_cmd_vel_drives_the_robot_and_the_wall_stops_it(driver) -> None:
 def test_the_live_judge_passes_a_right_node_and_explains_a_wrong_one(
     node: str, code: int, says: str, tmp_path: Path
 ) -> None:
-    evidence = ["--record", str(tmp_path / "records"), "--animate", str(tmp_path / "s.gif")]
+    evidence = ["--record", str(tmp_path / "records"), "--animation", str(tmp_path / "s.gif")]
     with own_domain() as domain:
         done = fossbot_hil(
             "sim", "obstacle_at_side", "--duration", "2", "--foxglove-port", "off", "--node", node,
