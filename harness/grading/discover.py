@@ -4,9 +4,13 @@ The rules, also in docs/grading.md:
 
 - A folder given on the command line is **one student** when it is itself a
   colcon workspace or package, or when it has no subfolders and holds one
-  node script. Otherwise **each subfolder is a student** (hidden folders and
-  the grader's own output folder are skipped; loose files are listed as
-  skipped).
+  node script. Otherwise **each subfolder is a student**, and **each archive**
+  (.zip, .tar.gz, .tgz, .tar, ...) is a student named after the archive, to be
+  unpacked once the output folder is the grader's (harness.grading.archives).
+  Any other file is a student with the reason it is not graded. Hidden
+  entries, file managers' litter (__MACOSX, Thumbs.db) and the grader's own
+  output folder are passed over. An archive given on the command line is
+  read as the folder it unpacks to.
 - A student folder is a **package** when it has a package.xml at its top; a
   **workspace** when package.xml files sit below it (only under src/ if it
   has one; build/, install/, log/, hidden folders and folders holding a
@@ -18,14 +22,29 @@ The rules, also in docs/grading.md:
 
 from __future__ import annotations
 
+import os
 import re
+from collections import Counter
 from collections.abc import Iterable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from harness.errors import ConfigError
 
-__all__ = ["GRADES_MARKER", "Discovery", "Student", "discover", "student_in"]
+__all__ = [
+    "ARCHIVE_SUFFIXES",
+    "GRADES_MARKER",
+    "Discovery",
+    "Entry",
+    "Student",
+    "add_folder",
+    "archive_stem",
+    "discover",
+    "is_archive",
+    "named",
+    "passed_over",
+    "student_in",
+]
 
 GRADES_MARKER = ".fossbot-hil-grades"  # marks an output folder of `grade`
 MANIFEST = "package.xml"
@@ -34,6 +53,10 @@ IGNORE_MARKERS = ("COLCON_IGNORE", "AMENT_IGNORE")
 MAX_DEPTH = 4  # src/<repo>/<group>/<package>/package.xml
 NOT_A_NODE = {"setup.py", "conftest.py", "__init__.py"}
 SCRIPT_PEEK_BYTES = 1 << 20
+# What LMSs export; the longest suffix first (".tar.gz" before ".tar").
+ARCHIVE_SUFFIXES = (".tar.gz", ".tgz", ".tar.bz2", ".tbz2", ".tar.xz", ".txz", ".tar", ".zip")
+OS_LITTER = {"__MACOSX", "Thumbs.db", "desktop.ini"}  # file managers' own files, never handed in
+NOT_A_SUBMISSION = "not a submission: a file, not a folder or archive"
 
 
 @dataclass(frozen=True)
@@ -49,12 +72,61 @@ class Student:
     slug: str = ""  # a file-name-safe, unique form of `name` for the artifact folder
 
 
+@dataclass(frozen=True)
+class Entry:
+    """A hand-in found, before it is named (`named` names them all together)."""
+
+    where: str  # the DIR (or class archive) it was found in: tells two equal names apart
+    name: str  # its own name: the folder's or file's, an archive's without .zip, .tar.gz...
+    path: Path  # the folder to look at; with a `problem`, what was handed in
+    problem: str | None = None  # why there is nothing to look at (a loose file, a bad archive)
+    file: str = ""  # the archive's file name, for two hand-ins of one name in one DIR
+    note: str = ""  # added to the reason when the folder holds no node (links left out)
+
+    def student(self, name: str, slug: str) -> Student:
+        if self.problem is not None:
+            return Student(name, self.path, "none", problem=self.problem, slug=slug)
+        student = student_in(self.path, name)
+        if student.problem is not None and self.note:
+            return replace(student, problem=f"{student.problem}; {self.note}", slug=slug)
+        return replace(student, slug=slug)
+
+
 @dataclass
 class Discovery:
-    """The students found, and the entries that were passed over (with why)."""
+    """The students found, the archives still to unpack, and what was passed over (with why).
+
+    `students` are the folder (and loose file) students, named among themselves;
+    archives.unpack_submissions names them again together with the archives' students.
+    """
 
     students: list[Student] = field(default_factory=list)
     skipped: list[str] = field(default_factory=list)
+    entries: list[Entry] = field(default_factory=list)  # folders and loose files
+    archives: list[Entry] = field(default_factory=list)  # one student each, in a DIR
+    class_archives: list[Entry] = field(default_factory=list)  # given as a DIR
+
+
+def archive_suffix(name: str) -> str | None:
+    """The archive suffix `name` ends with (any case), or None."""
+    folded = name.casefold()
+    return next((s for s in ARCHIVE_SUFFIXES if folded.endswith(s) and len(name) > len(s)), None)
+
+
+def is_archive(path: Path) -> bool:
+    """An archive by its name: .zip, .tar, .tar.gz, .tgz, .tar.bz2, .tbz2, .tar.xz, .txz."""
+    return archive_suffix(path.name) is not None
+
+
+def archive_stem(name: str) -> str:
+    """`name` without its archive suffix: alex.tar.gz -> alex."""
+    suffix = archive_suffix(name)
+    return name[: len(name) - len(suffix)] if suffix else name
+
+
+def passed_over(name: str) -> bool:
+    """Hidden entries and file managers' litter: never a submission, never a row."""
+    return name.startswith(".") or name in OS_LITTER
 
 
 def _searchable(folder: Path) -> bool:
@@ -163,75 +235,119 @@ def slugify(name: str) -> str:
     return slug or "student"
 
 
-def _named(found: Iterable[tuple[Path, Path]]) -> list[Student]:
-    """Students named by folder; a name given twice (in two DIRs) gets its DIR's name."""
-    pairs = list(found)
-    counts: dict[str, int] = {}
-    for _, folder in pairs:
-        counts[folder.name] = counts.get(folder.name, 0) + 1
+def named(found: Iterable[Entry]) -> list[Student]:
+    """The students, sorted by name; a name given twice (in two DIRs) gets its DIR's name.
+
+    Two of one name in one DIR (alex/ and alex.zip) are told apart by the
+    archive's file name; names that are still equal get " (2)". Slugs are
+    unique regardless of case.
+    """
+    entries = list(found)
+    names = [e.name for e in entries]
+    for form in (lambda e: f"{e.where}/{e.name}", lambda e: f"{e.where}/{e.file or e.name}"):
+        counts = Counter(names)
+        names = [form(e) if counts[n] > 1 else n for e, n in zip(entries, names, strict=True)]
     students: list[Student] = []
+    taken: set[str] = set()
     slugs: set[str] = set()
-    for parent, folder in pairs:
-        name = folder.name if counts[folder.name] == 1 else f"{parent.name}/{folder.name}"
-        slug = base = slugify(name)
+    for entry, base in zip(entries, names, strict=True):
+        name, n = base, 2
+        while name in taken:
+            name, n = f"{base} ({n})", n + 1
+        taken.add(name)
+        slug = base_slug = slugify(name)
         n = 2
         while slug.casefold() in slugs:
-            slug, n = f"{base}-{n}", n + 1
+            slug, n = f"{base_slug}-{n}", n + 1
         slugs.add(slug.casefold())
-        student = student_in(folder, name)
-        students.append(
-            Student(
-                student.name,
-                student.folder,
-                student.kind,
-                student.base_paths,
-                student.script,
-                student.problem,
-                slug,
-            )
-        )
+        students.append(entry.student(name, slug))
     return sorted(students, key=lambda s: (s.name.casefold(), s.name))
+
+
+def add_folder(
+    result: Discovery,
+    folder: Path,
+    *,
+    name: str,
+    where: str,
+    file: str = "",
+    exclude: Path | None = None,
+) -> None:
+    """A folder given to grade (or a class archive unpacked), into `result`.
+
+    One student (`name`, found in `where`) when the folder is one hand-in;
+    otherwise each entry is: a subfolder a student, an archive a student to
+    unpack, another file a row saying why it is not graded.
+    """
+    if _is_single_student(folder):
+        result.entries.append(Entry(where, name, folder, file=file))
+        return
+    for entry in sorted(folder.iterdir(), key=lambda p: p.name):
+        if passed_over(entry.name) or (exclude is not None and _inside(entry, exclude)):
+            continue
+        if entry.is_dir():
+            if (entry / GRADES_MARKER).exists():
+                result.skipped.append(f"{entry}: an output folder of `fossbot-hil grade`")
+            else:
+                result.entries.append(Entry(name, entry.name, entry))
+        elif is_archive(entry) and entry.is_file():
+            stem = archive_stem(entry.name)
+            result.archives.append(Entry(name, stem, entry, file=entry.name))
+        else:
+            result.entries.append(Entry(name, entry.name, entry, problem=NOT_A_SUBMISSION))
+
+
+def _once(entries: list[Entry]) -> list[Entry]:
+    """The entries without a path given twice."""
+    seen: set[Path] = set()
+    unique = []
+    for entry in entries:
+        key = entry.path.resolve()
+        if key not in seen:
+            seen.add(key)
+            unique.append(entry)
+    return unique
 
 
 def discover(dirs: Sequence[str | Path], *, exclude: str | Path | None = None) -> Discovery:
     """The students in `dirs`; ConfigError (exit 2) for a missing folder or no student at all.
 
     `exclude` is the grader's output folder: never a student, even inside a DIR.
+    Archives are only noted here (`archives`, `class_archives`), not opened:
+    archives.unpack_submissions unpacks them into the output folder.
     """
     result = Discovery()
-    found: list[tuple[Path, Path]] = []
     for given in dirs:
-        folder = Path(given)
-        if not folder.exists():
-            raise ConfigError(f"{given}: no such folder")
-        if not folder.is_dir():
-            raise ConfigError(f"{given}: not a folder (give a folder of student folders)")
-        if _is_single_student(folder):
-            found.append((folder.resolve().parent, folder))
-            continue
-        for entry in sorted(folder.iterdir(), key=lambda p: p.name):
-            if entry.name.startswith("."):
-                continue
-            if exclude is not None and _inside(entry, Path(exclude)):
-                continue
-            if not entry.is_dir():
-                result.skipped.append(f"{entry}: not a folder")
-            elif (entry / GRADES_MARKER).exists():
-                result.skipped.append(f"{entry}: an output folder of `fossbot-hil grade`")
-            else:
-                found.append((folder, entry))
-    seen: set[Path] = set()
-    unique = []
-    for parent, folder in found:
-        key = folder.resolve()
-        if key not in seen:
-            seen.add(key)
-            unique.append((parent, folder))
-    result.students = _named(unique)
-    if not any(s.kind != "none" for s in result.students):
+        path = Path(given)
+        if not path.exists():
+            raise ConfigError(f"{given}: no such {'archive' if is_archive(path) else 'folder'}")
+        absolute = Path(os.path.abspath(path))  # "." named after the folder, no link followed
+        where = absolute.parent.name
+        if path.is_file() and is_archive(path):
+            stem = archive_stem(path.name)
+            result.class_archives.append(Entry(where, stem, path, file=path.name))
+        elif path.is_dir():
+            add_folder(
+                result,
+                path,
+                name=absolute.name,
+                where=where,
+                exclude=None if exclude is None else Path(exclude),
+            )
+        else:
+            raise ConfigError(
+                f"{given}: not a folder or archive (give a folder of student folders, "
+                "or an archive of them)"
+            )
+    result.entries = _once(result.entries)
+    result.archives = _once(result.archives)
+    result.class_archives = _once(result.class_archives)
+    result.students = named(result.entries)
+    some_archive = result.archives or result.class_archives
+    if not some_archive and not any(s.kind != "none" for s in result.students):
         listed = ", ".join(str(d) for d in dirs)
         raise ConfigError(
-            f"no students found in {listed}: expected one folder per student holding a "
-            "colcon workspace (src/), a package (package.xml) or a node script (.py)"
+            f"no students found in {listed}: expected one folder (or archive) per student "
+            "holding a colcon workspace (src/), a package (package.xml) or a node script (.py)"
         )
     return result

@@ -83,16 +83,23 @@ def test_same_name_in_two_folders_is_told_apart(tmp_path: Path) -> None:
 
 
 def test_output_folder_hidden_folders_and_files_are_skipped(tmp_path: Path) -> None:
-    """--out inside the class folder, a .git folder and a zip are never students."""
+    """--out inside the class folder, a .git folder and OS litter are never students; a
+    zip is noted to unpack, a loose file is a row saying why it is not graded."""
     touch(tmp_path / "ana" / "package.xml")
     touch(tmp_path / "grades" / GRADES_MARKER)
     touch(tmp_path / "old_grades" / GRADES_MARKER)
     touch(tmp_path / ".git" / "config")
+    touch(tmp_path / ".DS_Store")
+    touch(tmp_path / "Thumbs.db")
     touch(tmp_path / "ben.zip")
+    touch(tmp_path / "cleo.pdf")
     found = discover([tmp_path], exclude=tmp_path / "grades")
-    assert [s.name for s in found.students] == ["ana"]
+    assert [(s.name, s.kind, s.problem) for s in found.students] == [
+        ("ana", "package", None),
+        ("cleo.pdf", "none", "not a submission: a file, not a folder or archive"),
+    ]
+    assert [(a.name, a.path) for a in found.archives] == [("ben", tmp_path / "ben.zip")]
     assert [note.split(":")[1] for note in found.skipped] == [
-        " not a folder",
         " an output folder of `fossbot-hil grade`",
     ]
 
