@@ -33,8 +33,29 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
     commands = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     for module in command_modules():
-        module.add_arguments(commands.add_parser(module.NAME, help=module.HELP))
+        description = getattr(module, "DESCRIPTION", module.HELP)  # `X --help`'s first line
+        module.add_arguments(
+            commands.add_parser(module.NAME, help=module.HELP, description=description)
+        )
     return parser
+
+
+def _without_defaults(parser: argparse.ArgumentParser) -> None:
+    """Every option of `parser` and its commands defaults to absent."""
+    parser._defaults.clear()  # argparse has no public way to read back what was typed
+    for action in parser._actions:
+        action.default = argparse.SUPPRESS
+        if isinstance(action, argparse._SubParsersAction):
+            for sub in action.choices.values():
+                _without_defaults(sub)
+
+
+def given_options(argv: Sequence[str] | None) -> frozenset[str]:
+    """The option names (argparse dests) given on the command line, whatever their value:
+    a file's setting yields to the command line only where the user typed one."""
+    parser = build_parser()
+    _without_defaults(parser)
+    return frozenset(vars(parser.parse_args(argv)))
 
 
 def _print_error(message: str) -> None:
@@ -60,6 +81,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         console = Console(highlight=False, width=200)  # files and pipes: no wrapping
     try:
         args = build_parser().parse_args(argv)
+        args.given = given_options(argv)  # what the user typed, apart from the defaults
         if args.command is None:
             build_parser().print_help()
             return EXIT_USAGE

@@ -26,7 +26,7 @@ GROUND = {"__init__", "errors", "safe_text", "holder_lock", "atomic_write", "use
 # Bottom to top; a package imports only from layers below its own.
 LAYERS: list[set[str]] = [
     {"lidar", "nodes", "serial_line", "cluster"},
-    {"faults", "devices", "ros"},
+    {"faults", "devices", "ros", "launch_files"},
     {"scenario", "judge"},
     {"sim", "record"},
     {"links", "report"},
@@ -47,6 +47,8 @@ PURE = [
     "harness.devices",
     "harness.ros.domain",
     "harness.ros.names",
+    "harness.launch_files",
+    "harness.nodes.package_folder",
     "harness.sim.motion",
     "harness.watch.sources",
     "harness.nodes.python_script",
@@ -56,6 +58,16 @@ PURE = [
     "harness.audit.mutants",
     "harness.audit.matrix",
     "harness.user_cache",
+    "harness.grading.discover",
+    "harness.grading.archives",
+    "harness.grading.class_table",
+    "harness.grading.scoring",
+    "harness.grading.grading_file",
+    "harness.grading.roster",
+    "harness.grading.hidden",
+    "harness.grading.gradescope",
+    "harness.grading.gradebook",
+    "harness.grading.student_text",
 ]
 
 

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import argparse
 import importlib.util
+import json
 import shutil
 import time
 from pathlib import Path
@@ -35,7 +36,11 @@ from harness.holder_lock import HolderLock
 from harness.report.folder_lock import lock_folder
 
 if TYPE_CHECKING:  # imported when grading starts (the parser is built for any command)
+    from harness.grading.class_table import StudentGrade
     from harness.grading.grade import GradeConfig
+    from harness.grading.grading_file import GradingFile
+    from harness.grading.roster import Roster
+    from harness.grading.scoring import ScorePlan
     from harness.scenario.schema import Scenario
 
 NAME = "grade"
@@ -72,7 +77,27 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         action="append",
         default=[],
         metavar="NAME[,NAME]",
-        help="scenario name or file (repeatable; default: all shipped)",
+        help="scenario name or file (repeatable; default: all shipped, or the grading file's)",
+    )
+    parser.add_argument(
+        "--grading",
+        type=given("--grading"),
+        metavar="FILE",
+        help="grading file (YAML): scenarios, weights, hidden scenarios, points and judging "
+        "options; options typed on the command line win (see docs/grading.md)",
+    )
+    parser.add_argument(
+        "--roster",
+        type=given("--roster"),
+        metavar="CSV",
+        help="class roster with columns folder,id[,name]: ids in the tables and the "
+        "gradebook, a row for every student on it",
+    )
+    parser.add_argument(
+        "--gradescope",
+        action="store_true",
+        help="also write each student's Gradescope results.json "
+        "(students/<name>/gradescope/results.json)",
     )
     add_link_option(parser)
     add_scenario_overrides(parser)
@@ -131,17 +156,59 @@ def check_grading_options(args: argparse.Namespace) -> None:
 
 
 def selected_scenarios(items: list[str]) -> list[Scenario]:
-    """`--scenario` items (comma lists allowed), all resolved now; default every shipped one."""
+    """`--scenario` items (comma lists allowed), all resolved now, relative to where the
+    command was given; default every shipped one."""
     from harness.scenario.files import resolve_scenario, shipped_scenarios
 
     names = [n.strip() for item in items for n in item.split(",") if n.strip()]
     scenarios = [resolve_scenario(n) for n in names] if names else shipped_scenarios()
+    return _distinct(scenarios)
+
+
+def _distinct(scenarios: list[Scenario]) -> list[Scenario]:
+    """The scenarios, each file made absolute (workers run in each student's folder); a name
+    given twice is a mistake."""
     seen: set[str] = set()
     for s in scenarios:
         if s.name in seen:
             raise ConfigError(f"--scenario {s.name}: given twice")
         seen.add(s.name)
-    return scenarios
+    return [
+        s.model_copy(update={"source": str(Path(s.source).resolve())}) if s.source else s
+        for s in scenarios
+    ]
+
+
+def apply_grading_file(args: argparse.Namespace) -> GradingFile | None:
+    """The grading file of --grading, its options set on `args` where the user typed none;
+    None without one. Its scenarios replace --scenario (both given: a usage error)."""
+    from harness.grading.grading_file import load_grading_file
+
+    if not args.grading:
+        return None
+    grading = load_grading_file(args.grading)
+    if args.scenario:
+        raise ConfigError(
+            f"--scenario and --grading {args.grading}: the grading file lists the scenarios "
+            "(give one of them)"
+        )
+    grading.apply_to(args, typed=getattr(args, "given", frozenset()))
+    return grading
+
+
+def graded_scenarios(
+    args: argparse.Namespace, grading: GradingFile | None
+) -> tuple[list[Scenario], ScorePlan]:
+    """The scenarios, resolved now, and how they are scored and shown."""
+    from harness.grading.scoring import ScorePlan
+    from harness.scenario.files import resolve_scenario
+
+    if grading is None:
+        scenarios = selected_scenarios(args.scenario)
+        return scenarios, ScorePlan.equal([s.name for s in scenarios])
+    scenarios = _distinct([resolve_scenario(p.scenario) for p in grading.planned])
+    plan = grading.score_plan([s.name for s in scenarios])
+    return scenarios, plan
 
 
 def check_out(out: Path) -> None:
@@ -173,7 +240,9 @@ def prepare_out(out: Path) -> HolderLock:
     except OSError as err:
         lock.release()
         raise ConfigError(f"--out {out}: {err.strerror or err}") from None
-    shutil.rmtree(out / "students", ignore_errors=True)  # last time's students
+    for earlier in ("students", "grader"):  # last time's students
+        shutil.rmtree(out / earlier, ignore_errors=True)
+    shutil.rmtree(out / "unpacked", ignore_errors=True)  # and their archives' contents
     return lock
 
 
@@ -221,15 +290,20 @@ def run(args: argparse.Namespace, console: Console) -> int:
     )
     from harness.grading.discover import discover
     from harness.grading.grade import WORKER_RETRIES, GradeConfig, grade_class
+    from harness.grading.hidden import HiddenScenario
+    from harness.grading.roster import load_roster
+    from harness.runner.planned_ticks import planned_ticks
     from harness.runner.settings import check_settings
 
+    grading = apply_grading_file(args)  # its options count as typed where none was
     check_grading_options(args)
     check_cluster_options(args.scheduler, args.workers)
     options = link_options(args)  # topics and parameters: refused now, before any folder
-    scenarios = selected_scenarios(args.scenario)
+    scenarios, plan = graded_scenarios(args, grading)
     settings = judging_settings(args)
     check_settings(scenarios, settings)  # a bad --faults or --threshold: a usage error now
     check_status_regex(args)
+    roster = load_roster(args.roster) if args.roster else None
     out = Path(args.out)
     found = discover(args.dirs, exclude=out)  # before prepare_out: no folder for a typo
     check_out(out)
@@ -239,12 +313,19 @@ def run(args: argparse.Namespace, console: Console) -> int:
         raise ConfigError(
             "grading needs rclpy: pip install 'fossbot-hil[ros]' (or source ROS 2 Jazzy)"
         )
+    planned = planned_ticks(scenarios, settings)  # what a partial score counts against
+    replaced = previous_grading(out)
     with (
         open_client(
             args.scheduler, args.workers, retries=WORKER_RETRIES, worker_wait=args.worker_wait
         ) as client,
         prepare_out(out),  # the folder is this grade's until it is done
     ):
+        from harness.grading.archives import UNPACKED, unpack_submissions
+
+        found.students = unpack_submissions(found, out / UNPACKED)  # now that --out is ours
+        if any(s.kind in ("package", "workspace") for s in found.students):
+            colcon_executable()  # an archive may hold the class's first package
         names = tuple(s.name for s in scenarios)
         config = GradeConfig(
             scenarios=names,
@@ -255,7 +336,13 @@ def run(args: argparse.Namespace, console: Console) -> int:
             students_dir=out.resolve() / "students",  # workers run in their student's folder
             build_timeout=args.build_timeout,
             student_timeout=args.student_timeout,
+            planned=planned,
+            hidden={
+                s.name: HiddenScenario(s.label, s.show_failure) for s in plan.scenarios if s.hidden
+            },
         )
+        if replaced:
+            console.print(replaced, markup=False, highlight=False)
         for note in found.skipped:
             console.print(f"skipped {note}", markup=False, highlight=False)
         count = len(found.students)
@@ -268,7 +355,7 @@ def run(args: argparse.Namespace, console: Console) -> int:
         )
         _show_dashboard(console, dashboard(client))
         started = time.monotonic()
-        with task_progress(console, "students") as progress:
+        with task_progress(console, "students", failed="not all passed") as progress:
             bar = add_task(progress, "students", count)
             failed = 0
 
@@ -280,9 +367,12 @@ def run(args: argparse.Namespace, console: Console) -> int:
 
             grades = grade_class(found.students, config, client, on_graded=graded)
         wall_s = time.monotonic() - started
+        _write_gradescope(found.students, grades, plan, out, enabled=args.gradescope)
+        grades = scored_rows(grades, plan, roster, config, console)
         audit_line = None if args.no_audit else _audit(console, client, scenarios, config, out)
         meta = [
             ("scenarios", ", ".join(names)),
+            ("score", _score_words(plan)),
             ("link", args.link),
             ("package students", f"{args.package}/{args.executable}"),
             ("seed", "per scenario" if args.seed is None else str(args.seed)),
@@ -290,20 +380,145 @@ def run(args: argparse.Namespace, console: Console) -> int:
             ("warning when clear", args.warning_when_clear or "per scenario (optional)"),
             ("graded", time.strftime("%Y-%m-%d %H:%M")),
         ]
-        csv_path = write_atomically(out / "grades.csv", class_csv(grades, names))
-        html_path = write_atomically(out / "grades.html", class_html(grades, names, meta=meta))
+        csv_path = write_atomically(
+            out / "grades.csv", class_csv(grades, names, roster=roster is not None)
+        )
+        html_path = write_atomically(
+            out / "grades.html", class_html(grades, names, meta=meta, max_score=plan.max_score)
+        )
+        book_path = write_atomically(out / GRADEBOOK, _gradebook(grades, plan))
         console.print()
         console.print(class_rich_table(grades, names, width=console.width))
         console.print(scenario_legend(names), markup=False, highlight=False)
         console.print()
         console.print(
-            f"graded {count} in {wall_s:.1f} s; wrote {csv_path} and {html_path}",
+            f"graded {count} in {wall_s:.1f} s; wrote {csv_path}, {html_path} and {book_path}",
             markup=False,
             highlight=False,
         )
         if audit_line:  # one line, however long: scripts look for it
             console.print(audit_line, markup=False, highlight=False, soft_wrap=True)
         return 0
+
+
+GRADEBOOK = "gradebook.csv"
+
+
+def previous_grading(out: Path) -> str | None:
+    """What grading into `out` replaces, in words (None: nothing of ours is there)."""
+    table = out / "grades.csv"
+    if not (out / GRADES_MARKER).exists() or not table.is_file():
+        return None
+    try:
+        rows = max(0, table.read_text(encoding="utf-8").count("\r\n") - 1)
+        when = time.strftime("%Y-%m-%d %H:%M", time.localtime(table.stat().st_mtime))
+    except (OSError, UnicodeDecodeError):
+        return f"replacing the earlier grading in {out}"
+    return f"replacing the grading of {rows} student{'s' if rows != 1 else ''} from {when} in {out}"
+
+
+def _score_words(plan: ScorePlan) -> str:
+    from harness.grading.scoring import points_text
+
+    weights = ", ".join(
+        f"{s.shown_name if s.hidden else s.name} {points_text(plan.max_points(s.name))}"
+        for s in plan.scenarios
+    )
+    partial = "; partial credit by ticks held" if plan.partial_credit else ""
+    return f"of {points_text(plan.max_score)} ({weights}){partial}"
+
+
+def scored_rows(
+    grades: list[StudentGrade],
+    plan: ScorePlan,
+    roster: Roster | None,
+    config: GradeConfig,
+    console: Console,
+) -> list[StudentGrade]:
+    """Every row with its score; with a roster, its id and name, and a row for each
+    student on the roster who handed nothing in."""
+    from dataclasses import replace
+
+    from harness.grading.class_table import NOT_RUN, StudentGrade
+    from harness.safe_text import for_terminal
+
+    rows = [replace(g, points=plan.score(g.verdicts, g.ticks)) for g in grades]
+    if roster is None:
+        return rows
+    matched: set[str] = set()
+    named, unknown = [], []
+    for g in rows:
+        entry = roster.entry_for(g.name)
+        if entry is None:
+            unknown.append(g.name)
+            named.append(g)
+            continue
+        matched.add(entry.folder.casefold())
+        named.append(replace(g, student_id=entry.id, full_name=entry.name))
+    unheld = {n: (0, c) for n, c in config.planned.items() if c > 0}
+    for entry in roster.entries:
+        if entry.folder.casefold() not in matched:
+            named.append(
+                StudentGrade(
+                    entry.folder,
+                    "none",
+                    dict.fromkeys(config.scenarios, NOT_RUN),
+                    "no submission",
+                    ticks=unheld,
+                    points=0.0,
+                    student_id=entry.id,
+                    full_name=entry.name,
+                )
+            )
+    missing = len(named) - len(rows)
+    if missing:
+        console.print(
+            f"{missing} student{'s' if missing != 1 else ''} on the roster handed nothing in",
+            markup=False,
+            highlight=False,
+        )
+    if unknown:
+        listed = ", ".join(for_terminal(n) for n in unknown)
+        console.print(f"not on the roster (no id): {listed}", markup=False, highlight=False)
+    return sorted(named, key=lambda g: (g.name.casefold(), g.name))
+
+
+def _gradebook(grades: list[StudentGrade], plan: ScorePlan) -> bytes:
+    from harness.grading.gradebook import gradebook_csv
+
+    return gradebook_csv(
+        [(g.student_id or g.name, g.full_name or g.name, g.points) for g in grades],
+        column="Lab 07",
+        max_score=plan.max_score,
+    )
+
+
+def _write_gradescope(
+    students: list[Student],
+    grades: list[StudentGrade],
+    plan: ScorePlan,
+    out: Path,
+    *,
+    enabled: bool,
+) -> None:
+    """One Gradescope results.json per graded student, in their own folder."""
+    if not enabled:
+        return
+    from harness.atomic_write import write_atomically
+    from harness.grading.gradescope import gradescope_results
+
+    for student, grade in zip(students, grades, strict=True):
+        data = gradescope_results(
+            plan,
+            grade.verdicts,
+            grade.ticks,
+            grade.failures,
+            notes=grade.notes,
+            execution_time=grade.run_s,
+        )
+        path = out / "students" / student.slug / "gradescope" / "results.json"
+        path.parent.mkdir(parents=True, exist_ok=True)
+        write_atomically(path, json.dumps(data, indent=2).encode())
 
 
 def _audit(

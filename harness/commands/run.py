@@ -16,6 +16,8 @@ from harness.commands.arguments import (
     add_scenario_overrides,
     given,
 )
+from harness.commands.launch_option import add_launch_option, check_launch
+from harness.commands.run_grading import RunGrading, add_grading_options, apply_grading
 from harness.commands.run_steps import (
     open_report,
     prepared,
@@ -103,7 +105,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "inprocess), which report nothing",
     )
     add_node_options(parser)
+    add_launch_option(parser)
     add_device_options(parser)
+    add_grading_options(parser)
 
 
 def check_baseline(args: argparse.Namespace) -> Baseline | None:
@@ -154,8 +158,10 @@ def check_watch(args: argparse.Namespace) -> None:
 def run(args: argparse.Namespace, console: Console) -> int:
     from harness.nodes.forkserver import scope
 
+    grading = apply_grading(args)  # --grading's scenarios and options, before any check
     check_animate(args)  # before a node or a fork server starts
     check_watch(args)
+    check_launch(args, console)  # --launch: its file read now; exit 2 without `ros2 launch`
     baseline = check_baseline(args)
 
     with scope():  # whatever prepare() starts stops with the command (servers live across runs)
@@ -163,11 +169,14 @@ def run(args: argparse.Namespace, console: Console) -> int:
             from harness.commands.run_watch import watch
 
             return watch(args, console)
-        return _run(args, console, baseline)
+        return _run(args, console, baseline, grading)
 
 
-def _run(args: argparse.Namespace, console: Console, baseline: Baseline | None) -> int:
+def _run(
+    args: argparse.Namespace, console: Console, baseline: Baseline | None, grading: RunGrading
+) -> int:
     options, scenarios = prepared(args)
+    grading.bind(scenarios)
     from harness.judge.alignment import run_alignment
     from harness.report.progress import RunProgress
     from harness.report.summary import alignment_fails
@@ -189,7 +198,7 @@ def _run(args: argparse.Namespace, console: Console, baseline: Baseline | None) 
         )
     ran = scenario_of(scenarios)
 
-    with RunProgress(console, [s.name for s in scenarios]) as progress:
+    with RunProgress(console, grading.shown_names(scenarios)) as progress:
 
         def finished(result: RunResult) -> None:
             progress.on_result(result)
@@ -213,7 +222,8 @@ def _run(args: argparse.Namespace, console: Console, baseline: Baseline | None) 
     cache.remember(results, interrupted=interrupted is not None)
     alignment = run_alignment(results)
     mode = args.alignment
-    print_results(console, results, wall_s=wall_s, alignment=alignment, alignment_mode=mode)
+    shown = grading.shown(results)  # a hidden scenario: its label, and whether it passed
+    print_results(console, shown, wall_s=wall_s, alignment=alignment, alignment_mode=mode)
     comparison = compared(results, baseline) if baseline is not None else None
     if comparison is not None:
         from harness.report.terminal import print_comparison
@@ -230,7 +240,8 @@ def _run(args: argparse.Namespace, console: Console, baseline: Baseline | None) 
         )
         console.print(f"report: {index}", highlight=False, markup=False, soft_wrap=True)
     if args.junit_xml:
-        write_junit_file(args.junit_xml, results, report)
+        write_junit_file(args.junit_xml, shown, report)
+    grading.finish(console, results, args, wall_s)  # the score; --gradescope's results.json
     if interrupted is not None:
         judged = sum(1 for r in results if not r.not_run)
         summary = f"{judged} of {len(scenarios)} scenarios judged, the last one in part"

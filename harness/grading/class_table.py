@@ -39,6 +39,11 @@ class StudentGrade:
     run_s: float | None = None
     ticks: dict[str, tuple[int, int]] = field(default_factory=dict)  # (held, judged)
     node: str = ""  # the node the suite ran, e.g. "lidar_node.py (script)"
+    failures: dict[str, str] = field(default_factory=dict)  # scenario -> its first failure
+    notes: tuple[str, ...] = ()  # said once about the whole run, e.g. a launch file's problem
+    points: float | None = None  # the score (harness.grading.scoring); None: not scored
+    student_id: str = ""  # from the roster
+    full_name: str = ""  # from the roster
 
     @property
     def passed(self) -> int:
@@ -49,7 +54,8 @@ class StudentGrade:
         return f"{self.passed}/{len(self.verdicts)}"
 
     def scenario_ticks(self, scenario: str) -> str:
-        """'88/95': the ticks of `scenario` whose expectations held, of those judged."""
+        """'88/95': the ticks of `scenario` whose expectations held, of those it should have
+        run (a scenario that broke early counts its missing ticks as not held)."""
         if scenario not in self.ticks:
             return ""
         held, judged = self.ticks[scenario]
@@ -57,7 +63,7 @@ class StudentGrade:
 
     @property
     def ticks_held(self) -> str:
-        """The partial score over every scenario judged: '480/544 (88%)'."""
+        """The partial score over the suite: '480/544 (88%)'."""
         held = sum(h for h, _ in self.ticks.values())
         judged = sum(j for _, j in self.ticks.values())
         return f"{held}/{judged} ({100 * held // judged}%)" if judged else ""
@@ -68,16 +74,28 @@ def _cell(text: str) -> str:
     return for_csv(clip(text, TEXT_LIMIT))
 
 
-def class_csv(grades: Sequence[StudentGrade], scenarios: Sequence[str]) -> bytes:
-    """student, node, per scenario its verdict and ticks held, passed, ticks_held,
-    first_failure (UTF-8, RFC 4180 quoting)."""
+def points_cell(grade: StudentGrade) -> str:
+    """The score as a table shows it: '7.5', or '' when not scored."""
+    return "" if grade.points is None else f"{round(grade.points, 2):g}"
+
+
+def class_csv(
+    grades: Sequence[StudentGrade], scenarios: Sequence[str], *, roster: bool = False
+) -> bytes:
+    """student, (id, name with a roster,) node, per scenario its verdict and ticks held,
+    passed, ticks_held, score, first_failure, notes (UTF-8, RFC 4180 quoting)."""
     buffer = io.StringIO()
     writer = csv.writer(buffer, lineterminator="\r\n")
     per_scenario = [c for s in scenarios for c in (s, f"{s} ticks")]
-    writer.writerow(["student", "node", *per_scenario, "passed", "ticks_held", "first_failure"])
+    who = ["student", "id", "name"] if roster else ["student"]
+    writer.writerow(
+        [*who, "node", *per_scenario, "passed", "ticks_held", "score", "first_failure", "notes"]
+    )
     for g in grades:
         cells = [c for s in scenarios for c in (g.verdicts.get(s, NOT_RUN), g.scenario_ticks(s))]
-        row = [g.name, g.node, *cells, g.score, g.ticks_held, g.first_failure]
+        names = [g.name, g.student_id, g.full_name] if roster else [g.name]
+        row = [*names, g.node, *cells, g.score, g.ticks_held, points_cell(g), g.first_failure]
+        row.append(" | ".join(g.notes))
         writer.writerow([_cell(c) for c in row])
     return buffer.getvalue().encode("utf-8")
 
@@ -94,6 +112,9 @@ td.PASS { background: #e3f5e1; color: #17621a; }
 td.FAIL, td.ERROR { background: #fbe3e1; color: #9b1c12; }
 td.NOT-RUN { background: #fdf5d8; color: #7a5c00; }
 td.why { font-size: .92em; word-break: break-word; }
+th.scenario, td.student { overflow-wrap: anywhere; }
+td.student { min-width: 9em; }
+td.why { min-width: 12em; }
 td.student small { color: #555; }
 td.student a { color: #555; }
 td.v small { font-weight: normal; color: #555; }
@@ -116,17 +137,24 @@ def _verdict_cell(grade: StudentGrade, scenario: str) -> str:
     return f'<td class="v {_h(verdict.replace(" ", "-"))}">{_h(verdict)}{held}</td>'
 
 
+def _notes_html(grade: StudentGrade) -> str:
+    """What the run said about how the node is wired (e.g. its launch file), under the
+    first failure."""
+    return "".join(f"<br><small>note: {_h(n)}</small>" for n in grade.notes)
+
+
 def class_html(
     grades: Sequence[StudentGrade],
     scenarios: Sequence[str],
     *,
     title: str = "FOSSBot LIDAR lab: class results",
     meta: Sequence[tuple[str, str]] = (),
+    max_score: float | None = None,
 ) -> bytes:
     """One self-contained page (inline CSS, no script); every text escaped."""
     passed_all = sum(1 for g in grades if g.passed == len(scenarios) and scenarios)
     about = [f"{len(grades)} students, {passed_all} passed every scenario", *map(": ".join, meta)]
-    head = "".join(f"<th>{_h(s)}</th>" for s in scenarios)
+    head = "".join(f'<th class="scenario">{_h(s)}</th>' for s in scenarios)
     rows = []
     for g in grades:
         links = " · ".join(
@@ -134,11 +162,14 @@ def class_html(
         )
         cells = "".join(_verdict_cell(g, s) for s in scenarios)
         node = g.node or g.kind
+        who = " · ".join(_h(x) for x in (g.student_id, g.full_name) if x)
+        who = f"<br><small>{who}</small>" if who else ""
         rows.append(
-            f'<tr><td class="student">{_h(g.name)}<br><small>{_h(node)}'
+            f'<tr><td class="student">{_h(g.name)}{who}<br><small>{_h(node)}'
             f"{' · ' + links if links else ''}</small></td>{cells}"
             f'<td class="v">{_h(g.score)}<br><small>{_h(g.ticks_held)}</small></td>'
-            f'<td class="why">{_h(g.first_failure)}</td></tr>'
+            f'<td class="v">{_h(points_cell(g))}</td>'
+            f'<td class="why">{_h(g.first_failure)}{_notes_html(g)}</td></tr>'
         )
     page = (
         "<!DOCTYPE html>\n"
@@ -146,7 +177,8 @@ def class_html(
         f"<style>{_CSS}</style>\n</head>\n<body>\n<h1>{_h(title)}</h1>\n"
         f'<p class="meta">{" · ".join(_h(a) for a in about)}</p>\n'
         f"<table>\n<thead><tr><th>student</th>{head}<th>passed<br><small>ticks held</small></th>"
-        "<th>first failure</th></tr>"
+        f"<th>score{'<br><small>of ' + _h(f'{max_score:g}') + '</small>' if max_score else ''}"
+        "</th><th>first failure</th></tr>"
         "</thead>\n<tbody>\n" + "\n".join(rows) + "\n</tbody>\n</table>\n</body>\n</html>\n"
     )
     return page.encode("utf-8")
@@ -166,20 +198,24 @@ def class_rich_table(
     names = min(MAX_NAME, max([len("student"), *(len(g.name) for g in grades)]))
     passed = max([len("passed"), *(len(g.score) for g in grades)])
     held = max([len("ticks held"), *(len(g.ticks_held) for g in grades)])
+    scored = max([len("score"), *(len(points_cell(g)) for g in grades)])
     numbers = sum(len(str(i)) for i in range(1, len(scenarios) + 1))
-    gaps = 2 * (len(scenarios) + 3)  # two spaces between columns
-    room = max(MIN_FAILURE, width - names - numbers - passed - held - gaps)
+    gaps = 2 * (len(scenarios) + 4)  # two spaces between columns
+    room = max(MIN_FAILURE, width - names - numbers - passed - held - scored - gaps)
     table = Table(box=None, pad_edge=False)
     table.add_column("student", no_wrap=True, overflow="ellipsis", max_width=MAX_NAME)
     for number in range(1, len(scenarios) + 1):
         table.add_column(str(number), justify="center", no_wrap=True)
     table.add_column("passed", justify="right", no_wrap=True)
     table.add_column("ticks held", justify="right", no_wrap=True)
+    table.add_column("score", justify="right", no_wrap=True)
     table.add_column("first failure", no_wrap=True, overflow="ellipsis", max_width=room)
     for g in grades:
         verdicts = [g.verdicts.get(s, NOT_RUN) for s in scenarios]
         cells = [_t(LETTERS.get(v, "?"), VERDICT_STYLE.get(v, "")) for v in verdicts]
-        table.add_row(_t(g.name), *cells, g.score, g.ticks_held, _t(g.first_failure))
+        table.add_row(
+            _t(g.name), *cells, g.score, g.ticks_held, points_cell(g), _t(g.first_failure)
+        )
     return table
 
 

@@ -20,7 +20,7 @@ import threading
 import traceback
 import uuid
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -28,6 +28,7 @@ from harness.atomic_write import write_atomically
 from harness.grading.build import build_student
 from harness.grading.class_table import ERROR, NOT_RUN, PASS, StudentGrade
 from harness.grading.discover import Student
+from harness.grading.hidden import HiddenScenario, scrub_folder
 from harness.grading.process import TERM_GRACE_S, Finished, StopFlag, run_bounded
 from harness.grading.worker import write_job
 from harness.judge.records import RunResult
@@ -59,6 +60,14 @@ class GradeConfig:
     students_dir: Path  # <out>/students: one artifact folder per student
     build_timeout: float
     student_timeout: float
+    planned: dict[str, int] = field(default_factory=dict)  # scenario -> ticks when unbroken
+    hidden: dict[str, HiddenScenario] = field(default_factory=dict)  # scenario -> how shown
+
+    @property
+    def grader_dir(self) -> Path:
+        """<out>/grader: what the grader keeps of each student for itself (job, raw results),
+        apart from the folder a student may be handed."""
+        return self.students_dir.parent / "grader"
 
 
 def _shorten(text: str, folder: Path, command: str | None = None) -> str:
@@ -73,12 +82,47 @@ def _placeholder_junit(config: GradeConfig, folder: Path, reason: str) -> None:
     from harness.report.junit import write_junit
 
     results = [
-        RunResult(name, config.link, 0, 0.0, "", error=reason if i == 0 else f"not run: {reason}")
+        RunResult(
+            _shown_name(name, config),
+            config.link,
+            0,
+            0.0,
+            "",
+            error=reason if i == 0 else f"not run: {reason}",
+        )
         for i, name in enumerate(config.scenarios)
     ]
     for result in results[1:]:
         result.not_run = True
     write_junit(folder / "junit.xml", results)
+
+
+def _shown_name(name: str, config: GradeConfig) -> str:
+    """A scenario's name as the student's own files give it (a hidden one's label)."""
+    hidden = config.hidden.get(name)
+    return name if hidden is None else hidden.label
+
+
+def student_scrub(student: Student, config: GradeConfig, folder: Path) -> list[tuple[str, str]]:
+    """What the student's own files must not say, and what they say instead: the
+    instructor's paths (the class folder, --out, the harness, the Python) and the files of
+    the scenarios (a hidden one by its label)."""
+    import harness
+
+    pairs: list[tuple[str, str]] = []
+    for where, instead in (
+        (student.folder, ""),
+        (folder, ""),
+        (config.students_dir.parent, ""),
+        (Path(harness.__file__).parent.parent, ""),
+    ):
+        pairs += [(f"{where}/", instead), (f"{where.resolve()}/", instead)]
+    pairs += [(sys.executable, "python3"), (str(Path(sys.executable).resolve()), "python3")]
+    for name, ref in zip(config.scenarios, config.scenario_refs, strict=True):
+        if Path(ref).is_absolute():
+            hidden = config.hidden.get(name)
+            pairs.append((ref, Path(ref).name if hidden is None else hidden.label))
+    return pairs
 
 
 def _read_results(path: Path) -> dict[str, Any]:
@@ -109,12 +153,30 @@ def verdicts_from(
     command: str | None = None,
 ) -> tuple[dict[str, str], str]:
     """Each scenario's verdict and the first failure in words, from the worker's results."""
+    verdicts, failures = verdicts_and_failures(data, finished, config, folder, command)
+    first = next((failures[n] for n in config.scenarios if n in failures), "")
+    return verdicts, first
+
+
+def verdicts_and_failures(
+    data: dict[str, Any],
+    finished: Finished,
+    config: GradeConfig,
+    folder: Path,
+    command: str | None = None,
+) -> tuple[dict[str, str], dict[str, str]]:
+    """Each scenario's verdict, and the first failure in words of each that did not pass
+    (the run's start error, or how it ended, belongs to the scenario it stopped)."""
     entries = {e.get("scenario"): e for e in data.get("results", []) if isinstance(e, dict)}
     error = data.get("error")
     start_error = str(error) if error and error != "stopped" else None  # "stopped": SIGTERM
     unfinished = not data.get("finished") and start_error is None
-    first = f"node did not start: {_shorten(start_error, folder, command)}" if start_error else ""
     verdicts: dict[str, str] = {}
+    failures: dict[str, str] = {}
+    if start_error and config.scenarios:  # the suite never began: said on its first scenario
+        failures[config.scenarios[0]] = (
+            f"node did not start: {_shorten(start_error, folder, command)}"
+        )
     for name in config.scenarios:
         entry = entries.get(name)
         if entry is None:
@@ -123,31 +185,37 @@ def verdicts_from(
                 unfinished = False
                 if not finished.cancelled:
                     verdicts[name] = ERROR
-                first = first or f"{name}: {_unfinished_reason(finished, config)}"
+                failures.setdefault(name, f"{name}: {_unfinished_reason(finished, config)}")
             continue
         verdicts[name] = str(entry.get("verdict", ERROR))
-        if first or verdicts[name] in (PASS, NOT_RUN):
+        if verdicts[name] in (PASS, NOT_RUN) or name in failures:
             continue
         if entry.get("not_started"):
-            first = f"node did not start: {_shorten(str(entry.get('error')), folder, command)}"
+            why = f"node did not start: {_shorten(str(entry.get('error')), folder, command)}"
         else:
-            first = _shorten(str(entry.get("first_failure") or f"{name}: failed"), folder, command)
-    return verdicts, first
+            why = _shorten(str(entry.get("first_failure") or f"{name}: failed"), folder, command)
+        failures[name] = why
+    return verdicts, failures
 
 
 def ticks_from(data: dict[str, Any], config: GradeConfig) -> dict[str, tuple[int, int]]:
-    """(ticks held, ticks judged) of each scenario the worker judged."""
-    held: dict[str, tuple[int, int]] = {}
+    """(ticks held, ticks it should have run) of each scenario: a scenario that broke early,
+    or never ran, counts its missing ticks as not held (`config.planned`, when known)."""
+    held: dict[str, tuple[int, int]] = {
+        name: (0, count) for name, count in config.planned.items() if count > 0
+    }
     for entry in data.get("results", []):
         if not isinstance(entry, dict) or entry.get("scenario") not in config.scenarios:
             continue
+        name = str(entry["scenario"])
         try:
             judged, failed = int(entry.get("ticks", 0)), int(entry.get("failed_ticks", 0))
         except (TypeError, ValueError):
             continue
-        if judged > 0:
-            held[str(entry["scenario"])] = (max(0, judged - failed), judged)
-    return held
+        of = max(judged, config.planned.get(name, 0))
+        if of > 0:
+            held[name] = (max(0, judged - failed), of)
+    return {name: held[name] for name in config.scenarios if name in held}
 
 
 def node_of(student: Student, config: GradeConfig) -> str:
@@ -178,9 +246,12 @@ def _run_options(student: Student, config: GradeConfig, folder: Path) -> LinkOpt
 
 def _grade(student: Student, config: GradeConfig, cancel: StopFlag) -> StudentGrade:
     folder = config.students_dir / student.slug
-    shutil.rmtree(folder, ignore_errors=True)
-    folder.mkdir(parents=True)
+    grader = config.grader_dir / student.slug  # the grader's own: job, every detail
+    for where in (folder, grader):
+        shutil.rmtree(where, ignore_errors=True)
+        where.mkdir(parents=True)
     not_run = dict.fromkeys(config.scenarios, NOT_RUN)
+    unheld = {n: (0, c) for n, c in config.planned.items() if c > 0}
     artifacts = tuple(
         (label, f"students/{student.slug}/{name}")
         for label, name in ARTIFACTS
@@ -191,8 +262,18 @@ def _grade(student: Student, config: GradeConfig, cancel: StopFlag) -> StudentGr
 
     def without_run(reason: str, build_s: float | None = None) -> StudentGrade:
         _placeholder_junit(config, folder, reason)
+        scrub_folder(folder, student_scrub(student, config, folder))
+        failures = {config.scenarios[0]: reason} if config.scenarios else {}
         return StudentGrade(
-            student.name, student.kind, not_run, reason, artifacts, build_s=build_s, node=node
+            student.name,
+            student.kind,
+            not_run,
+            reason,
+            artifacts,
+            build_s=build_s,
+            node=node,
+            ticks=unheld,
+            failures=failures,
         )
 
     if student.problem is not None:
@@ -215,14 +296,17 @@ def _grade(student: Student, config: GradeConfig, cancel: StopFlag) -> StudentGr
         return without_run("interrupted", build_s)
     options = _run_options(student, config, folder)
     job = write_job(
-        folder / "job.json",
+        grader / "job.json",
         scenarios=list(config.scenario_refs),
         link=config.link,
         options=options,
         settings=config.settings,
-        results=folder / "results.json",
+        results=grader / "results.json",
         junit=folder / "junit.xml",
         report=folder / "report",
+        hidden={
+            n: {"label": h.label, "show_failure": h.show_failure} for n, h in config.hidden.items()
+        },
     )
     finished = run_bounded(
         [sys.executable, "-m", "harness.grading.worker", str(job)],
@@ -232,10 +316,12 @@ def _grade(student: Student, config: GradeConfig, cancel: StopFlag) -> StudentGr
         cwd=folder,
         cancel=cancel,
     )
-    data = _read_results(folder / "results.json")
-    verdicts, first = verdicts_from(data, finished, config, folder, options.node)
+    data = _read_results(grader / "results.json")
+    verdicts, failures = verdicts_and_failures(data, finished, config, folder, options.node)
+    first = next((failures[n] for n in config.scenarios if n in failures), "")
     if not (folder / "junit.xml").exists():
         _placeholder_junit(config, folder, first or "no results")
+    scrub_folder(folder, student_scrub(student, config, folder))
     return StudentGrade(
         student.name,
         student.kind,
@@ -246,7 +332,18 @@ def _grade(student: Student, config: GradeConfig, cancel: StopFlag) -> StudentGr
         finished.wall_s,
         ticks=ticks_from(data, config),
         node=node,
+        failures=failures,
+        notes=_notes(data),
     )
+
+
+def _notes(data: dict[str, Any]) -> tuple[str, ...]:
+    """What the run said once about how the node is wired (e.g. its launch file), in order."""
+    notes: list[str] = []
+    for entry in data.get("results", []):
+        if isinstance(entry, dict):
+            notes += [str(n) for n in entry.get("notes") or () if str(n) not in notes]
+    return tuple(notes)
 
 
 def grade_student(
@@ -257,10 +354,11 @@ def grade_student(
     try:
         return _grade(student, config, cancel)
     except Exception as err:  # one student must never stop the class
-        folder = config.students_dir / student.slug
+        folder = config.grader_dir / student.slug
         folder.mkdir(parents=True, exist_ok=True)
         write_atomically(folder / "grader-error.log", traceback.format_exc().encode())
-        reason = f"could not grade: {type(err).__name__}: {err} (see grader-error.log)"
+        log = f"grader/{student.slug}/grader-error.log"
+        reason = f"could not grade: {type(err).__name__}: {err} (see {log})"
         return StudentGrade(
             student.name, student.kind, dict.fromkeys(config.scenarios, NOT_RUN), reason
         )

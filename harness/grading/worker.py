@@ -48,6 +48,7 @@ def result_entry(result: RunResult) -> dict[str, Any]:
         "failed_ticks": len(result.failed_ticks),
         "wall_s": round(result.wall_s, 3),
         "diagnostics": result.diagnostics,
+        "notes": list(result.notes),
     }
 
 
@@ -61,9 +62,12 @@ def write_job(
     results: Path,
     junit: Path,
     report: Path | None = None,
+    hidden: dict[str, Any] | None = None,
 ) -> Path:
-    """Write a job file for this worker: LinkOptions and RunSettings as their fields."""
+    """Write a job file for this worker: LinkOptions and RunSettings as their fields;
+    `hidden`: scenario name -> {"label", "show_failure"}, shown to the student by label."""
     job = {
+        "hidden": hidden or {},
         "scenarios": scenarios,
         "link": link,
         "options": asdict(options),
@@ -120,17 +124,28 @@ class _Suite:
         self.entries: list[dict[str, Any]] = []
         self.results: list[RunResult] = []
         self.scenarios: dict[str, Any] = {}
+        self.hidden = _hidden_scenarios(job.get("hidden") or {})
+
+    def shown(self, result: RunResult) -> RunResult:
+        """`result` as the student's own files show it (a hidden scenario: label, verdict)."""
+        from harness.grading.hidden import hidden_run
+
+        hidden = self.hidden.get(result.scenario)
+        return result if hidden is None else hidden_run(result, hidden)
 
     def keep(self, result: RunResult) -> None:
         from harness.report.junit import write_junit
 
-        self.results.append(result)
-        self.entries.append(result_entry(result))
+        shown = self.shown(result)
+        self.results.append(shown)
+        self.entries.append(result_entry(result))  # the grader's own: every detail
         _write_results(self.results_path, self.entries, finished=False, error=None)
         write_junit(self.job["junit"], self.results)  # a run stopped later keeps its report
         if self.report is not None:
-            self.report.add(result, self.scenarios.get(result.scenario))
-        print(f"{result.scenario}: judged ({len(result.records)} ticks)", flush=True)
+            hidden = shown is not result
+            self.report.add(shown, None if hidden else self.scenarios.get(result.scenario))
+        count = "" if shown is not result else f" ({len(result.records)} ticks)"
+        print(f"{shown.scenario}: judged{count}", flush=True)
 
     def run(self) -> int:
         from rich.console import Console
@@ -162,6 +177,15 @@ class _Suite:
         console = Console(highlight=False, width=160, force_terminal=False)
         print_results(console, self.results)  # the verdicts, once, with the failures explained
         return 0
+
+
+def _hidden_scenarios(data: dict[str, Any]) -> dict[str, Any]:
+    from harness.grading.hidden import HiddenScenario
+
+    return {
+        str(name): HiddenScenario(str(how["label"]), bool(how.get("show_failure")))
+        for name, how in data.items()
+    }
 
 
 def interrupt_on_sigterm() -> None:

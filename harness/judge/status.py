@@ -306,8 +306,11 @@ def parse_status(text: str, pattern: str | re.Pattern[str] | None = None) -> Sta
 
 
 def half_unit(decimals: int | None) -> float:
-    """Half a unit in the last printed digit (0 when unknown)."""
-    return 0.5 * 10.0 ** (-decimals) if decimals is not None else 0.0
+    """Half a unit in the last printed digit (0 when unknown; a number printed with an
+    exponent past a float's range, e.g. '1000E1000', has no finite unit)."""
+    if decimals is None:
+        return 0.0
+    return 0.5 * 10.0 ** (-decimals) if -decimals < 308 else math.inf
 
 
 def is_finite(value: float | None) -> bool:

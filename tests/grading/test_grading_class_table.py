@@ -46,9 +46,11 @@ def test_csv_has_one_row_per_student_and_never_a_formula() -> None:
         "out_of_range ticks",
         "passed",
         "ticks_held",
+        "score",
         "first_failure",
+        "notes",
     ]
-    assert rows[1] == ["ana", "", "PASS", "", "PASS", "", "2/2", "", ""]
+    assert rows[1] == ["ana", "", "PASS", "", "PASS", "", "2/2", "", "", "", ""]
     assert rows[2] == [
         '\'=HYPERLINK("http://x")',
         "",
@@ -58,7 +60,9 @@ def test_csv_has_one_row_per_student_and_never_a_formula() -> None:
         "",
         "0/2",
         "30/95 (31%)",
+        "",
         f"approach_wall: status {NASTY}",
+        "",
     ]
 
 

@@ -42,6 +42,11 @@ def classroom(tmp_path: Path) -> Path:
         (["{class}", "--out", "{foreign}"], "not empty and not written by 'fossbot-hil grade'"),
         (["{class}", "--out", "{file}"], "not a folder"),
         ([], "the following arguments are required: DIR"),
+        (["{class}", "--scenario", "examples/narrow_corridor.yaml"], "no such scenario file"),
+        (["{class}", "--grading", "gradin.yaml"], "--grading gradin.yaml: No such file"),
+        (["{class}", "--grading", "{grading}", "--scenario", "out_of_range"], "give one of them"),
+        (["{class}", "--grading", "{bad_grading}"], "hidden/corridor.yaml: no such scenario file"),
+        (["{class}", "--roster", "{bad_roster}"], "must name the columns folder and id"),
     ],
 )
 def test_usage_errors_exit_2_with_one_line(
@@ -50,13 +55,23 @@ def test_usage_errors_exit_2_with_one_line(
     classroom: Path,
     tmp_path: Path,
     capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
 ) -> None:
     """Bad input: exit 2, one line naming the problem, and no output folder made."""
     (tmp_path / "empty").mkdir()
     (tmp_path / "foreign").mkdir()
     (tmp_path / "foreign" / "thesis.tex").write_text("precious")
     (tmp_path / "file").write_text("x")
+    (tmp_path / "grading.yaml").write_text("scenarios: [approach_wall]\n")
+    (tmp_path / "course").mkdir()
+    (tmp_path / "course" / "grading.yaml").write_text(
+        "scenarios:\n  - scenario: hidden/corridor.yaml\n    hidden: true\n"
+    )
+    (tmp_path / "roster.csv").write_text("name,email\nana,a@b\n")
     places = {
+        "{grading}": str(tmp_path / "grading.yaml"),
+        "{bad_grading}": str(tmp_path / "course" / "grading.yaml"),
+        "{bad_roster}": str(tmp_path / "roster.csv"),
         "{missing}": str(tmp_path / "missing"),
         "{empty}": str(tmp_path / "empty"),
         "{class}": str(classroom),
@@ -65,6 +80,7 @@ def test_usage_errors_exit_2_with_one_line(
     }
     out = tmp_path / "grades"
     argv = ["grade", *(places.get(a, a) for a in args)]
+    monkeypatch.chdir(tmp_path)  # a relative path is the instructor's, from where they are
     if "--out" not in args:
         argv += ["--out", str(out)]
     assert main(argv) == 2

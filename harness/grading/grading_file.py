@@ -1,0 +1,183 @@
+"""The instructor's grading file (e.g. grading.yaml): scenarios, weights, hidden ones, judging.
+
+```yaml
+scenarios:
+  - approach_wall                   # a shipped scenario, weight 1
+  - scenario: out_of_range
+    weight: 2
+  - scenario: hidden/narrow_corridor.yaml   # a file, relative to this grading file
+    weight: 3
+    hidden: true                    # students see "hidden 1" and whether it passed
+    show_failure: false             # ... and its first failure only if true
+points: 100                         # what a full pass earns (default: the sum of the weights)
+partial_credit: false               # true: a failed scenario earns its share of ticks held
+threshold: 0.5                      # the judging options, as on the command line
+timeout: 1.0
+```
+
+Read with the scenarios' own bounded YAML loader and validated here (pure:
+no rclpy, no pybullet). Paths are made absolute against the file's folder
+now, so nothing is ever resolved inside a student's folder.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Collection, Sequence
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, Literal
+
+import yaml
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
+
+from harness.errors import ConfigError
+from harness.scenario.files import SCENARIO_SUFFIXES
+from harness.scenario.yaml_loader import load_yaml, yaml_problem
+
+if TYPE_CHECKING:
+    from harness.grading.scoring import ScorePlan
+
+__all__ = ["GradingFile", "PlannedScenario", "load_grading_file"]
+
+MAX_GRADING_FILE_BYTES = 1 << 20
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
+
+
+class PlannedScenario(_Strict):
+    """One scenario of the grading file."""
+
+    scenario: str = Field(min_length=1, max_length=1000)  # a shipped name or a file
+    weight: float = Field(default=1.0, ge=0.0, le=1e6)
+    hidden: bool = False
+    show_failure: bool = False  # hidden only: students see its first failure
+    label: str | None = Field(default=None, min_length=1, max_length=80)
+
+
+class GradingFile(_Strict):
+    """What grade and run take from the grading file; None leaves an option as given."""
+
+    scenarios: list[PlannedScenario] = Field(min_length=1, max_length=500)
+    points: float | None = Field(default=None, gt=0.0, le=1e6)
+    partial_credit: bool = False
+    threshold: float | None = Field(default=None, gt=0.0)
+    timeout: float | None = Field(default=None, gt=0.0)
+    ready_timeout: float | None = Field(default=None, gt=0.0)
+    seed: int | None = Field(default=None, ge=0, le=2**32 - 1)
+    faults: str | list[str] | None = None
+    warning_when_clear: Literal["optional", "required"] | None = None
+    status_regex: str | None = None
+    link: str | None = None
+    package: str | None = None
+    executable: str | None = None
+    source: str = Field(default="", exclude=True)
+
+    @field_validator("scenarios", mode="before")
+    @classmethod
+    def _names_are_entries(cls, value: Any) -> Any:
+        """`- approach_wall` is short for `- scenario: approach_wall`."""
+        if isinstance(value, list):
+            return [{"scenario": e} if isinstance(e, str) else e for e in value]
+        return value
+
+    @field_validator("scenarios")
+    @classmethod
+    def _some_weight(cls, value: list[PlannedScenario]) -> list[PlannedScenario]:
+        if not any(e.weight > 0 for e in value):
+            raise ValueError("every scenario has weight 0: nothing can be scored")
+        return value
+
+    @property
+    def planned(self) -> tuple[PlannedScenario, ...]:
+        """The entries, hidden ones labelled "hidden N" unless the file names them."""
+        planned, hidden = [], 0
+        for e in self.scenarios:
+            if e.hidden:
+                hidden += 1
+                e = e.model_copy(update={"label": e.label or f"hidden {hidden}"})
+            planned.append(e)
+        return tuple(planned)
+
+    def score_plan(self, names: Sequence[str]) -> ScorePlan:
+        """How the scenarios score, `names` being what each entry resolved to, in order."""
+        from harness.grading.scoring import ScenarioScore, ScorePlan
+
+        return ScorePlan(
+            tuple(
+                ScenarioScore(name, p.weight, p.hidden, p.show_failure, p.label or "")
+                for name, p in zip(names, self.planned, strict=True)
+            ),
+            points=self.points,
+            partial_credit=self.partial_credit,
+        )
+
+    def apply_to(self, args: Any, *, typed: Collection[str], skip: Collection[str] = ()) -> None:
+        """Set the file's options on an argparse namespace, except those the user typed
+        (the command line wins) and those in `skip`."""
+        for name, value in self.judging_options().items():
+            if name not in typed and name not in skip:
+                setattr(args, name, value)
+
+    def judging_options(self) -> dict[str, Any]:
+        """The options the file sets, by their argparse names (faults as --faults text)."""
+        names = ("threshold", "timeout", "ready_timeout", "seed", "warning_when_clear")
+        options = {n: getattr(self, n) for n in names if getattr(self, n) is not None}
+        if self.status_regex is not None:
+            options["status_regex"] = self.status_regex
+        if self.faults is not None:
+            options["faults"] = (
+                self.faults if isinstance(self.faults, str) else ",".join(self.faults)
+            )
+        for name in ("link", "package", "executable"):
+            if getattr(self, name) is not None:
+                options[name] = getattr(self, name)
+        return options
+
+
+def _absolute(ref: str, folder: Path) -> str:
+    """A scenario file named by the grading file, as an absolute path; a name stays a name."""
+    candidate = Path(ref)
+    if candidate.suffix in SCENARIO_SUFFIXES or "/" in ref or (folder / ref).exists():
+        return str((folder / candidate).resolve())
+    return ref
+
+
+def load_grading_file(path: str | Path) -> GradingFile:
+    """The grading file at `path`, validated, its scenario files made absolute; ConfigError
+    (exit 2) naming the file and the first problem."""
+    path = Path(path)
+    name = f"--grading {path}"
+    try:
+        with open(path, "rb") as handle:
+            data = handle.read(MAX_GRADING_FILE_BYTES + 1)
+    except OSError as err:
+        raise ConfigError(f"{name}: {err.strerror or err}") from None
+    if len(data) > MAX_GRADING_FILE_BYTES:
+        raise ConfigError(f"{name}: larger than {MAX_GRADING_FILE_BYTES // 1024} KB")
+    try:
+        raw = load_yaml(data.decode("utf-8"))
+    except UnicodeDecodeError:
+        raise ConfigError(f"{name}: not UTF-8 text") from None
+    except yaml.YAMLError as err:
+        raise ConfigError(f"{name}: {yaml_problem(err)}") from None
+    except (RecursionError, ValueError) as err:
+        raise ConfigError(f"{name}: YAML error: {err}") from None
+    if not isinstance(raw, dict):
+        raise ConfigError(f"{name}: expected a mapping with a 'scenarios' list")
+    try:
+        parsed = GradingFile.model_validate(raw)
+    except ValidationError as err:
+        raise ConfigError(f"{name}: {_first_error(err)}") from None
+    folder = path.resolve().parent
+    scenarios = [
+        e.model_copy(update={"scenario": _absolute(e.scenario, folder)}) for e in parsed.scenarios
+    ]
+    return parsed.model_copy(update={"scenarios": scenarios, "source": str(path)})
+
+
+def _first_error(err: ValidationError) -> str:
+    first = err.errors()[0]
+    where = ".".join(str(p) for p in first["loc"])
+    message = str(first["msg"]).removeprefix("Value error, ")
+    return f"{where}: {message}" if where else message

@@ -1,0 +1,148 @@
+"""A course's grading, end to end: folders and an archive, a roster, a grading file with
+weights and a hidden scenario named by a relative path; the tables, the gradebook, a
+Gradescope results.json per student, and students' files free of the instructor's paths.
+
+Real parts: students' nodes in their own processes over Fast DDS, the embedded Dask
+cluster, a real zip file.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import shutil
+import sys
+import zipfile
+from pathlib import Path
+
+import pytest
+
+from harness.cli import main
+from tests.grading.gradescope_schema import check_gradescope, read_results
+from tests.grading.grading_class import STUDENT_NODE
+
+REPO = Path(__file__).resolve().parents[2]
+HIDDEN = "narrow_corridor"
+
+pytestmark = pytest.mark.timeout(240)
+
+
+def node_script(folder: Path, variant: str) -> Path:
+    """A one-file hand-in running the test suite's student node as `variant`."""
+    folder.mkdir(parents=True)
+    (folder / "lidar_node.py").write_text(
+        "import runpy\nimport sys\n\n"
+        f"sys.argv[1:1] = [{variant!r}]\n"
+        f"runpy.run_path({str(STUDENT_NODE)!r}, run_name='__main__')\n"
+    )
+    return folder
+
+
+def zipped(folder: Path) -> Path:
+    """`folder` handed in as `folder`.zip (wrapped in its own folder, as LMSs export)."""
+    archive = folder.with_suffix(".zip")
+    with zipfile.ZipFile(archive, "w") as handle:
+        for path in sorted(folder.rglob("*")):
+            handle.write(path, str(path.relative_to(folder.parent)))
+    shutil.rmtree(folder)
+    return archive
+
+
+@pytest.fixture(scope="module")
+def course(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The instructor's folder: class/, course/grading.yaml, course/hidden/, roster.csv."""
+    root = tmp_path_factory.mktemp("instructor")
+    node_script(root / "class" / "alex", "correct")
+    zipped(node_script(root / "class" / "bea", "angle_in_degrees"))
+    node_script(root / "class" / "carl", "crash_when_nothing_in_range")
+    (root / "course" / "hidden").mkdir(parents=True)
+    shutil.copy(REPO / "examples" / f"{HIDDEN}.yaml", root / "course" / "hidden")
+    (root / "course" / "grading.yaml").write_text(
+        "scenarios:\n"
+        "  - approach_wall\n"
+        "  - scenario: out_of_range\n    weight: 2\n"
+        f"  - scenario: hidden/{HIDDEN}.yaml\n    weight: 3\n    hidden: true\n"
+        "points: 60\n"
+    )
+    (root / "course" / "roster.csv").write_text(
+        "folder,id,name\nalex,s100,Alex A\nbea,s200,Bea B\ncarl,s300,Carl C\ndan,s400,Dan D\n"
+    )
+    return root
+
+
+@pytest.fixture(scope="module")
+def graded(course: Path) -> Path:
+    """`fossbot-hil grade` run from the instructor's folder, with relative paths."""
+    with pytest.MonkeyPatch.context() as patch:
+        patch.chdir(course)
+        code = main(
+            [
+                "grade",
+                "class",
+                "--grading",
+                "course/grading.yaml",
+                "--roster",
+                "course/roster.csv",
+                "--gradescope",
+                "--no-audit",
+                "--out",
+                "grades",
+            ]
+        )
+    assert code == 0
+    return course / "grades"
+
+
+def rows(path: Path) -> dict[str, dict[str, str]]:
+    table = csv.DictReader(io.StringIO(path.read_text(encoding="utf-8")))
+    return {row.get("student") or row.get("Student", ""): row for row in table}
+
+
+def test_every_student_on_the_roster_has_a_row_with_id_and_score(graded: Path) -> None:
+    table = rows(graded / "grades.csv")
+    assert sorted(table) == ["alex", "bea", "carl", "dan"]
+    alex, bea, carl, dan = (table[n] for n in ("alex", "bea", "carl", "dan"))
+    assert (alex["id"], alex["score"], alex["passed"]) == ("s100", "60", "3/3")
+    assert alex[HIDDEN] == "PASS"  # the class table is the instructor's: names it
+    assert bea["approach_wall"] == "FAIL" and float(bea["score"]) < 60
+    # carl's node crashed in out_of_range: its missing ticks count as not held
+    assert carl["out_of_range"] == "ERROR"
+    held, planned = map(int, carl["out_of_range ticks"].split("/"))
+    assert held < planned == int(alex["out_of_range ticks"].split("/")[1])
+    assert (dan["id"], dan["score"], dan["first_failure"]) == ("s400", "0", "no submission")
+
+
+def test_the_gradebook_has_every_id_and_score(graded: Path) -> None:
+    text = (graded / "gradebook.csv").read_text(encoding="utf-8")
+    for student_id in ("s100", "s200", "s300", "s400"):
+        assert student_id in text
+    assert "60" in text
+
+
+def test_each_student_gets_a_gradescope_results_json_that_hides_the_hidden(graded: Path) -> None:
+    for name in ("alex", "bea", "carl"):
+        data = read_results(graded / "students" / name / "gradescope" / "results.json")
+        check_gradescope(data)
+        names = [t["name"] for t in data["tests"]]
+        assert names == ["approach_wall", "out_of_range", "hidden 1"]
+        assert sum(t["max_score"] for t in data["tests"]) == pytest.approx(60, abs=0.05)
+        assert HIDDEN not in str(data)
+    alex = read_results(graded / "students" / "alex" / "gradescope" / "results.json")
+    assert alex["score"] == pytest.approx(60)
+
+
+def test_students_files_name_no_instructor_path_nor_the_hidden_scenario(
+    graded: Path, course: Path
+) -> None:
+    secrets = [str(course), str(course.resolve()), sys.executable, str(REPO), HIDDEN]
+    checked = 0
+    for path in (graded / "students").rglob("*"):
+        if path.is_file() and path.suffix in (".html", ".json", ".xml", ".log"):
+            text = path.read_text(encoding="utf-8", errors="replace")
+            found = [s for s in secrets if s in text]
+            assert not found, f"{path.relative_to(graded)} names {found}"
+            checked += 1
+        assert HIDDEN not in path.name
+    assert checked >= 15  # reports, logs, JUnit, results of three students
+    report = (graded / "students" / "alex" / "report" / "index.html").read_text()
+    assert "hidden 1" in report
