@@ -30,6 +30,7 @@ import yaml
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
 
 from harness.errors import ConfigError
+from harness.grading.instructor_file import read_instructor_file
 from harness.scenario.files import SCENARIO_SUFFIXES
 from harness.scenario.yaml_loader import load_yaml, yaml_problem
 
@@ -148,17 +149,9 @@ def load_grading_file(path: str | Path) -> GradingFile:
     (exit 2) naming the file and the first problem."""
     path = Path(path)
     name = f"--grading {path}"
+    text = read_instructor_file(path, MAX_GRADING_FILE_BYTES, name)
     try:
-        with open(path, "rb") as handle:
-            data = handle.read(MAX_GRADING_FILE_BYTES + 1)
-    except OSError as err:
-        raise ConfigError(f"{name}: {err.strerror or err}") from None
-    if len(data) > MAX_GRADING_FILE_BYTES:
-        raise ConfigError(f"{name}: larger than {MAX_GRADING_FILE_BYTES // 1024} KB")
-    try:
-        raw = load_yaml(data.decode("utf-8"))
-    except UnicodeDecodeError:
-        raise ConfigError(f"{name}: not UTF-8 text") from None
+        raw = load_yaml(text)
     except yaml.YAMLError as err:
         raise ConfigError(f"{name}: {yaml_problem(err)}") from None
     except (RecursionError, ValueError) as err:

@@ -22,6 +22,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from harness.errors import ConfigError
+from harness.grading.instructor_file import read_instructor_file
 
 __all__ = ["Roster", "RosterEntry", "load_roster"]
 
@@ -101,15 +102,5 @@ def parse_roster(text: str, source: str = "--roster") -> Roster:
 def load_roster(path: str | Path) -> Roster:
     """The roster file at `path`; ConfigError (exit 2) when it cannot be read or is ambiguous."""
     source = f"--roster {path}"
-    try:
-        with open(path, "rb") as handle:
-            data = handle.read(MAX_ROSTER_BYTES + 1)
-    except OSError as err:
-        raise ConfigError(f"{source}: {err.strerror or err}") from None
-    if len(data) > MAX_ROSTER_BYTES:
-        raise ConfigError(f"{source}: larger than {MAX_ROSTER_BYTES >> 20} MB")
-    try:
-        text = data.decode("utf-8")
-    except UnicodeDecodeError:
-        raise ConfigError(f"{source}: not UTF-8 text (save the CSV as UTF-8)") from None
+    text = read_instructor_file(path, MAX_ROSTER_BYTES, source)
     return parse_roster(text, source)
