@@ -25,10 +25,12 @@ DIAGNOSTIC_LINES = 15
 CHANGE_HEAD = ["change", "scenario", "faults", "then", "now", "why"]
 
 _STYLE = """
-body { font: 14px/1.4 system-ui, sans-serif; margin: 1.5em auto; max-width: 60em; color: #222; }
+body { font: 14px/1.4 system-ui, sans-serif; margin: 1.5em auto; max-width: 72em; color: #222; }
 table { border-collapse: collapse; }
-th, td { padding: 0.2em 0.7em; text-align: left; border-bottom: 1px solid #ddd; }
+th, td { padding: 0.2em 0.5em; text-align: left; border-bottom: 1px solid #ddd; }
 td.n { text-align: right; font-variant-numeric: tabular-nums; }
+td.faults { overflow-wrap: anywhere; min-width: 8em; }
+td.faults span { display: inline-block; }
 .PASS { color: #1a7f37; font-weight: bold; }
 .FAIL, .ERROR { color: #c62828; font-weight: bold; }
 .NOT_RUN { color: #9a6700; font-weight: bold; }
@@ -55,6 +57,12 @@ def _verdict(verdict: str) -> str:
     return f'<span class="{verdict.replace(" ", "_")}">{_text(verdict)}</span>'
 
 
+def _faults(faults: str) -> str:
+    """Fault names joined by "+", each in a box of its own: a line breaks after a "+"
+    (and inside a name only when the name alone is wider than the column)."""
+    return "<span>" + "+</span><span>".join(_text(faults).split("+")) + "</span>"
+
+
 def _file_links(files: Mapping[str, str | None]) -> str:
     return " ".join(f'<a href="{_href(p)}">{_text(n)}</a>' for n, p in files.items() if p)
 
@@ -76,7 +84,7 @@ def _row(i: int, e: Mapping[str, Any]) -> str:
         f'<td class="n">{_text(e["seed"])}',
         f'<td class="n">{_text(e["threshold"])}',
         _text(e.get("warning_when_clear", "optional")),
-        _text(e["faults"]),
+        f'<td class="faults">{_faults(e["faults"])}',
         _file_links(e["files"]),
     ]
     return "<tr>" + "".join(c if c.startswith("<td") else f"<td>{c}" for c in cells) + "</tr>"
@@ -201,6 +209,7 @@ def index_html(summary: Mapping[str, Any], *, diagnostics: Sequence[str] = ()) -
         *(_row(i, e) for i, e in enumerate(entries)),
         "</table>",
     ]
+    lines.extend(f'<p class="note">note: {_text(note)}</p>' for note in summary.get("notes", ()))
     if summary.get("alignment"):
         lines.extend(_alignment(summary["alignment"]))
     if "baseline" in summary:
