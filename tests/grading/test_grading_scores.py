@@ -158,3 +158,19 @@ def test_paths_are_replaced_longest_first() -> None:
     pairs = [("/home/t/class/", ""), ("/home/t/class/alex/", ""), ("/usr/bin/python3", "python3")]
     text = "/usr/bin/python3 /home/t/class/alex/node.py; see /home/t/class/grades.csv"
     assert scrub_text(text, pairs) == "python3 node.py; see grades.csv"
+
+
+def test_grading_into_an_earlier_output_says_what_it_replaces(tmp_path: Path) -> None:
+    from harness.commands.grade import previous_grading
+    from harness.grading.discover import GRADES_MARKER
+
+    out = tmp_path / "grades"
+    assert previous_grading(out) is None  # nothing there
+    out.mkdir()
+    (out / "grades.csv").write_text("student,passed\r\nalex,1/1\r\nbea,0/1\r\n")
+    assert previous_grading(out) is None  # not ours: check_out refuses it instead
+    (out / GRADES_MARKER).write_text("written by fossbot-hil grade\n")
+    said = previous_grading(out)
+    assert said is not None
+    assert said.startswith("replacing the grading of 2 students from ")
+    assert said.endswith(f" in {out}")
