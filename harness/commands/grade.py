@@ -410,7 +410,7 @@ def previous_grading(out: Path) -> str | None:
     if not (out / GRADES_MARKER).exists() or not table.is_file():
         return None
     try:
-        rows = max(0, table.read_text(encoding="utf-8").count("\r\n") - 1)
+        rows = max(0, len(table.read_text(encoding="utf-8").splitlines()) - 1)
         when = time.strftime("%Y-%m-%d %H:%M", time.localtime(table.stat().st_mtime))
     except (OSError, UnicodeDecodeError):
         return f"replacing the earlier grading in {out}"
