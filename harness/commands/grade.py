@@ -8,6 +8,7 @@ output folder's layout, are in docs/grading.md.
 from __future__ import annotations
 
 import argparse
+import csv
 import importlib.util
 import json
 import shutil
@@ -410,9 +411,10 @@ def previous_grading(out: Path) -> str | None:
     if not (out / GRADES_MARKER).exists() or not table.is_file():
         return None
     try:
-        rows = max(0, len(table.read_text(encoding="utf-8").splitlines()) - 1)
+        with open(table, encoding="utf-8", newline="") as handle:  # cells may hold newlines
+            rows = max(0, sum(1 for _ in csv.reader(handle)) - 1)
         when = time.strftime("%Y-%m-%d %H:%M", time.localtime(table.stat().st_mtime))
-    except (OSError, UnicodeDecodeError):
+    except (OSError, UnicodeDecodeError, csv.Error):
         return f"replacing the earlier grading in {out}"
     return f"replacing the grading of {rows} student{'s' if rows != 1 else ''} from {when} in {out}"
 
