@@ -46,7 +46,11 @@ def working_tree_copy(target: Path) -> Path:
     ).stdout.decode()
     for name in filter(None, listed.split("\0")):
         source = REPO / name
-        if source.is_symlink() or not source.is_file():
+        if source.is_symlink():  # harness/scenarios -> ../scenarios, ...: kept as links
+            (target / name).parent.mkdir(parents=True, exist_ok=True)
+            (target / name).symlink_to(os.readlink(source))
+            continue
+        if not source.is_file():
             continue
         (target / name).parent.mkdir(parents=True, exist_ok=True)
         shutil.copy2(source, target / name)
