@@ -54,9 +54,11 @@ def chromium() -> str:
     return path
 
 
-@pytest.fixture(scope="session")
+@pytest.fixture(scope="module")
 def browser(chromium: str) -> Iterator[Any]:
-    """One headless Chromium for every browser test of this process."""
+    """One headless Chromium for the browser tests of a module, stopped when the process
+    moves on: Playwright's sync API keeps an asyncio loop running in this thread while it
+    is open, and another module's asyncio.run() (e.g. the live view's) would then fail."""
     from playwright.sync_api import sync_playwright
 
     with sync_playwright() as playwright:
