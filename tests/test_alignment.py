@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import math
 import re
-import time
 from dataclasses import replace
 
 import numpy as np
@@ -336,15 +335,11 @@ def test_run_alignment_without_board_scans_is_none() -> None:
     assert run_alignment([]) is None
 
 
-def test_a_long_run_fits_fast() -> None:
-    """600 ticks of 720 beams: well under a second (ticks beyond the cap are spread out)."""
+def test_a_long_run_fits_a_capped_spread_of_its_ticks() -> None:
+    """600 ticks of 720 beams: the fit reads a capped number of ticks, spread over the run
+    (what keeps it fast; its speed is the benchmarks' to measure, not a test's)."""
     truths = _run_scenes(ticks=20, layout="720 -pi..pi")
     boards = [_board(t, offset=0.0) for t in truths]
     pairs = [(truths[k % 20], boards[k % 20]) for k in range(600)]
-    took = []
-    for _ in range(2):  # the better of two: a busy machine may stall one
-        start = time.perf_counter()
-        fitted = fit_alignment(pairs, mount=V2)
-        took.append(time.perf_counter() - start)
+    fitted = fit_alignment(pairs, mount=V2)
     assert fitted is not None and fitted.status == "misaligned" and fitted.ticks < 600
-    assert min(took) < 1.0, f"{min(took):.2f} s"
