@@ -7,18 +7,14 @@ small class of a folder, a zip, a refused tar.gz and a PDF over ROS 2.
 
 from __future__ import annotations
 
-import csv
 import gzip
 import io
 import stat
-import subprocess
 import tarfile
 import zipfile
 from pathlib import Path
 
 import pytest
-from command_line import COMMAND
-from grading_class import script_student
 
 from harness.errors import ConfigError
 from harness.grading.archives import (
@@ -427,54 +423,5 @@ def test_prepare_out_removes_last_times_unpacked_archives(tmp_path: Path) -> Non
     assert not (out / "unpacked").exists()
 
 
-@pytest.mark.ros
-@pytest.mark.slow
-@pytest.mark.timeout(180)
-def test_every_submission_of_a_class_gets_a_row(tmp_path: Path) -> None:
-    """`fossbot-hil grade` of a folder, a zip, a refused tar.gz and a PDF: four rows."""
-    classroom = tmp_path / "class"
-    script_student(classroom / "dave")
-    staged = script_student(tmp_path / "staging" / "erin_lab07")
-    with zipfile.ZipFile(classroom / "erin.zip", "w") as zipped:
-        zipped.write(staged / "lidar_node.py", "erin_lab07/lidar_node.py")
-    make_tar(classroom / "mallory.tar.gz", {"x/../../etc/passwd": b"pwned"})
-    (classroom / "notes.pdf").write_bytes(b"%PDF-1.4")
-    done = subprocess.run(
-        [
-            *COMMAND,
-            "grade",
-            str(classroom),
-            "--out",
-            "grades",
-            "--jobs",
-            "2",
-            "--scenario",
-            "approach_wall",
-            "--no-audit",
-        ],
-        cwd=tmp_path,
-        capture_output=True,
-        text=True,
-        timeout=160,
-    )
-    print(done.stdout)  # shown with -s: what the instructor sees
-    assert done.returncode == 0, done.stdout + done.stderr
-    assert "Traceback" not in done.stdout + done.stderr
-    out = tmp_path / "grades"
-    with open(out / "grades.csv", newline="", encoding="utf-8") as handle:
-        rows = {row["student"]: row for row in csv.DictReader(handle)}
-    assert sorted(rows) == ["dave", "erin", "mallory", "notes.pdf"]
-    assert rows["dave"]["approach_wall"] == "PASS", rows["dave"]
-    assert rows["erin"]["approach_wall"] == "PASS", rows["erin"]
-    assert rows["erin"]["node"] == "lidar_node.py (script)"
-    assert rows["mallory"]["approach_wall"] == "NOT RUN"
-    assert rows["mallory"]["first_failure"] == (
-        "archive refused: 'x/../../etc/passwd' would be written outside the submission"
-    )
-    assert rows["notes.pdf"]["first_failure"] == (
-        "not a submission: a file, not a folder or archive"
-    )
-    page = (out / "grades.html").read_text(encoding="utf-8")
-    assert all(name in page for name in rows)
-    assert (out / "unpacked" / "erin" / "erin_lab07" / "lidar_node.py").is_file()
-    assert "skipped" not in done.stdout
+# A class of a folder, a zip, a refused tar.gz and a PDF, graded end to end:
+# tests/grading/test_grading_course.py.

@@ -1,4 +1,5 @@
-"""A course's grading, end to end: folders and an archive, a roster, a grading file with
+"""A course's grading, end to end: folders, a zip, a refused archive and a loose file, a
+roster, a grading file with
 weights and a hidden scenario named by a relative path; the tables, the gradebook, a
 Gradescope results.json per student, and students' files free of the instructor's paths.
 
@@ -12,6 +13,7 @@ import csv
 import io
 import shutil
 import sys
+import tarfile
 import zipfile
 from pathlib import Path
 
@@ -55,6 +57,11 @@ def course(tmp_path_factory: pytest.TempPathFactory) -> Path:
     node_script(root / "class" / "alex", "correct")
     zipped(node_script(root / "class" / "bea", "angle_in_degrees"))
     node_script(root / "class" / "carl", "crash_when_nothing_in_range")
+    with tarfile.open(root / "class" / "mallory.tar.gz", "w:gz") as handle:  # climbs out
+        member = tarfile.TarInfo("x/../../etc/passwd")
+        member.size = 5
+        handle.addfile(member, io.BytesIO(b"pwned"))
+    (root / "class" / "notes.pdf").write_bytes(b"%PDF-1.4")
     (root / "course" / "hidden").mkdir(parents=True)
     shutil.copy(REPO / "examples" / f"{HIDDEN}.yaml", root / "course" / "hidden")
     (root / "course" / "grading.yaml").write_text(
@@ -100,7 +107,7 @@ def rows(path: Path) -> dict[str, dict[str, str]]:
 
 def test_every_student_on_the_roster_has_a_row_with_id_and_score(graded: Path) -> None:
     table = rows(graded / "grades.csv")
-    assert sorted(table) == ["alex", "bea", "carl", "dan"]
+    assert sorted(table) == ["alex", "bea", "carl", "dan", "mallory", "notes.pdf"]
     alex, bea, carl, dan = (table[n] for n in ("alex", "bea", "carl", "dan"))
     assert (alex["id"], alex["score"], alex["passed"]) == ("s100", "60", "3/3")
     assert alex[HIDDEN] == "PASS"  # the class table is the instructor's: names it
@@ -110,6 +117,22 @@ def test_every_student_on_the_roster_has_a_row_with_id_and_score(graded: Path) -
     held, planned = map(int, carl["out_of_range ticks"].split("/"))
     assert held < planned == int(alex["out_of_range ticks"].split("/")[1])
     assert (dan["id"], dan["score"], dan["first_failure"]) == ("s400", "0", "no submission")
+
+
+def test_every_submission_has_a_row_even_a_refused_archive_or_a_loose_file(
+    graded: Path,
+) -> None:
+    table = rows(graded / "grades.csv")
+    assert table["bea"]["node"] == "lidar_node.py (script)"  # unpacked from bea.zip
+    assert (graded / "unpacked" / "bea" / "bea" / "lidar_node.py").is_file()
+    mallory, pdf = table["mallory"], table["notes.pdf"]
+    assert mallory["approach_wall"] == "NOT RUN" and mallory["id"] == ""  # not on the roster
+    assert mallory["first_failure"] == (
+        "archive refused: 'x/../../etc/passwd' would be written outside the submission"
+    )
+    assert pdf["first_failure"] == "not a submission: a file, not a folder or archive"
+    page = (graded / "grades.html").read_text(encoding="utf-8")
+    assert all(name in page for name in table)
 
 
 def test_the_gradebook_has_every_id_and_score(graded: Path) -> None:
