@@ -13,7 +13,7 @@ import pytest
 from command_line import COMMAND
 from grading_class import script_student
 
-pytestmark = [pytest.mark.ros, pytest.mark.timeout(300)]
+pytestmark = [pytest.mark.ros, pytest.mark.slow, pytest.mark.timeout(300)]
 
 
 def grade(tmp_path: Path, out: str) -> subprocess.CompletedProcess[str]:

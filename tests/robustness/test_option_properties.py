@@ -38,7 +38,9 @@ from harness.report.folder_lock import LOCK_NAME
 
 pytestmark = [pytest.mark.timeout(300), pytest.mark.slow]
 
-EXAMPLES = examples(180)
+# Each option's hostile values are also refused one by one through the real command
+# (test_hostile_input.py's test_hostile_option); here they are mixed.
+EXAMPLES = examples(120)
 TINY = """\
 description: Three ticks beside a wall.
 obstacles:
