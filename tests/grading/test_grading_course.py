@@ -18,10 +18,10 @@ import zipfile
 from pathlib import Path
 
 import pytest
+from gradescope_schema import check_gradescope, read_results
+from grading_class import STUDENT_NODE
 
 from harness.cli import main
-from tests.grading.gradescope_schema import check_gradescope, read_results
-from tests.grading.grading_class import STUDENT_NODE
 
 REPO = Path(__file__).resolve().parents[2]
 HIDDEN = "narrow_corridor"
