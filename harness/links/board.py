@@ -56,9 +56,9 @@ SPARSE_WAIT_S = 0.25  # at least this long for the board's scan of such a revolu
 IDLE_ANSWER_S = 1.0  # before the first tick: for the node to answer the idle stream (each wait)
 STREAM_QUIET_REVOLUTIONS = 3  # no board scan of the idle stream in this many: none is coming
 IDLE_QUIET_MAX_S = 2.0  # longest wait for a lagging driver's last idle revolutions
-# Longest wait for a node (that answered the idle stream) to answer its last revolution:
-# answered later, during the first tick, it would be taken for the first tick's answer
-# (seen once in CI: out_of_range's tick 0 answered with approach_wall's last distance).
+# Longest wait for a node (that answered the idle stream) to answer its last revolutions
+# and fall quiet: answered later, during the first tick, one would be taken for the first
+# tick's answer (seen in CI: out_of_range's tick 0 answered with approach_wall's last).
 IDLE_LAST_ANSWER_S = 3.0
 
 
@@ -358,8 +358,18 @@ class BoardLink(Ros2Link):
 
         self._wait_for(driver_quiet, IDLE_QUIET_MAX_S)
         idle = [h.source_ns for h in obs.inbox if h.kind == "scan"]
-        if idle and answered:  # a loaded machine's node may take a while: it returns at once
-            self._wait_for(lambda: obs.heard_since("status", max(idle)), IDLE_LAST_ANSWER_S)
+        if idle and answered:
+            # A node lagging on a loaded machine answers older scans after the last one
+            # was published: wait (bounded) until it answered after the last idle scan and
+            # then said nothing for three revolutions, so no idle answer is left to arrive
+            # during the first tick.
+            def answers_done() -> bool:
+                if not obs.heard_since("status", max(idle)):
+                    return False
+                last = max((h.arrived for h in obs.inbox if h.kind == "status"), default=began)
+                return time.perf_counter() - last > quiet_s
+
+            self._wait_for(answers_done, IDLE_LAST_ANSWER_S)
             self._wait_for(lambda: False, self._grace())  # its Bool, if any
         obs.drain()
         obs.inbox.clear()
