@@ -21,7 +21,15 @@ DOCS = ROOT / "docs" / "architecture.md"
 NOT_CODE = {"reference", "board_driver", "robot_models", "scenarios"}
 
 # What every layer may use, at the root of the package.
-GROUND = {"__init__", "errors", "safe_text", "holder_lock", "atomic_write", "user_cache"}
+GROUND = {
+    "__init__",
+    "errors",
+    "safe_text",
+    "holder_lock",
+    "atomic_write",
+    "user_cache",
+    "text_file",
+}
 
 # Bottom to top; a package imports only from layers below its own.
 LAYERS: list[set[str]] = [
@@ -58,6 +66,7 @@ PURE = [
     "harness.audit.mutants",
     "harness.audit.matrix",
     "harness.user_cache",
+    "harness.text_file",
     "harness.grading.discover",
     "harness.grading.archives",
     "harness.grading.class_table",

@@ -30,9 +30,9 @@ import yaml
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
 
 from harness.errors import ConfigError
-from harness.grading.instructor_file import read_instructor_file
 from harness.scenario.files import SCENARIO_SUFFIXES
 from harness.scenario.yaml_loader import load_yaml, yaml_problem
+from harness.text_file import read_text_file
 
 if TYPE_CHECKING:
     from harness.grading.scoring import ScorePlan
@@ -149,7 +149,7 @@ def load_grading_file(path: str | Path) -> GradingFile:
     (exit 2) naming the file and the first problem."""
     path = Path(path)
     name = f"--grading {path}"
-    text = read_instructor_file(path, MAX_GRADING_FILE_BYTES, name)
+    text = read_text_file(path, limit=MAX_GRADING_FILE_BYTES, name=name, kind="grading file")
     try:
         raw = load_yaml(text)
     except yaml.YAMLError as err:

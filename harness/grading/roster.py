@@ -22,7 +22,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from harness.errors import ConfigError
-from harness.grading.instructor_file import read_instructor_file
+from harness.text_file import read_text_file
 
 __all__ = ["Roster", "RosterEntry", "load_roster"]
 
@@ -102,5 +102,5 @@ def parse_roster(text: str, source: str = "--roster") -> Roster:
 def load_roster(path: str | Path) -> Roster:
     """The roster file at `path`; ConfigError (exit 2) when it cannot be read or is ambiguous."""
     source = f"--roster {path}"
-    text = read_instructor_file(path, MAX_ROSTER_BYTES, source)
+    text = read_text_file(path, limit=MAX_ROSTER_BYTES, name=source, kind="roster (CSV)")
     return parse_roster(text, source)

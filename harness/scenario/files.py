@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import os
-import stat
 from importlib import resources
 from pathlib import Path
 from typing import Any
@@ -26,6 +25,7 @@ from harness.scenario.checks import (
 from harness.scenario.limits import MAX_FILE_BYTES
 from harness.scenario.schema import Scenario, first_error
 from harness.scenario.yaml_loader import load_yaml, yaml_problem
+from harness.text_file import read_text_file
 
 SCENARIO_SUFFIXES = (".yaml", ".yml")
 
@@ -66,38 +66,7 @@ def parse_scenario(data: Any, *, source: str = "<scenario>") -> Scenario:
 
 def _read_text(path: Path) -> str:
     """The file's text: a regular file, at most MAX_FILE_BYTES, UTF-8; never blocks on a FIFO."""
-    name = shown(str(path))
-    try:
-        mode = os.stat(path).st_mode
-    except FileNotFoundError:
-        raise ConfigError(f"{name}: no such scenario file") from None
-    except (OSError, ValueError) as err:
-        reason = getattr(err, "strerror", None) or err
-        raise ConfigError(f"{name}: cannot read: {reason}") from None
-    if stat.S_ISDIR(mode):
-        raise ConfigError(f"{name}: is a folder, not a scenario file")
-    if not stat.S_ISREG(mode):
-        raise ConfigError(f"{name}: not a regular file")
-    try:
-        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | os.O_NOCTTY)
-        try:
-            if not stat.S_ISREG(os.fstat(fd).st_mode):  # replaced since the stat above
-                raise ConfigError(f"{name}: not a regular file")
-            with os.fdopen(os.dup(fd), "rb") as handle:
-                data = handle.read(MAX_FILE_BYTES + 1)
-        finally:
-            os.close(fd)
-    except OSError as err:
-        raise ConfigError(f"{name}: cannot read: {err.strerror or err}") from None
-    if len(data) > MAX_FILE_BYTES:
-        raise ConfigError(f"{name}: larger than {MAX_FILE_BYTES >> 20} MiB; not a scenario file")
-    try:
-        return data.decode("utf-8")
-    except UnicodeDecodeError as err:
-        line = data[: err.start].count(b"\n") + 1
-        raise ConfigError(
-            f"{name}: not UTF-8 text (byte 0x{data[err.start]:02x} at line {line})"
-        ) from None
+    return read_text_file(path, limit=MAX_FILE_BYTES, name=shown(str(path)), kind="scenario file")
 
 
 def load_scenario_file(path: str | Path) -> Scenario:

@@ -134,7 +134,7 @@ def test_options_typed_win_over_the_grading_file_even_at_their_default(tmp_path:
     ("args", "needle"),
     [
         (["approach_wall", "--grading", "{grading}"], "the grading file lists the scenarios"),
-        (["--grading", "{missing}"], "missing.yaml: No such file"),
+        (["--grading", "{missing}"], "missing.yaml: no such grading file"),
         (["--gradescope", "{folder}"], "--gradescope {folder}: a folder, not a file"),
         (["--gradescope", "{nowhere}"], "its folder does not exist"),
         (["--gradescope", "{out}", "--watch"], "--gradescope cannot go with --watch"),

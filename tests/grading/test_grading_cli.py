@@ -43,7 +43,7 @@ def classroom(tmp_path: Path) -> Path:
         (["{class}", "--out", "{file}"], "not a folder"),
         ([], "the following arguments are required: DIR"),
         (["{class}", "--scenario", "examples/narrow_corridor.yaml"], "no such scenario file"),
-        (["{class}", "--grading", "gradin.yaml"], "--grading gradin.yaml: No such file"),
+        (["{class}", "--grading", "gradin.yaml"], "--grading gradin.yaml: no such grading file"),
         (["{class}", "--grading", "{grading}", "--scenario", "out_of_range"], "give one of them"),
         (["{class}", "--grading", "{bad_grading}"], "hidden/corridor.yaml: no such scenario file"),
         (["{class}", "--roster", "{bad_roster}"], "must name the columns folder and id"),

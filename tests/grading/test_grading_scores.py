@@ -113,7 +113,7 @@ def test_a_bad_grading_file_is_one_line_naming_the_field(
 
 
 def test_a_missing_grading_file_is_a_usage_error(tmp_path: Path) -> None:
-    with pytest.raises(ConfigError, match="No such file"):
+    with pytest.raises(ConfigError, match="no such grading file"):
         load_grading_file(tmp_path / "grading.yaml")
 
 
@@ -174,3 +174,14 @@ def test_grading_into_an_earlier_output_says_what_it_replaces(tmp_path: Path) ->
     assert said is not None
     assert said.startswith("replacing the grading of 2 students from ")
     assert said.endswith(f" in {out}")
+
+
+def test_a_fifo_given_as_the_roster_is_refused_without_waiting(tmp_path: Path) -> None:
+    import os
+
+    from harness.grading.roster import load_roster
+
+    fifo = tmp_path / "roster.csv"
+    os.mkfifo(fifo)  # nobody writes to it: opening it to read would wait for ever
+    with pytest.raises(ConfigError, match="not a regular file"):
+        load_roster(fifo)
