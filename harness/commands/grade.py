@@ -457,7 +457,6 @@ def scored_rows(
             continue
         matched.add(entry.folder.casefold())
         named.append(replace(g, student_id=entry.id, full_name=entry.name))
-    unheld = {n: (0, c) for n, c in config.planned.items() if c > 0}
     for entry in roster.entries:
         if entry.folder.casefold() not in matched:
             named.append(
@@ -466,7 +465,7 @@ def scored_rows(
                     "none",
                     dict.fromkeys(config.scenarios, NOT_RUN),
                     "no submission",
-                    ticks=unheld,
+                    ticks=config.unheld,
                     points=0.0,
                     student_id=entry.id,
                     full_name=entry.name,

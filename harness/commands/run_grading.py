@@ -243,6 +243,7 @@ def _ticks(
 ) -> dict[str, tuple[int, int]]:
     """(ticks held, ticks the scenario runs when nothing breaks) of each scenario: one that
     broke early, or never ran, counts its missing ticks as not held."""
+    from harness.grading.scoring import held_of
     from harness.runner.planned_ticks import planned_ticks
 
     by_name = {r.scenario: r for r in results}
@@ -252,8 +253,8 @@ def _ticks(
     for scenario in scenarios:
         result = by_name.get(scenario.name)
         judged = len(result.records) if result is not None else 0
-        held = judged - len(result.failed_ticks) if result is not None else 0
-        of = max(judged, planned.get(scenario.name, judged))
-        if of > 0:
-            ticks[scenario.name] = (held, of)
+        failed = len(result.failed_ticks) if result is not None else 0
+        counted = held_of(judged, failed, planned.get(scenario.name, 0))
+        if counted is not None:
+            ticks[scenario.name] = counted
     return ticks

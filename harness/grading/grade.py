@@ -30,6 +30,7 @@ from harness.grading.class_table import ERROR, NOT_RUN, PASS, StudentGrade
 from harness.grading.discover import Student
 from harness.grading.hidden import HiddenScenario, scrub_folder
 from harness.grading.process import TERM_GRACE_S, Finished, StopFlag, run_bounded
+from harness.grading.scoring import held_of
 from harness.grading.worker import write_job
 from harness.judge.records import RunResult
 from harness.links.base import LinkOptions
@@ -62,6 +63,11 @@ class GradeConfig:
     student_timeout: float
     planned: dict[str, int] = field(default_factory=dict)  # scenario -> ticks when unbroken
     hidden: dict[str, HiddenScenario] = field(default_factory=dict)  # scenario -> how shown
+
+    @property
+    def unheld(self) -> dict[str, tuple[int, int]]:
+        """Every scenario's ticks, none held: the row of a student whose suite never ran."""
+        return {name: (0, count) for name, count in self.planned.items() if count > 0}
 
     @property
     def grader_dir(self) -> Path:
@@ -201,9 +207,7 @@ def verdicts_and_failures(
 def ticks_from(data: dict[str, Any], config: GradeConfig) -> dict[str, tuple[int, int]]:
     """(ticks held, ticks it should have run) of each scenario: a scenario that broke early,
     or never ran, counts its missing ticks as not held (`config.planned`, when known)."""
-    held: dict[str, tuple[int, int]] = {
-        name: (0, count) for name, count in config.planned.items() if count > 0
-    }
+    held = dict(config.unheld)
     for entry in data.get("results", []):
         if not isinstance(entry, dict) or entry.get("scenario") not in config.scenarios:
             continue
@@ -212,9 +216,9 @@ def ticks_from(data: dict[str, Any], config: GradeConfig) -> dict[str, tuple[int
             judged, failed = int(entry.get("ticks", 0)), int(entry.get("failed_ticks", 0))
         except (TypeError, ValueError):
             continue
-        of = max(judged, config.planned.get(name, 0))
-        if of > 0:
-            held[name] = (max(0, judged - failed), of)
+        counted = held_of(judged, failed, config.planned.get(name, 0))
+        if counted is not None:
+            held[name] = counted
     return {name: held[name] for name in config.scenarios if name in held}
 
 
@@ -251,7 +255,6 @@ def _grade(student: Student, config: GradeConfig, cancel: StopFlag) -> StudentGr
         shutil.rmtree(where, ignore_errors=True)
         where.mkdir(parents=True)
     not_run = dict.fromkeys(config.scenarios, NOT_RUN)
-    unheld = {n: (0, c) for n, c in config.planned.items() if c > 0}
     artifacts = tuple(
         (label, f"students/{student.slug}/{name}")
         for label, name in ARTIFACTS
@@ -272,7 +275,7 @@ def _grade(student: Student, config: GradeConfig, cancel: StopFlag) -> StudentGr
             artifacts,
             build_s=build_s,
             node=node,
-            ticks=unheld,
+            ticks=config.unheld,
             failures=failures,
         )
 

@@ -12,7 +12,7 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
-__all__ = ["ScenarioScore", "ScorePlan"]
+__all__ = ["ScenarioScore", "ScorePlan", "held_of"]
 
 PASS = "PASS"
 
@@ -89,6 +89,14 @@ class ScorePlan:
             self.earned(s.name, verdicts.get(s.name, ""), ticks.get(s.name)) for s in self.scenarios
         )
         return round(total, 2)
+
+
+def held_of(judged: int, failed: int, planned: int) -> tuple[int, int] | None:
+    """(ticks held, ticks the scenario has) of a run that judged `judged` ticks, `failed` of
+    them failed, of a scenario that has `planned` when nothing breaks: the ticks a run that
+    broke early never reached count as not held. None: nothing to count."""
+    of = max(judged, planned)
+    return (max(0, judged - failed), of) if of > 0 else None
 
 
 def points_text(value: float) -> str:
