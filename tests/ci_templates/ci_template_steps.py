@@ -15,7 +15,6 @@ import re
 import shutil
 import subprocess
 import sys
-import sysconfig
 import xml.etree.ElementTree as ET
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -23,6 +22,7 @@ from pathlib import Path
 from typing import Any
 
 import yaml
+from borrowed_venv import borrowing_venv
 
 ROOT = Path(__file__).resolve().parents[2]
 TEMPLATES = ROOT / "examples" / "ci"
@@ -77,22 +77,7 @@ class Machine:
 
     @classmethod
     def create(cls, where: Path) -> Machine:
-        subprocess.run(
-            [sys.executable, "-m", "venv", "--without-pip", str(where)], check=True, timeout=60
-        )
-        python = where / "bin" / "python"
-        purelib = subprocess.run(
-            [str(python), "-c", "import sysconfig; print(sysconfig.get_paths()['purelib'])"],
-            capture_output=True,
-            text=True,
-            check=True,
-            timeout=30,
-        ).stdout.strip()
-        project = sysconfig.get_paths()["purelib"]
-        Path(purelib, "_ci_borrows_project.pth").write_text(
-            f"import site; site.addsitedir({project!r})\n"
-        )
-        return cls(where)
+        return cls(borrowing_venv(where, "_ci_borrows_project.pth"))
 
     def environment(self, variables: Mapping[str, str]) -> dict[str, str]:
         """The process environment of a step: this machine's, then the CI's variables."""

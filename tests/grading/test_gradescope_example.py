@@ -20,11 +20,11 @@ import os
 import shutil
 import subprocess
 import sys
-import sysconfig
 from collections.abc import Mapping
 from pathlib import Path
 
 import pytest
+from borrowed_venv import borrowing_venv
 from gradescope_schema import read_results
 from grading_class import broken_setup_package, script_student
 
@@ -55,22 +55,6 @@ def working_tree_copy(target: Path) -> Path:
         (target / name).parent.mkdir(parents=True, exist_ok=True)
         shutil.copy2(source, target / name)
     return target
-
-
-def borrowing_venv(where: Path) -> Path:
-    """A virtual environment without pip that sees this project's installed packages."""
-    subprocess.run([sys.executable, "-m", "venv", "--without-pip", str(where)], check=True)
-    python = where / "bin" / "python"
-    purelib = subprocess.run(
-        [str(python), "-c", "import sysconfig; print(sysconfig.get_paths()['purelib'])"],
-        capture_output=True,
-        text=True,
-        check=True,
-        timeout=30,
-    ).stdout.strip()
-    project = sysconfig.get_paths()["purelib"]
-    Path(purelib, "_borrows_project.pth").write_text(f"import site; site.addsitedir({project!r})\n")
-    return where
 
 
 def environment(root: Path, **more: str) -> dict[str, str]:
