@@ -536,6 +536,14 @@ class BoardLink(Ros2Link):
             self.session.judged_at = time.perf_counter()
         return answers
 
+    def _settled(self) -> None:
+        """While the last scan's trailing answers are awaited, the device may repeat its
+        revolution on its own: the answers to those repeats answer no tick (as in
+        `collect`), never the last tick twice."""
+        repeat = self._repeat_from()
+        if repeat is not None:
+            self._sends = [*self._sends, (None, repeat)]
+
     def _sort(self, answers: Answers, heard: Any, mine: Any) -> None:
         """Keep the driver's scans of this exchange, in order, for pairing, and when the
         device's first repeat came."""

@@ -820,6 +820,7 @@ class Ros2Link(Link):
         while time.perf_counter() < end:
             self.observer.spin(end - time.perf_counter())
         self.observer.drain()
+        self._settled()
         late = [
             Received(h.value, h.arrived - self._sent_at, self._tick_of(h.source_ns))
             for h in self.observer.inbox
@@ -827,6 +828,9 @@ class Ros2Link(Link):
         ]
         self.observer.inbox.clear()
         return late
+
+    def _settled(self) -> None:
+        """Hook: what `settle` heard is in the inbox, before its answers get their ticks."""
 
     def _watch_silence(self, answers: Answers, tick: int, *, empty: bool = False) -> None:
         """End the run when the node misses its deadline on several scans in a row
