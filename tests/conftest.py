@@ -8,10 +8,8 @@ they were deselected on purpose (``pytest -m "not ros"``).
 from __future__ import annotations
 
 import importlib.util
-import json
 import os
 from collections.abc import Iterator
-from pathlib import Path
 
 import pytest
 
@@ -42,105 +40,6 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
             f"{len(wants_ros)} selected tests need rclpy and Fast DDS, which are not installed: "
             "pip install '.[ros]' (or source ROS 2 Jazzy), or deselect them with -m 'not ros'"
         )
-    items[:] = scheduled(items, _estimates(), _worksteal_workers(config))
-
-
-# -- the order tests run in ----------------------------------------------------------
-
-# Seconds each test file took (setup, call and teardown of all its tests) in a whole
-# run of the suite: `pytest --store-durations` rewrites it. Only the order of the
-# tests depends on it, never what they prove.
-DURATIONS = Path(__file__).with_name("durations.json")
-UNKNOWN_SLOW_S = 5.0  # a `slow` test of a file the table does not know yet
-UNKNOWN_S = 0.3  # any other test of such a file
-HEAVY_S = 5.0  # a file at least this long is dealt to a worker whole, longest first
-
-
-def _estimates() -> dict[str, float]:
-    try:
-        return {str(k): float(v) for k, v in json.loads(DURATIONS.read_text()).items()}
-    except (OSError, ValueError, AttributeError):
-        return {}  # no table: every file is estimated from its marks
-
-
-def _worksteal_workers(config: pytest.Config) -> int:
-    """How many pytest-xdist workers share the tests by work stealing (1: no dealing)."""
-    workers = int(getattr(config, "workerinput", {}).get("workercount", 1))
-    return workers if config.getoption("dist", None) == "worksteal" else 1
-
-
-def scheduled(
-    items: list[pytest.Item], seconds: dict[str, float], workers: int
-) -> list[pytest.Item]:
-    """The order that ends the run soonest, its files kept whole (a module fixture runs
-    once) and in collection order inside.
-
-    pytest-xdist's worksteal gives each worker a contiguous share of the
-    collection at the start (the first ``len // workers`` tests, then a share of
-    the rest, ...); an idle worker then steals the *last* half of the longest
-    queue. So each share starts with long files dealt longest first to the
-    share with the least time (LPT), and ends with the short tests, which are
-    what gets stolen: every long file starts early on some worker, and the run
-    does not end with one worker on a long test while the others sit idle.
-    Without work stealing the long files simply come first.
-    """
-    files: dict[str, list[pytest.Item]] = {}
-    for item in items:
-        files.setdefault(item.nodeid.split("::", 1)[0], []).append(item)
-
-    def estimate(name: str) -> float:
-        if name in seconds:
-            return seconds[name]
-        slow = sum(1 for item in files[name] if item.get_closest_marker("slow"))
-        return slow * UNKNOWN_SLOW_S + (len(files[name]) - slow) * UNKNOWN_S
-
-    longest_first = sorted(files, key=estimate, reverse=True)  # stable: ties as collected
-    heavy = [name for name in longest_first if estimate(name) >= HEAVY_S]
-    light = [item for name in files if name not in heavy for item in files[name]]
-    if workers <= 1:
-        return [item for name in heavy for item in files[name]] + light
-    sizes: list[int] = []
-    left = len(items)
-    for done in range(workers):  # worksteal's first split, by count
-        sizes.append(left // (workers - done))
-        left -= sizes[-1]
-    shares: list[list[pytest.Item]] = [[] for _ in sizes]
-    loads = [0.0] * workers
-    for name in heavy:
-        room = [i for i in range(workers) if len(shares[i]) + len(files[name]) <= sizes[i]]
-        least = min(room or range(workers), key=lambda i: loads[i])
-        shares[least] += files[name]
-        loads[least] += estimate(name)
-    ordered: list[pytest.Item] = []
-    for share, size in zip(shares, sizes, strict=True):  # the short tests fill each share
-        take = max(0, size - len(share))
-        ordered += share + light[:take]
-        del light[:take]
-    return ordered + light
-
-
-def pytest_addoption(parser: pytest.Parser) -> None:
-    parser.addoption(
-        "--store-durations",
-        action="store_true",
-        help=f"after the run, write the seconds each test file took into tests/{DURATIONS.name} "
-        "(it orders later runs; files not run keep their entries)",
-    )
-
-
-_measured: dict[str, float] = {}
-
-
-def pytest_runtest_logreport(report: pytest.TestReport) -> None:
-    """Each phase's time, by file (with xdist: the controller sees every worker's)."""
-    name = report.nodeid.split("::", 1)[0]
-    _measured[name] = _measured.get(name, 0.0) + report.duration
-
-
-def pytest_sessionfinish(session: pytest.Session) -> None:
-    config = session.config
-    if config.getoption("store_durations") and not hasattr(config, "workerinput"):
-        # Merged into the table: a run of some files updates theirs, keeps the rest.
-        table = {**_estimates(), **_measured}
-        kept = {k: round(v, 1) for k, v in sorted(table.items()) if (config.rootpath / k).is_file()}
-        DURATIONS.write_text(json.dumps(kept, indent=1) + "\n")
+    # The longest tests first (a stable sort keeps the rest in order): started
+    # last, one of them would run on alone while the other workers sit idle.
+    items.sort(key=lambda item: item.get_closest_marker("slow") is None)
