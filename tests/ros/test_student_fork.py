@@ -45,12 +45,18 @@ CRASHING = "import rclpy\n\n\ndef main():\n    raise ValueError('no scan yet')\n
 
 
 def wait_for(process: NodeProcess, text: str, seconds: float = 10.0) -> str:
-    """The node's stderr once it holds `text` (bounded)."""
+    """The node's stderr once a whole line of it holds `text` (bounded): a command's
+    stderr is unbuffered, so a print's words may be read before the rest of its line."""
     import time
+
+    def said() -> bool:
+        output = process._outputs.get("stderr")
+        lines = output.text().splitlines(keepends=True) if output is not None else []
+        return any(text in line and line.endswith("\n") for line in lines)
 
     end = time.monotonic() + seconds
     while time.monotonic() < end:
-        if text in process.tail("stderr", 40):
+        if said():
             return process.tail("stderr", 40)
         if process.returncode() is not None:
             break
