@@ -109,7 +109,12 @@ class BoardLink(Ros2Link):
         self._repeat_at: int | None = None  # the first repeat's scan in this exchange, if any
         self._line_damage: LineDamage | None = None
         self._first_damage: LineDamage | None = None  # as it was before the first scan's copy
+        self._after_first: LineDamage | None = None  # as it was after it (copies were sent)
         self._after_idle = False  # the first exchange after the idle stream is next
+        # The node may still answer idle revolutions during the first tick (it lagged, or
+        # answered none before the first tick, so how many it owes is not known).
+        self._idle_owed = False
+        self._idle_quiet_s = 0.0  # three revolutions at the first scan's rate
 
     @classmethod
     def run_session(cls, options: LinkOptions) -> BoardSession:
@@ -304,19 +309,33 @@ class BoardLink(Ros2Link):
         self._end_idle_stream(scan)
         self._after_idle = True
         super().send_first(scan, tick, clock=clock)
+        self._after_copies()
         assert self.server is not None
         self.server.align_stream()
 
     def _copy(self, n: int) -> None:
-        """Each copy of the first scan is damaged as the first was (the same draws), so
-        the line's damage from then on does not depend on how many copies it took."""
+        """Each later copy of the first scan is damaged from the line's state before the
+        first copy, by a scratch copy of it, after the stream was ended on a whole start
+        marker (so its bytes are the first's: the first came after the idle stream's),
+        and once the copies are out the line goes on from its state after the first copy
+        (`_after_copies`): what the driver makes of each copy, the line's damage from
+        then on, and its counts do not depend on how many copies it took."""
         assert self.server is not None
         if self._line_damage is None:
             return
         if n == 0:
             self._first_damage = copy.deepcopy(self._line_damage)
-        elif self._first_damage is not None:
-            self._line_damage = copy.deepcopy(self._first_damage)
+            return
+        if n == 1:
+            self._after_first = self._line_damage
+        self.server.align_stream()  # the copy's bytes are the first's
+        if self._first_damage is not None:
+            self.server.damage = copy.deepcopy(self._first_damage)
+
+    def _after_copies(self) -> None:
+        assert self.server is not None
+        if self._after_first is not None:
+            self._line_damage, self._after_first = self._after_first, None
             self.server.damage = self._line_damage
 
     def _end_idle_stream(self, scan: Scan) -> None:
@@ -358,6 +377,7 @@ class BoardLink(Ros2Link):
 
         self._wait_for(driver_quiet, IDLE_QUIET_MAX_S)
         idle = [h.source_ns for h in obs.inbox if h.kind == "scan"]
+        self._idle_quiet_s, self._idle_owed = quiet_s, bool(idle)
         if idle and answered:
             # A node lagging on a loaded machine answers older scans after the last one
             # was published: wait (bounded) until it answered after the last idle scan and
@@ -369,7 +389,7 @@ class BoardLink(Ros2Link):
                 last = max((h.arrived for h in obs.inbox if h.kind == "status"), default=began)
                 return time.perf_counter() - last > quiet_s
 
-            self._wait_for(answers_done, IDLE_LAST_ANSWER_S)
+            self._idle_owed = self._wait_for(answers_done, IDLE_LAST_ANSWER_S) == "timeout"
             self._wait_for(lambda: False, self._grace())  # its Bool, if any
         obs.drain()
         obs.inbox.clear()
@@ -506,11 +526,22 @@ class BoardLink(Ros2Link):
         return self._statuses() >= max(len(self._driver_scans()), 1)
 
     def _settle_answers(self) -> None:
-        """Line faults: more statuses than driver scans heard may mean a late scan's
+        """The first tick, when the node may still owe answers to idle revolutions: wait
+        (bounded) until it has been quiet for three revolutions, so its answer to this
+        tick, which comes after those, is in (`collect` keeps the last).
+
+        Line faults: more statuses than driver scans heard may mean a late scan's
         answer overtook the scan on its way to us (two topics, two readers). Wait a
         moment for it; a node that simply answers twice costs that moment."""
+        if self._after_idle and self._idle_owed:
+            self._wait_for(self._statuses_quiet, IDLE_LAST_ANSWER_S)
         if self._line_damage is not None and self._statuses() > len(self._driver_scans()):
             self._wait_for(lambda: len(self._driver_scans()) >= self._statuses(), SCAN_CATCH_UP_S)
+
+    def _statuses_quiet(self) -> bool:
+        assert self.observer is not None
+        last = max((h.arrived for h in self.observer.inbox if h.kind == "status"), default=0.0)
+        return time.perf_counter() - last > self._idle_quiet_s
 
     def collect(self, scan: Scan, tick: int, *, may_be_ignored: bool = False) -> Answers:
         if self._lost is not None:
@@ -519,6 +550,11 @@ class BoardLink(Ros2Link):
             return Answers(lost=self._lost)
         assert self.observer is not None
         self._heard_scans = []
+        if self._after_idle:
+            # Not the first copy's answer (the ros2 link's rule: there the node saw
+            # nothing before it): here idle revolutions came before, and the node
+            # answers in order, so the last answer is the last copy's.
+            self._copies = 1
         answers = super().collect(scan, tick, may_be_ignored=may_be_ignored)
         if self._after_idle:
             self._after_idle = False
