@@ -41,6 +41,7 @@ from harness.lidar.scan import Scan
 from harness.links.base import LinkOptions
 from harness.links.board_session import BoardSession
 from harness.links.ros2 import POLL_S, Ros2Link
+from harness.nodes.quiescence import Quiescence
 from harness.ros.observer import Heard
 
 if TYPE_CHECKING:
@@ -60,6 +61,7 @@ IDLE_QUIET_MAX_S = 2.0  # longest wait for a lagging driver's last idle revoluti
 # and fall quiet: answered later, during the first tick, one would be taken for the first
 # tick's answer (seen in CI: out_of_range's tick 0 answered with approach_wall's last).
 IDLE_LAST_ANSWER_S = 3.0
+IDLE_IN_FLIGHT_S = 0.03  # then for an answer already published to reach us
 
 
 def board_options(options: LinkOptions) -> LinkOptions:
@@ -378,7 +380,14 @@ class BoardLink(Ros2Link):
         self._wait_for(driver_quiet, IDLE_QUIET_MAX_S)
         idle = [h.source_ns for h in obs.inbox if h.kind == "scan"]
         self._idle_quiet_s, self._idle_owed = quiet_s, bool(idle)
-        if idle and answered:
+        pids = self._local_pids()
+        if idle and pids:
+            # The node and the board's software run here: wait (bounded) until every
+            # thread of theirs sleeps, so none has a revolution left to answer.
+            done = self._wait_for(Quiescence(pids), IDLE_LAST_ANSWER_S) is None
+            self._idle_owed = not done
+            self._wait_for(lambda: False, max(self._grace(), IDLE_IN_FLIGHT_S))
+        elif idle and answered:
             # A node lagging on a loaded machine answers older scans after the last one
             # was published: wait (bounded) until it answered after the last idle scan and
             # then said nothing for three revolutions, so no idle answer is left to arrive
@@ -393,6 +402,15 @@ class BoardLink(Ros2Link):
             self._wait_for(lambda: False, self._grace())  # its Bool, if any
         obs.drain()
         obs.inbox.clear()
+
+    def _local_pids(self) -> list[int]:
+        """The node under test and the virtual board's processes (none for a physical
+        board: its software runs elsewhere)."""
+        if self.physical:
+            return []
+        processes = [p for _, p in self.session.processes] if self.session is not None else []
+        processes += [self.process] if self.process is not None else []
+        return [p.node_pid for p in processes if p.node_pid is not None]
 
     def _idle_over(self, rate: float) -> None:
         """End the session's idle stream (this scenario's first push comes next); line
