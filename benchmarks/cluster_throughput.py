@@ -54,13 +54,11 @@ def make_class(folder: Path, students: int) -> None:
         students - 2: "hangs",
         students - 1: "kills_worker",
     }
-    from cluster_nodes import HANGS, KILLS_ITS_WORKER, VARIANT
+    from cluster_nodes import HANGS, KILLS_ITS_WORKER, variant_source
 
     for index in range(students):
         kind = special.get(index, "correct")
-        source = {"hangs": HANGS, "kills_worker": KILLS_ITS_WORKER}.get(
-            kind, VARIANT.format(variant=kind)
-        )
+        source = {"hangs": HANGS, "kills_worker": KILLS_ITS_WORKER}.get(kind, variant_source(kind))
         (folder / f"s{index:03d}").mkdir(parents=True)
         (folder / f"s{index:03d}" / "lidar_node.py").write_text(source)
 

@@ -8,12 +8,13 @@ from pathlib import Path
 
 STUDENT_NODE = Path(__file__).resolve().parent / "ros" / "student_node.py"
 
-# VARIANT.format(variant=...) runs a student_node variant.
-VARIANT = (
-    "import runpy\nimport sys\n\n"
-    'sys.argv[1:1] = ["{variant}"]\n'
-    f'runpy.run_path({str(STUDENT_NODE)!r}, run_name="__main__")\n'
-)
+
+def variant_source(variant: str) -> str:
+    """A student_node variant as one self-contained file: what a student hands in (a
+    sandboxed node sees its own folder only, never the test suite's files)."""
+    return f"import sys\n\nsys.argv[1:1] = [{variant!r}]\n" + STUDENT_NODE.read_text()
+
+
 HANGS = (
     "import signal\nimport time\n\n"
     "signal.signal(signal.SIGTERM, signal.SIG_IGN)  # and never comes up\n"

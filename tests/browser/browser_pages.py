@@ -114,9 +114,7 @@ def make_class(folder: Path) -> list[tuple[int, str]]:
     for name, variant in STUDENTS.items():
         (classroom / name).mkdir(parents=True)
         (classroom / name / "lidar_node.py").write_text(
-            "import runpy\nimport sys\n\n"
-            f"sys.argv[1:1] = [{variant!r}]\n"
-            f'runpy.run_path({str(STUDENT_NODE)!r}, run_name="__main__")\n'
+            f"import sys\n\nsys.argv[1:1] = [{variant!r}]\n" + STUDENT_NODE.read_text()
         )
     options = ("--workers", "2", "--scenario", ",".join(SCENARIOS), "--no-audit")
     return [command("grade", "class", "--out", "grades", *options, cwd=folder, timeout=200)]

@@ -54,11 +54,8 @@ def broken_setup_package(folder: Path) -> Path:
 def script_student(folder: Path) -> Path:
     """One .py file, as a student without a package hands in (the correct variant)."""
     folder.mkdir(parents=True)
-    (folder / "lidar_node.py").write_text(
-        "import runpy\nimport sys\n\n"
-        "# the test suite's student node, correct variant\n"
-        'sys.argv[1:1] = ["correct"]\n'
-        f'runpy.run_path({str(STUDENT_NODE)!r}, run_name="__main__")\n'
+    (folder / "lidar_node.py").write_text(  # the test suite's student node, correct variant
+        'import sys\n\nsys.argv[1:1] = ["correct"]\n' + STUDENT_NODE.read_text()
     )
     return folder
 
