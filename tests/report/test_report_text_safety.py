@@ -194,7 +194,7 @@ def _result(status: str, diagnostics: str, error: str, scenario: str) -> RunResu
     )
 
 
-@settings(max_examples=examples(220), deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=examples(120), deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(status=LONG_TEXTS, diagnostics=LONG_TEXTS, error=LONG_TEXTS, scenario=TEXTS)
 def test_any_text_makes_valid_bounded_reports(
     status: str, diagnostics: str, error: str, scenario: str

@@ -40,7 +40,7 @@ pytestmark = [pytest.mark.timeout(300), pytest.mark.slow]
 
 # Each option's hostile values are also refused one by one through the real command
 # (test_hostile_input.py's test_hostile_option); here they are mixed.
-EXAMPLES = examples(120)
+EXAMPLES = examples(60)
 TINY = """\
 description: Three ticks beside a wall.
 obstacles:

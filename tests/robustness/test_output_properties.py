@@ -31,7 +31,7 @@ from harness.safe_text import TEXT_LIMIT
 
 pytestmark = [pytest.mark.timeout(600), pytest.mark.slow]
 
-EXAMPLES = examples(36)  # each writes a whole report folder (a plot, a recording); 200+ at the
+EXAMPLES = examples(20)  # each writes a whole report folder (a plot, a recording); 200+ at the
 # writers alone: tests/report/test_report_text_safety.py
 ONE_TICK = """\
 description: One tick beside a wall.

@@ -43,8 +43,8 @@ from harness.scenario.files import load_scenario_file
 from harness.scenario.geometry import cylinder_segments
 from harness.scenario.schema import Cylinder, Scenario
 
-IN_PROCESS_EXAMPLES = 400
-CLI_EXAMPLES = 22
+IN_PROCESS_EXAMPLES = 200
+CLI_EXAMPLES = 16
 # A valid scenario is run only if it is this cheap; the generator keeps almost all of them so.
 RUN_SECONDS, RUN_BEAMS, RUN_CYLINDER_SIDES = 5.0, 300_000, 20_000
 
