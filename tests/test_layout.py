@@ -34,7 +34,7 @@ GROUND = {
 # Bottom to top; a package imports only from layers below its own.
 LAYERS: list[set[str]] = [
     {"lidar", "nodes", "serial_line", "cluster"},
-    {"faults", "devices", "ros", "launch_files"},
+    {"faults", "devices", "ros", "launch_files", "sandbox"},
     {"scenario", "judge"},
     {"sim", "record"},
     {"links", "report"},
@@ -77,6 +77,9 @@ PURE = [
     "harness.grading.gradescope",
     "harness.grading.gradebook",
     "harness.grading.student_text",
+    "harness.sandbox.bwrap",
+    "harness.sandbox.limits",
+    "harness.sandbox.refusals",
 ]
 
 

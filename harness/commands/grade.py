@@ -8,6 +8,7 @@ output folder's layout, are in docs/grading.md.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import csv
 import importlib.util
 import json
@@ -30,9 +31,10 @@ from harness.commands.arguments import (
     link_options,
 )
 from harness.commands.cluster_options import add_cluster_options, describe_cluster, workers
+from harness.commands.sandbox_options import add_sandbox_options, check_workers, sandbox_limits
 from harness.errors import ConfigError
 from harness.grading import LAB_EXECUTABLE, LAB_PACKAGE
-from harness.grading.discover import GRADES_MARKER, Student
+from harness.grading.discover import GRADES_MARKER, Student, absolute
 from harness.holder_lock import HolderLock
 from harness.report.folder_lock import lock_folder
 
@@ -125,6 +127,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "fossbot-hil audit)",
     )
     add_cluster_options(parser, unit="students")
+    add_sandbox_options(parser)
     add_node_options(parser)
     _adapt_node_options(parser)
 
@@ -314,17 +317,22 @@ def run(args: argparse.Namespace, console: Console) -> int:
         raise ConfigError(
             "grading needs rclpy: pip install 'fossbot-hil[ros]' (or source ROS 2 Jazzy)"
         )
+    sandbox = sandbox_limits(args, console)  # this machine cannot sandbox: exit 2 now
     planned = planned_ticks(scenarios, settings)  # what a partial score counts against
     replaced = previous_grading(out)
-    with (
-        open_client(
-            args.scheduler, args.workers, retries=WORKER_RETRIES, worker_wait=args.worker_wait
-        ) as client,
-        prepare_out(out),  # the folder is this grade's until it is done
-    ):
+    with contextlib.ExitStack() as stack:
+        client = stack.enter_context(
+            open_client(
+                args.scheduler, args.workers, retries=WORKER_RETRIES, worker_wait=args.worker_wait
+            )
+        )
+        if sandbox is not None and args.scheduler:
+            check_workers(client, console)  # the embedded cluster's are this machine's
+        stack.enter_context(prepare_out(out))  # the folder is this grade's until it is done
         from harness.grading.archives import UNPACKED, unpack_submissions
 
         found.students = unpack_submissions(found, out / UNPACKED)  # now that --out is ours
+        found.students = [absolute(s) for s in found.students]  # workers run elsewhere
         if any(s.kind in ("package", "workspace") for s in found.students):
             colcon_executable()  # an archive may hold the class's first package
         names = tuple(s.name for s in scenarios)
@@ -341,6 +349,7 @@ def run(args: argparse.Namespace, console: Console) -> int:
             hidden={
                 s.name: HiddenScenario(s.label, s.show_failure) for s in plan.scenarios if s.hidden
             },
+            sandbox=sandbox,
         )
         if replaced:
             console.print(replaced, markup=False, highlight=False)

@@ -16,6 +16,9 @@ from pathlib import Path
 from harness.errors import ConfigError
 from harness.grading.discover import Student
 from harness.grading.process import Finished, StopFlag, run_bounded
+from harness.sandbox.limits import SandboxLimits
+from harness.sandbox.refusals import refused_in
+from harness.sandbox.student import sandboxed_build
 
 __all__ = ["BuildResult", "build_student", "build_error", "colcon_command"]
 
@@ -175,12 +178,17 @@ def build_student(
     log: Path,
     timeout: float,
     cancel: StopFlag | None = None,
+    sandbox: SandboxLimits | None = None,
 ) -> BuildResult:
-    """Build `student` into `workspace` (wiped first), logging colcon's output to `log`."""
+    """Build `student` into `workspace` (wiped first), logging colcon's output to `log`;
+    in a sandbox under `sandbox`'s limits unless it is None."""
     shutil.rmtree(workspace, ignore_errors=True)
     workspace.mkdir(parents=True)
+    command = colcon_command(student, workspace, colcon_executable())
+    if sandbox is not None:
+        command = sandboxed_build(command, student.folder, workspace, sandbox)
     finished = run_bounded(
-        colcon_command(student, workspace, colcon_executable()),
+        command,
         log=log,
         timeout=timeout,
         max_log_bytes=MAX_LOG_BYTES,
@@ -191,6 +199,8 @@ def build_student(
     if error is None and finished.returncode != 0:
         text = log.read_text(encoding="utf-8", errors="replace")
         error = build_error(text, hide=(student.folder, workspace))
+        refused = None if sandbox is None else refused_in(text, sandbox)
+        error += f" ({refused})" if refused else ""
     if error is None:
         error = check_installed(workspace / "install", package, executable)
     return BuildResult(workspace, finished.wall_s, error)

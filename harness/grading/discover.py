@@ -72,6 +72,21 @@ class Student:
     slug: str = ""  # a file-name-safe, unique form of `name` for the artifact folder
 
 
+def absolute(student: Student) -> Student:
+    """`student` with every path absolute (no link followed): a cluster worker runs in a
+    folder of its own, where the paths given on the command line mean nothing."""
+
+    def made(path: Path) -> Path:
+        return Path(os.path.abspath(path))
+
+    return replace(
+        student,
+        folder=made(student.folder),
+        base_paths=tuple(made(p) for p in student.base_paths),
+        script=None if student.script is None else made(student.script),
+    )
+
+
 @dataclass(frozen=True)
 class Entry:
     """A hand-in found, before it is named (`named` names them all together)."""

@@ -35,6 +35,10 @@ from harness.grading.worker import write_job
 from harness.judge.records import RunResult
 from harness.links.base import LinkOptions
 from harness.runner.settings import RunSettings
+from harness.sandbox.limits import SandboxLimits
+from harness.sandbox.probe import sandbox_problem
+from harness.sandbox.refusals import refused_in
+from harness.sandbox.student import sandboxed_run
 
 __all__ = ["GradeConfig", "grade_class", "grade_student"]
 
@@ -63,6 +67,7 @@ class GradeConfig:
     student_timeout: float
     planned: dict[str, int] = field(default_factory=dict)  # scenario -> ticks when unbroken
     hidden: dict[str, HiddenScenario] = field(default_factory=dict)  # scenario -> how shown
+    sandbox: SandboxLimits | None = None  # each student's build and run in bubblewrap
 
     @property
     def unheld(self) -> dict[str, tuple[int, int]]:
@@ -281,6 +286,8 @@ def _grade(student: Student, config: GradeConfig, cancel: StopFlag) -> StudentGr
 
     if student.problem is not None:
         return without_run(student.problem)
+    if config.sandbox is not None and (problem := sandbox_problem()) is not None:
+        return without_run(f"could not grade: {problem}")  # this worker cannot sandbox
     build_s = None
     if student.kind in ("package", "workspace"):
         built = build_student(
@@ -291,6 +298,7 @@ def _grade(student: Student, config: GradeConfig, cancel: StopFlag) -> StudentGr
             log=folder / "build.log",
             timeout=config.build_timeout,
             cancel=cancel,
+            sandbox=config.sandbox,
         )
         build_s = built.wall_s
         if not built.ok:
@@ -312,7 +320,7 @@ def _grade(student: Student, config: GradeConfig, cancel: StopFlag) -> StudentGr
         },
     )
     finished = run_bounded(
-        [sys.executable, "-m", "harness.grading.worker", str(job)],
+        _judging_command(job, student, config, folder, grader),
         log=folder / "run.log",
         timeout=config.student_timeout,
         max_log_bytes=MAX_RUN_LOG_BYTES,
@@ -322,6 +330,8 @@ def _grade(student: Student, config: GradeConfig, cancel: StopFlag) -> StudentGr
     data = _read_results(grader / "results.json")
     verdicts, failures = verdicts_and_failures(data, finished, config, folder, options.node)
     first = next((failures[n] for n in config.scenarios if n in failures), "")
+    refused = None if config.sandbox is None else refused_in(first, config.sandbox)
+    first += f" ({refused})" if refused else ""
     if not (folder / "junit.xml").exists():
         _placeholder_junit(config, folder, first or "no results")
     scrub_folder(folder, student_scrub(student, config, folder))
@@ -337,6 +347,25 @@ def _grade(student: Student, config: GradeConfig, cancel: StopFlag) -> StudentGr
         node=node,
         failures=failures,
         notes=_notes(data),
+    )
+
+
+def _judging_command(
+    job: Path, student: Student, config: GradeConfig, folder: Path, grader: Path
+) -> list[str]:
+    """The worker that runs the student's suite; in its sandbox, the node in a nested one
+    that shows only the node's own files (its script's folder, or its build)."""
+    command = [sys.executable, "-m", "harness.grading.worker", str(job)]
+    if config.sandbox is None:
+        return command
+    node_files = [student.folder] if student.kind == "script" else [folder / "colcon"]
+    scenario_files = [Path(ref) for ref in config.scenario_refs if Path(ref).is_absolute()]
+    return sandboxed_run(
+        command,
+        node_files=node_files,
+        scenario_files=scenario_files,
+        outputs=[folder, grader],
+        limits=config.sandbox,
     )
 
 

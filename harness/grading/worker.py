@@ -14,6 +14,7 @@ account goes to stdout (run.log), as ``fossbot-hil run`` prints it.
 from __future__ import annotations
 
 import json
+import os
 import signal
 import sys
 import time
@@ -24,6 +25,7 @@ from typing import Any
 from harness.atomic_write import write_atomically
 from harness.errors import ConfigError
 from harness.judge.records import RunResult
+from harness.nodes.sandbox_prefix import NODE_SANDBOX_ENV
 from harness.report.summary import verdict_of
 
 __all__ = [
@@ -188,6 +190,15 @@ def _hidden_scenarios(data: dict[str, Any]) -> dict[str, Any]:
     }
 
 
+def _not_dumpable() -> None:
+    """In a sandbox: the node shares this process's PIDs, so keep it out of this process's
+    /proc entries (its open files, its root, its memory: the scenario files)."""
+    import ctypes
+
+    PR_SET_DUMPABLE = 4
+    ctypes.CDLL(None, use_errno=True).prctl(PR_SET_DUMPABLE, 0, 0, 0, 0)
+
+
 def interrupt_on_sigterm() -> None:
     def handler(signum: int, frame: object) -> None:
         raise KeyboardInterrupt
@@ -200,6 +211,8 @@ def main(argv: list[str]) -> int:
         print("usage: python -m harness.grading.worker JOB.json", file=sys.stderr)
         return 2
     interrupt_on_sigterm()
+    if os.environ.get(NODE_SANDBOX_ENV):
+        _not_dumpable()
     job = json.loads(Path(argv[0]).read_text(encoding="utf-8"))
     return run_job(job)
 

@@ -45,6 +45,7 @@ import sys
 from collections.abc import Iterator
 
 from harness.nodes.quick_exit import exit_now, finish_interpreter
+from harness.nodes.sandbox_prefix import node_sandbox_prefix, parent_for
 
 READY_WAIT_S = 10.0  # for the server's imports (a cold disk cache is slow)
 ANSWER_WAIT_S = 5.0  # for a fork
@@ -105,8 +106,17 @@ class ForkServer:
         # What the server's interpreter started with: what a node started anew gets.
         self.env = {**os.environ, "PYTHONUNBUFFERED": "1"}
         try:
+            sandbox = node_sandbox_prefix()  # grading: the nodes' nested sandbox
             self._process: subprocess.Popen[bytes] | None = subprocess.Popen(
-                [sys.executable, "-m", __name__, str(theirs.fileno()), str(os.getpid()), module],
+                [
+                    *sandbox,
+                    sys.executable,
+                    "-m",
+                    __name__,
+                    str(theirs.fileno()),
+                    parent_for(sandbox),
+                    module,
+                ],
                 pass_fds=(theirs.fileno(),),
                 env=self.env,
                 stdin=subprocess.DEVNULL,
@@ -439,7 +449,7 @@ def main(argv: list[str]) -> int:
     sock = socket.socket(fileno=int(fd))
     libc = ctypes.CDLL(None, use_errno=True)
     libc.prctl(1, signal.SIGKILL, 0, 0, 0)  # PR_SET_PDEATHSIG: go when the harness goes
-    if os.getppid() != int(parent):
+    if os.getppid() != (int(parent) or os.getppid()):  # 0: a sandbox's launcher started us
         return 1
     try:
         importlib.import_module(module)

@@ -30,6 +30,7 @@ from harness.nodes.forkserver import ForkedSupervisor, ForkServer
 from harness.nodes.forkserver import shared as shared_fork_server
 from harness.nodes.python_script import SERVER_MODULE as SCRIPT_SERVER_MODULE
 from harness.nodes.python_script import ScriptCommand, plan_start, script_command
+from harness.nodes.sandbox_prefix import node_sandbox_prefix, parent_for
 
 REAPER = Path(__file__).with_name("reaper.py")
 INT_GRACE_S = 2.0  # a ROS 2 node stops on SIGINT well within this
@@ -194,13 +195,15 @@ class NodeProcess:
         status_r, status_w = os.pipe()
         out_r, out_w = os.pipe()
         err_r, err_w = os.pipe()
+        sandbox = node_sandbox_prefix()  # grading: the node's nested sandbox
         argv = [
+            *sandbox,
             sys.executable,
             "-I",  # the reaper needs the standard library only
             "-S",
             str(REAPER),
             str(status_w),
-            str(os.getpid()),
+            parent_for(sandbox),
             f"{INT_GRACE_S:g}",
             f"{TERM_GRACE_S:g}",
             "--",

@@ -225,7 +225,7 @@ def main(argv: list[str]) -> int:
         separator = argv.index("--", 4)
         command = argv[separator + 1 :]
         reaper = Reaper(int(status_fd), float(int_grace), float(term_grace))
-        parent_pid = int(parent)
+        parent_pid = int(parent) or os.getppid()  # 0: a sandbox's launcher started us
     except ValueError:
         print(__doc__, file=sys.stderr)
         return 2
