@@ -363,6 +363,13 @@ def run(args: argparse.Namespace, console: Console) -> int:
             markup=False,
             highlight=False,
         )
+        if sandbox is not None:
+            console.print(
+                f"each student in a bubblewrap sandbox: {sandbox.describe()} "
+                "(--sandbox-memory, --sandbox-processes)",
+                markup=False,
+                highlight=False,
+            )
         _show_dashboard(console, dashboard(client))
         started = time.monotonic()
         with task_progress(console, "students", failed="not all passed") as progress:

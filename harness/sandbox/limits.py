@@ -32,4 +32,4 @@ class SandboxLimits:
         ]
 
     def describe(self) -> str:
-        return f"{self.memory_mb} MB of memory per process, {self.processes} processes"
+        return f"{self.memory_mb} MB of memory per process, at most {self.processes} processes"

@@ -201,7 +201,9 @@ def test_embedded_cluster_contains_the_hostile_hand_in(
 ) -> None:
     root = make_course(tmp_path, listener, hostile=True)
     before = {"class": snapshot(root / "class"), "course": snapshot(root / "course")}
-    grade(root)
+    done = grade(root)
+    said = f"each student in a bubblewrap sandbox: {SANDBOX_MB} MB of memory per process"
+    assert said in done.stdout
     check_rows(rows(root / "grades"), unsandboxed)
     check_contained(root, before, listener.connections)
 
@@ -216,3 +218,22 @@ def test_external_cluster_contains_the_hostile_hand_in(
     check_rows(rows(root / "grades"), unsandboxed)
     check_contained(root, before, listener.connections)
     shutil.rmtree(root / "grades", ignore_errors=True)
+
+
+def test_an_external_cluster_whose_workers_cannot_sandbox_is_refused(tmp_path: Path) -> None:
+    """Workers without bubblewrap (here: none on their PATH) are named, never used
+    silently: with no worker able to sandbox, grade exits 2 before any student runs."""
+    (tmp_path / "class" / "ana").mkdir(parents=True)
+    (tmp_path / "class" / "ana" / "lidar_node.py").write_text(variant_source("correct"))
+    with dask_cluster(1, nanny=False, env={**GRADING_ENV, "PATH": str(tmp_path)}) as (address, _):
+        done = subprocess.run(
+            [*COMMAND, "grade", "class", "--scenario", "approach_wall", "--no-audit"]
+            + ["--scheduler", address],
+            cwd=tmp_path,
+            capture_output=True,
+            text=True,
+            timeout=120,
+        )
+    assert done.returncode == 2, done.stdout + done.stderr
+    assert "bwrap is not installed on " in done.stderr and "--no-sandbox" in done.stderr
+    assert not (tmp_path / "grades" / "students").exists()

@@ -13,6 +13,7 @@ import contextlib
 import io
 import json
 import re
+import shutil
 import subprocess
 import sys
 import xml.dom.minidom
@@ -131,10 +132,14 @@ def test_grading_a_student_writing_control_characters_gives_safe_tables(tmp_path
     """`fossbot-hil grade`: the student's junit.xml, grades.csv and grades.html are safe."""
     student = tmp_path / "class" / "mallory"
     student.mkdir(parents=True)
+    (student / "lib").mkdir()
+    shutil.copy(HOSTILE, student / "lib" / "hostile_node.py")  # in the hand-in, as a sandbox
+    # shows only the hand-in
     (student / "lidar_node.py").write_text(
-        "import runpy\nimport sys\n\n"
+        "import os\nimport runpy\nimport sys\n\n"
         'sys.argv[1:1] = ["control_characters"]\n'
-        f'runpy.run_path({str(HOSTILE)!r}, run_name="__main__")\n'
+        'runpy.run_path(os.path.join(os.path.dirname(__file__), "lib", "hostile_node.py"), '
+        'run_name="__main__")\n'
     )
     out = tmp_path / "grades"
     done = subprocess.run(
