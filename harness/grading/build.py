@@ -17,7 +17,7 @@ from harness.errors import ConfigError
 from harness.grading.discover import Student
 from harness.grading.process import Finished, StopFlag, run_bounded
 from harness.sandbox.limits import SandboxLimits
-from harness.sandbox.refusals import refused_in
+from harness.sandbox.refusals import refusal_of
 from harness.sandbox.student import sandboxed_build
 
 __all__ = ["BuildResult", "build_student", "build_error", "colcon_command"]
@@ -199,7 +199,7 @@ def build_student(
     if error is None and finished.returncode != 0:
         text = log.read_text(encoding="utf-8", errors="replace")
         error = build_error(text, hide=(student.folder, workspace))
-        refused = None if sandbox is None else refused_in(text, sandbox)
+        refused = None if sandbox is None else refusal_of(text, sandbox)
         error += f" ({refused})" if refused else ""
     if error is None:
         error = check_installed(workspace / "install", package, executable)

@@ -37,7 +37,7 @@ from harness.links.base import LinkOptions
 from harness.runner.settings import RunSettings
 from harness.sandbox.limits import SandboxLimits
 from harness.sandbox.probe import sandbox_problem
-from harness.sandbox.refusals import refused_in
+from harness.sandbox.refusals import refusal_of
 from harness.sandbox.student import sandboxed_run
 
 __all__ = ["GradeConfig", "grade_class", "grade_student"]
@@ -330,7 +330,7 @@ def _grade(student: Student, config: GradeConfig, cancel: StopFlag) -> StudentGr
     data = _read_results(grader / "results.json")
     verdicts, failures = verdicts_and_failures(data, finished, config, folder, options.node)
     first = next((failures[n] for n in config.scenarios if n in failures), "")
-    refused = None if config.sandbox is None else refused_in(first, config.sandbox)
+    refused = None if config.sandbox is None else refusal_of(first, config.sandbox)
     first += f" ({refused})" if refused else ""
     if not (folder / "junit.xml").exists():
         _placeholder_junit(config, folder, first or "no results")

@@ -393,10 +393,7 @@ class BoardLink(Ros2Link):
             # then said nothing for three revolutions, so no idle answer is left to arrive
             # during the first tick.
             def answers_done() -> bool:
-                if not obs.heard_since("status", max(idle)):
-                    return False
-                last = max((h.arrived for h in obs.inbox if h.kind == "status"), default=began)
-                return time.perf_counter() - last > quiet_s
+                return obs.heard_since("status", max(idle)) and self._statuses_quiet()
 
             self._idle_owed = self._wait_for(answers_done, IDLE_LAST_ANSWER_S) == "timeout"
             self._wait_for(lambda: False, self._grace())  # its Bool, if any
@@ -556,7 +553,13 @@ class BoardLink(Ros2Link):
         if self._line_damage is not None and self._statuses() > len(self._driver_scans()):
             self._wait_for(lambda: len(self._driver_scans()) >= self._statuses(), SCAN_CATCH_UP_S)
 
+    def _one_answer_of_the_copies(self, answers: Answers) -> None:
+        """Not the first copy's answer, as over ROS 2: idle revolutions came before the
+        copies, and the node answers in order, so the last answer is the last copy's
+        (`collect` keeps it, setting aside what answered the idle stream)."""
+
     def _statuses_quiet(self) -> bool:
+        """The node said nothing for three revolutions (it has at least answered once)."""
         assert self.observer is not None
         last = max((h.arrived for h in self.observer.inbox if h.kind == "status"), default=0.0)
         return time.perf_counter() - last > self._idle_quiet_s
@@ -568,11 +571,6 @@ class BoardLink(Ros2Link):
             return Answers(lost=self._lost)
         assert self.observer is not None
         self._heard_scans = []
-        if self._after_idle:
-            # Not the first copy's answer (the ros2 link's rule: there the node saw
-            # nothing before it): here idle revolutions came before, and the node
-            # answers in order, so the last answer is the last copy's.
-            self._copies = 1
         answers = super().collect(scan, tick, may_be_ignored=may_be_ignored)
         if self._after_idle:
             self._after_idle = False

@@ -726,7 +726,7 @@ class Ros2Link(Link):
         self._sort(answers, obs.inbox, mine)
         obs.inbox.clear()
         if self._copies > 1:  # the first scan went more than once: one answer is this tick's
-            answers.first_answer_only()
+            self._one_answer_of_the_copies(answers)
         self._copies = 1
         if answers.timed_out:  # whatever came after the deadline is late, not an answer
             answers.late += [
@@ -740,6 +740,11 @@ class Ros2Link(Link):
             self._watch_silence(answers, tick, empty=not scan.valid_mask().any())
         self._watch_flood(answers)
         return answers
+
+    def _one_answer_of_the_copies(self, answers: Answers) -> None:
+        """The first scan went out several times: keep the first copy's answer (the node saw
+        nothing before it; the later ones become late answers of no tick)."""
+        answers.first_answer_only()
 
     def _settle_answers(self) -> None:
         """Hook: once the answers are in, anything else to wait (briefly) for."""

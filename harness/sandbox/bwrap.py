@@ -59,8 +59,8 @@ def bwrap_argv(view: View, command: Sequence[str], *, bwrap: str = "bwrap") -> l
     argv += ["--chdir", SCRATCH]
     if not view.keep_env:
         argv.append("--clearenv")
-    env = {"HOME": HOME, "TMPDIR": SCRATCH} if view.keep_env else {**view.env, "HOME": HOME}
-    for name, value in sorted({**env, "TMPDIR": SCRATCH}.items()):
+    env = {} if view.keep_env else dict(view.env)
+    for name, value in sorted({**env, "HOME": HOME, "TMPDIR": SCRATCH}.items()):
         argv += ["--setenv", name, value]
     for name in view.unset:
         argv += ["--unsetenv", name]

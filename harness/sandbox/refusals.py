@@ -10,7 +10,7 @@ import re
 
 from harness.sandbox.limits import SandboxLimits
 
-__all__ = ["refusal_of", "refused_in"]
+__all__ = ["refusal_of"]
 
 _REFUSALS = (
     (
@@ -36,14 +36,10 @@ _REFUSALS = (
 )
 
 
-def refusal_of(text: str, *, memory_mb: int, processes: int) -> str | None:
-    """What the sandbox refused, if the failure `text` shows it; None otherwise."""
+def refusal_of(text: str, limits: SandboxLimits) -> str | None:
+    """What the sandbox (with `limits`) refused, if the failure `text` shows it; None
+    otherwise."""
     for pattern, words in _REFUSALS:
         if pattern.search(text):
-            return words.format(memory_mb=memory_mb, processes=processes)
+            return words.format(memory_mb=limits.memory_mb, processes=limits.processes)
     return None
-
-
-def refused_in(text: str, limits: SandboxLimits) -> str | None:
-    """`refusal_of` with the limits the sandbox had."""
-    return refusal_of(text, memory_mb=limits.memory_mb, processes=limits.processes)

@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import json
 from collections.abc import Iterable, Sequence
-from dataclasses import replace
 from pathlib import Path
 
 from harness.nodes.sandbox_prefix import NODE_SANDBOX_ENV
@@ -34,6 +33,5 @@ def sandboxed_run(
     """The judging process's command line in its sandbox; its nodes start in theirs."""
     node_files = list(node_files)
     nested = bwrap_argv(node_view(node_files), limits.prefix())
-    view = run_view(node_files, scenario_files, outputs)
-    view = replace(view, env={**view.env, NODE_SANDBOX_ENV: json.dumps(nested)})
+    view = run_view(node_files, scenario_files, outputs, {NODE_SANDBOX_ENV: json.dumps(nested)})
     return bwrap_argv(view, command)

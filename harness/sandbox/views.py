@@ -10,6 +10,7 @@ only the folders that step needs.
 
 from __future__ import annotations
 
+import functools
 import os
 import sys
 from collections.abc import Iterable, Mapping
@@ -21,17 +22,12 @@ from harness.sandbox.bwrap import View
 __all__ = ["build_view", "node_view", "run_view", "sandbox_env", "system_paths"]
 
 SYSTEM = ("/usr", "/bin", "/sbin", "/lib", "/lib32", "/lib64", "/libx32", "/etc", "/opt")
-# What the sandboxed environment keeps of the grader's (names, or prefixes ending in _).
-KEPT_ENV = (
-    "PATH",
-    "LANG",
-    "LANGUAGE",
+# What the sandboxed environment keeps of the grader's: these names, and names with these
+# beginnings.
+KEPT_NAMES = ("PATH", "LANG", "LANGUAGE", "TZ", "TERM", "VIRTUAL_ENV", "LD_LIBRARY_PATH")
+KEPT_PREFIXES = (
     "LC_",
-    "TZ",
-    "TERM",
     "PYTHON",
-    "VIRTUAL_ENV",
-    "LD_LIBRARY_PATH",
     "ROS_",
     "RMW_",
     "RCUTILS_",
@@ -53,9 +49,11 @@ def _existing(paths: Iterable[str | Path]) -> list[str]:
     return list(seen)
 
 
+@functools.cache
 def system_paths() -> tuple[tuple[str, ...], dict[str, str]]:
     """(folders, symlinks) of the system a sandbox shows read-only: the OS, this Python
-    and its packages, the harness, ROS 2 where it is sourced."""
+    and its packages, the harness, ROS 2 where it is sourced. Looked up once a process
+    (every student's three sandboxes show the same)."""
     import harness
 
     links = {p: os.readlink(p) for p in SYSTEM if os.path.islink(p)}
@@ -80,8 +78,7 @@ def sandbox_env(extra: Mapping[str, str] | None = None) -> dict[str, str]:
     kept = {
         name: value
         for name, value in os.environ.items()
-        if any(name == k or (k.endswith("_") and name.startswith(k)) for k in KEPT_ENV)
-        or name.startswith("PYTHON")
+        if name in KEPT_NAMES or name.startswith(KEPT_PREFIXES)
     }
     kept["PYTHONUNBUFFERED"] = "1"
     return {**kept, **(extra or {})}
@@ -103,14 +100,17 @@ def build_view(student_folder: Path, colcon_folder: Path) -> View:
 
 
 def run_view(
-    node_files: Iterable[Path], scenario_files: Iterable[Path], outputs: Iterable[Path]
+    node_files: Iterable[Path],
+    scenario_files: Iterable[Path],
+    outputs: Iterable[Path],
+    env: Mapping[str, str] | None = None,
 ) -> View:
     """The judging process: the node's files (to start it), the scenario files, and the
-    student's output folders (report, results)."""
+    student's output folders (report, results); `env` added to its environment."""
     return _view(
         [*(p.resolve() for p in node_files), *(p.resolve() for p in scenario_files)],
         [p.resolve() for p in outputs],
-        env=sandbox_env(),
+        env=sandbox_env(env),
     )
 
 
