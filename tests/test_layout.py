@@ -39,7 +39,7 @@ LAYERS: list[set[str]] = [
     {"sim", "record"},
     {"links", "report"},
     {"runner"},
-    {"bench", "grading", "live", "campaign"},
+    {"bench", "grading", "live", "campaign", "hunt"},
     {"watch", "audit"},
     {"commands"},
     {"pytest_plugin", "cli"},
@@ -80,6 +80,9 @@ PURE = [
     "harness.sandbox.bwrap",
     "harness.sandbox.limits",
     "harness.sandbox.refusals",
+    "harness.hunt.space",
+    "harness.hunt.shrink",
+    "harness.hunt.margin",
 ]
 
 

@@ -22,6 +22,7 @@ COMMAND_MODULES = (
     "grade",
     "sweep",
     "audit",
+    "hunt",
     "bench",
 )
 

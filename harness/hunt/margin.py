@@ -1,0 +1,139 @@
+"""How close a run came to failing, and how it failed (pure).
+
+A hunt minimises the margin of its runs. A run that failed has a margin
+below 0; a run that passed has the mean of three closenesses, each the
+smallest over its ticks and clipped to [0, 1]:
+
+* the answer's closeness to its tolerance: 1 - the larger of the distance
+  error and the angle error beyond what printing explains, each divided by
+  the rest of the oracle's tolerance (0: an answer at the edge of what is
+  accepted, such as the angle of the next beam; 1 for a right answer);
+* the nearest return's distance from the warning threshold, divided by the
+  threshold (0: at the threshold, where a comparison written the wrong way,
+  or against a rounded or hard-coded number, goes wrong; 1 with no return);
+* ten times the share of the scan's beams holding a valid return (0:
+  nothing in range, the scan a node that assumes an obstacle mishandles).
+
+The mean, not the smallest, so that no one of them (nothing in range is
+easy to reach) holds the search; each still pulls it toward its edge.
+The way a run failed (``kinds``) names what its
+first failing tick got wrong, so shrinking keeps a failure of the same kind.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from harness.judge.oracle import Oracle
+from harness.judge.records import RunResult, TickRecord
+from harness.judge.status import half_unit
+
+FAILED = -1.0  # the margin of a run that failed
+
+#: What a failure's text starts with (or holds) -> its kind.
+_KINDS = (
+    ("expected warning", "warning"),
+    ("expected distance", "distance"),
+    ("gives no distance", "distance"),
+    ("expected angle", "angle"),
+    ("gives no angle", "angle"),
+    ("claims an obstacle", "phantom obstacle"),
+    ("expected an obstacle", "missed obstacle"),
+)
+
+
+@dataclass(frozen=True)
+class Assessment:
+    """What a hunt keeps of one run."""
+
+    failed: bool
+    margin: float  # FAILED when failed, else in [0, 1]
+    kinds: tuple[str, ...]  # how the first failing tick failed, sorted; () when passed
+    tick: int | None  # the first failing tick
+    first_failure: str  # the run's first failure in words ("" when passed)
+    ticks: int
+
+    def same_way(self, other: Assessment) -> bool:
+        """Did `other` fail as this one did (a kind in common)?"""
+        return other.failed and bool(set(self.kinds) & set(other.kinds))
+
+
+def assess(result: RunResult) -> Assessment:
+    """The margin and the way of failing of `result`."""
+    failed = result.failed_ticks
+    if result.error is not None and result.broken:
+        tick = failed[0].tick if failed else None
+        return Assessment(True, FAILED, ("error",), tick, result.error, len(result.records))
+    if failed:
+        first = failed[0]
+        return Assessment(
+            True,
+            FAILED,
+            failure_kinds(first.verdict.failures),
+            first.tick,
+            result.first_failure or "; ".join(first.verdict.failures),
+            len(result.records),
+        )
+    if result.error is not None:  # an error after wrong answers is counted above
+        return Assessment(True, FAILED, ("error",), None, result.error, len(result.records))
+    margin = run_margin([closeness(r, result.threshold) for r in result.records])
+    return Assessment(False, margin, (), None, "", len(result.records))
+
+
+def failure_kinds(failures: tuple[str, ...] | list[str]) -> tuple[str, ...]:
+    """The kinds of a tick's failures, sorted; "answer" for one of no known kind (no
+    status, several, late)."""
+    kinds = set()
+    for text in failures:
+        kind = next((k for words, k in _KINDS if words in text), "answer")
+        kinds.add(kind)
+    return tuple(sorted(kinds))
+
+
+def run_margin(ticks: list[tuple[float, float, float]]) -> float:
+    """The mean over the three closenesses of their smallest over `ticks` (1 with none)."""
+    if not ticks:
+        return 1.0
+    return sum(min(values) for values in zip(*ticks, strict=True)) / 3
+
+
+def closeness(record: TickRecord, threshold: float) -> tuple[float, float, float]:
+    """A passed tick's (answer, threshold, valid returns) closenesses (module docstring)."""
+    exp, claim, scan = record.verdict.expected, record.verdict.claim, record.scan
+    valid = _clip(scan.valid_mask().sum() / max(len(scan.ranges), 1) * 10)
+    band = 1.0 if exp.distance is None else _clip(abs(exp.distance - threshold) / threshold)
+    answer = 1.0
+    if (
+        claim is not None
+        and claim.obstacle
+        and exp.distance is not None
+        and exp.angle is not None
+        and claim.distance is not None
+        and math.isfinite(claim.distance)
+    ):
+        tol = Oracle.distance_tolerance(exp.distance, claim.distance_decimals)
+        ratio = _beyond_printing(abs(claim.distance - exp.distance), tol, claim.distance_decimals)
+        if claim.angle is not None and math.isfinite(claim.angle):
+            truths = [scan.angle_min + i * scan.angle_increment for i in exp.indices]
+            off = min(_angle_between(claim.angle, t) for t in truths or [exp.angle])
+            tol = Oracle.angle_tolerance(scan, claim.angle_decimals)
+            ratio = max(ratio, _beyond_printing(off, tol, claim.angle_decimals))
+        answer = _clip(1.0 - ratio)
+    return answer, band, valid
+
+
+def _beyond_printing(error: float, tolerance: float, decimals: int | None) -> float:
+    """The part of `error` that printing to `decimals` places does not explain, as a
+    share of the rest of `tolerance`: 0 for a right answer however it was rounded."""
+    printing = half_unit(decimals)
+    return max(0.0, error - printing) / max(tolerance - printing, 1e-12)
+
+
+def _angle_between(a: float, b: float) -> float:
+    """|a - b| folded into [0, pi]."""
+    return abs((a - b + math.pi) % (2 * math.pi) - math.pi)
+
+
+def _clip(value: float) -> float:
+    return min(1.0, max(0.0, float(value)))
