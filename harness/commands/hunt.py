@@ -216,6 +216,7 @@ def _search(
             def on_batch(result: Hunt) -> None:
                 failed = sum(1 for o in result.runs if o.assessment and o.assessment.failed)
                 progress.update(bar, completed=len(result.runs), failed=failed, running=0)
+                _write_runs(Path(args.out), result)  # an interrupted hunt keeps its runs
 
             return hunt(plan, run_batch, feasible, on_batch)
 

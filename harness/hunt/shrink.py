@@ -17,7 +17,7 @@ from harness.hunt.space import Candidate
 
 Step = tuple[str, Candidate]  # what changed, in words, and the simpler candidate
 
-DURATIONS = (0.2, 0.5, 1.0, 2.0)  # s, tried shortest first
+DURATIONS = (0.2, 0.5, 1.0)  # s, tried shortest first
 #: name -> the steps of its rounder values, coarsest first.
 ROUND_STEPS: dict[str, tuple[float, ...]] = {
     "threshold": (0.5, 0.1, 0.05, 0.01, 0.005, 0.001),  # 0.5 m: the lab's, tried as is

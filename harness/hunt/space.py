@@ -16,6 +16,7 @@ a real robot could drive.
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, fields, replace
@@ -37,7 +38,7 @@ RANGES: dict[str, tuple[float, float]] = {
     "bearing": (-math.pi, math.pi),  # rad, 0 straight ahead, counter-clockwise
     "size": (0.05, 3.0),  # m: a wall's length, a box's side, a cylinder's diameter
     "speed": (0.05, 0.5),  # m/s; a turn at 4x that in rad/s
-    "duration": (0.2, 3.0),  # s of the one motion segment
+    "duration": (0.2, 2.0),  # s of the one motion segment: a run costs about 0.1 s a tick
     "fault_rate": (0.01, 0.3),  # a rate; noise sigma is a tenth of it in metres
     "threshold": (0.2, 1.5),  # m
 }
@@ -180,11 +181,12 @@ def obstacle_entry(candidate: Candidate) -> dict[str, Any] | None:
     }
 
 
-def robot_footprint() -> list[Outline]:
+@functools.cache
+def robot_footprint() -> tuple[Outline, ...]:
     """The default robot's outline at the origin, read from its URDF as the start check
-    reads it."""
+    reads it (once a process)."""
     urdf = RobotConfig().urdf
-    return robot_outlines(parse_xml(robot_models_dir() / urdf, f"robot model {urdf!r}"))
+    return tuple(robot_outlines(parse_xml(robot_models_dir() / urdf, f"robot model {urdf!r}")))
 
 
 def placed(candidate: Candidate, robot: Sequence[Outline]) -> Candidate:

@@ -30,18 +30,26 @@ def summary(out: Path) -> dict:
     return json.loads((out / "hunt.json").read_text())
 
 
-PLANTED = {  # mistake -> what its counterexample must keep
-    "rounded_before_comparing": "warning",
-    "angle_without_angle_min": "angle",
-    "zero_as_obstacle": "driver_zero",
-    "crash_when_nothing_in_range": "error",
+# mistake -> the hunt's seed. A hunt is the same for a seed, so each test is too; any seed
+# finds each within the 150 runs (benchmarks/hunt_rate.py: seeds 0-4 needed 4 to 88 runs),
+# and these need few, which keeps the suite short.
+PLANTED = {
+    "rounded_before_comparing": 3,
+    "angle_without_angle_min": 0,
+    "zero_as_obstacle": 0,
+    "crash_when_nothing_in_range": 0,
 }
 
 
 @pytest.mark.parametrize("mistake", PLANTED)
 def test_hunt_finds_shrinks_and_reproduces_a_planted_mistake(mistake: str, tmp_path: Path) -> None:
     out = tmp_path / "hunt"
-    code = hunt(out, "--node", mutant_command(mistake), "--budget", "150", "--workers", "1")
+    seed = str(PLANTED[mistake])
+    node = mutant_command(mistake)
+    # The shrink budget is cut to 20 runs (default 60): the simplifications that matter come
+    # first (fault, convention, obstacle, motion, length, preset); rounding comes last.
+    options = ["--budget", "150", "--workers", "1", "--seed", seed, "--shrink-budget", "20"]
+    code = hunt(out, "--node", node, *options)
     assert code == 1
     found = summary(out)
     assert found["found"] and found["found_at_run"] <= 150
