@@ -21,7 +21,10 @@ Which commands may be served so is the harness's to decide
 
 The harness side (`ForkServer`) starts the server lazily, once per process,
 and falls back to the plain start if the server cannot come up. The server
-exits when the harness closes its socket or dies (PDEATHSIG).
+exits when the harness closes its socket or dies (PDEATHSIG). PDEATHSIG
+follows the thread that started it, so a server wanted from any thread but
+the main one (a Dask worker's task) is started from one lasting thread of
+this module's, and requests from several threads take turns.
 
 Protocol, over a SOCK_SEQPACKET socket pair: the server sends ``ready JSON``
 (its Python version and where each module it imported came from) or
@@ -42,7 +45,10 @@ import signal
 import socket
 import subprocess
 import sys
-from collections.abc import Iterator
+import threading
+from collections.abc import Callable, Iterator
+from concurrent.futures import ThreadPoolExecutor
+from typing import TypeVar
 
 from harness.nodes.quick_exit import exit_now, finish_interpreter
 from harness.nodes.sandbox_prefix import node_sandbox_prefix, parent_for
@@ -51,6 +57,8 @@ READY_WAIT_S = 10.0  # for the server's imports (a cold disk cache is slow)
 ANSWER_WAIT_S = 5.0  # for a fork
 MESSAGE_BYTES = 1 << 20  # a request carries the environment
 REAP_EVERY_S = 0.5  # the server collects its exited children this often
+STARTER_WAIT_S = 30.0  # for the lasting thread to start a server (a Popen)
+T = TypeVar("T")
 
 
 class ForkedSupervisor:
@@ -95,11 +103,12 @@ class ForkedSupervisor:
 
 
 class ForkServer:
-    """The harness's end: one server per harness process, started on first use, used from
-    the main thread only (see ``nodes.process.fork_server_enabled``)."""
+    """The harness's end: one server per harness process and module, started on first
+    use (``shared``); any thread may use it, one request at a time."""
 
     def __init__(self, module: str) -> None:
         self.module = module
+        self._turn = threading.RLock()  # one request (and its answer) at a time
         self.problem: str | None = None  # why the server is not used, once known
         ours, theirs = socket.socketpair(socket.AF_UNIX, socket.SOCK_SEQPACKET)
         self._socket: socket.socket | None = ours
@@ -152,6 +161,10 @@ class ForkServer:
         return message, fds
 
     def _wait_ready(self) -> bool:
+        with self._turn:
+            return self._wait_ready_now()
+
+    def _wait_ready_now(self) -> bool:
         if not self._ready and self._socket is not None:
             try:
                 message, _ = self._receive(READY_WAIT_S)
@@ -174,10 +187,11 @@ class ForkServer:
 
     def still_importing(self) -> bool:
         """Would a start wait for the server's imports now? (It has not said ready.)"""
-        if self._ready or self._socket is None:
-            return False
-        readable, _, _ = select.select([self._socket], [], [], 0)
-        return not readable
+        with self._turn:
+            if self._ready or self._socket is None:
+                return False
+            readable, _, _ = select.select([self._socket], [], [], 0)
+            return not readable
 
     def start(
         self,
@@ -193,19 +207,20 @@ class ForkServer:
         module search path) with `argv`, in this process's working folder; None when
         the server is not usable (then `problem` says why, and the caller starts the
         node itself)."""
-        if not self._wait_ready():
-            return None
-        assert self._socket is not None
         request: dict[str, object] = {"argv": argv, "env": env, "graces": graces}
         request["cwd"] = os.getcwd()
         if script is not None:
             request.update(script=script, sys_path=sys_path or [])
-        try:
-            socket.send_fds(self._socket, [json.dumps(request).encode()], fds)
-            message, pidfds = self._receive(ANSWER_WAIT_S)
-        except (OSError, TimeoutError) as err:
-            self._fail(f"the fork server stopped answering: {err}")
-            return None
+        with self._turn:
+            if not self._wait_ready_now():
+                return None
+            assert self._socket is not None
+            try:
+                socket.send_fds(self._socket, [json.dumps(request).encode()], fds)
+                message, pidfds = self._receive(ANSWER_WAIT_S)
+            except (OSError, TimeoutError) as err:
+                self._fail(f"the fork server stopped answering: {err}")
+                return None
         answer = json.loads(message)
         if "error" in answer or len(pidfds) != 1:
             for fd in pidfds:
@@ -216,7 +231,8 @@ class ForkServer:
 
     def close(self) -> None:
         """Stop the server (its children, supervisors still stopping, carry on alone)."""
-        self._fail("closed")
+        with self._turn:
+            self._fail("closed")
         if self._process is not None:
             with contextlib.suppress(subprocess.TimeoutExpired):
                 self._process.wait(timeout=2.0)
@@ -247,14 +263,31 @@ def scope() -> Iterator[None]:
             close_all()
 
 
+_SHARED = threading.Lock()
+_starter: ThreadPoolExecutor | None = None  # the lasting thread that starts servers
+
+
 def shared(module: str) -> ForkServer:
     """This process's fork server for `module`, started on first use (closed at exit)."""
-    server = _SERVERS.get(module)
-    if server is None:
-        if not _SERVERS:
-            atexit.register(close_all)
-        server = _SERVERS[module] = ForkServer(module)
+    with _SHARED:
+        server = _SERVERS.get(module)
+        if server is None:
+            if not _SERVERS:
+                atexit.register(close_all)
+            server = _SERVERS[module] = _from_a_lasting_thread(lambda: ForkServer(module))
     return server
+
+
+def _from_a_lasting_thread(make: Callable[[], T]) -> T:
+    """`make()` in the main thread, or in a thread that lasts as long as the process: a
+    child's PDEATHSIG fires when the thread that started it ends, and a worker's task
+    thread may end before the process does."""
+    global _starter
+    if threading.current_thread() is threading.main_thread():
+        return make()
+    if _starter is None:
+        _starter = ThreadPoolExecutor(max_workers=1, thread_name_prefix="fossbot-hil-fork-servers")
+    return _starter.submit(make).result(timeout=STARTER_WAIT_S)
 
 
 def close_all() -> None:

@@ -45,11 +45,11 @@ LINE_CHARS = 300  # a longer line in a tail is cut (a flood may have no newlines
 
 
 def fork_server_enabled() -> bool:
-    """Start the bundled node by fork from a warm process? Not when
-    ``FOSSBOT_HIL_FORK_SERVER=0``, and only from the main thread: the server
-    (and every node it started) goes when the thread that started it ends."""
-    on = os.environ.get(FORK_SERVER_SETTING, "1") != "0"
-    return on and threading.current_thread() is threading.main_thread()
+    """Start Python nodes by fork from a warm process? Not when
+    ``FOSSBOT_HIL_FORK_SERVER=0``. Any thread may (a Dask worker runs its tasks in
+    a thread of its own): the server is started from a thread that lasts
+    (``forkserver.shared``)."""
+    return os.environ.get(FORK_SERVER_SETTING, "1") != "0"
 
 
 def _fork_server_of(command: NodeCommand) -> str | None:

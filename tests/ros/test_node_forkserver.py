@@ -184,3 +184,47 @@ def test_overlapping_scenarios_get_fresh_nodes_in_their_own_domains() -> None:
     assert all(not alive(pid) for _, pid, _ in seen if pid)  # all stopped and reaped
     # Overlapped: the next scenarios' nodes were started before the first one was ready.
     assert starts[1] < seen[0][0] and starts[2] < seen[0][0]
+
+
+THREADED = textwrap.dedent(
+    """
+    import threading
+    import time
+    from harness.nodes.command import reference_node, ros_arguments
+    from harness.nodes.forkserver import ForkedSupervisor, _SERVERS
+    from harness.nodes.process import NodeProcess
+    from harness.ros.domain import discovery_environment, reserve_domain
+
+    def one_node(said):
+        domain = reserve_domain(None)
+        env = {"ROS_DOMAIN_ID": str(domain.domain_id), **discovery_environment(network=False)}
+        process = NodeProcess(reference_node(), ros_arguments(("threshold:=0.4",)), env)
+        try:
+            process.start()
+            said.append(isinstance(process._popen, ForkedSupervisor))
+            end = time.monotonic() + 15
+            while "threshold 0.4 m" not in process.tail("stderr") and time.monotonic() < end:
+                time.sleep(0.02)  # up and running: then a SIGINT ends it with 0
+            said.append(process.stop())
+        finally:
+            domain.release()
+
+    said = []
+    for _ in range(2):  # a task thread that ends, then another, as a Dask worker's may
+        thread = threading.Thread(target=one_node, args=(said,))
+        thread.start()
+        thread.join(60)
+    servers = list(_SERVERS.values())
+    print(said, len(servers), all(s._process.poll() is None for s in servers))
+    """
+)
+
+
+def test_nodes_started_from_threads_that_end_are_forked_and_the_server_outlives_them() -> None:
+    """A Dask worker runs each task in a thread: its nodes are forked too, from a server
+    started by a thread that lasts (PDEATHSIG follows the starting thread)."""
+    done = subprocess.run(
+        [sys.executable, "-c", THREADED], capture_output=True, text=True, timeout=100
+    )
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.split() == ["[True,", "0,", "True,", "0]", "1", "True"], done.stdout
