@@ -3,9 +3,21 @@
 from __future__ import annotations
 
 import argparse
+from typing import TYPE_CHECKING
 
 from harness.cluster.client import WORKER_WAIT_S
-from harness.commands.arguments import given, positive, whole_number
+from harness.commands.arguments import (
+    check_link_options,
+    check_status_regex,
+    given,
+    positive,
+    whole_number,
+)
+from harness.errors import ConfigError
+
+if TYPE_CHECKING:
+    from harness.links.base import LinkOptions
+    from harness.runner.settings import RunSettings
 
 workers = whole_number("workers", 1, 1_000)
 
@@ -43,3 +55,21 @@ def describe_cluster(scheduler: str | None, workers: int | None) -> str:
         return f"on the Dask cluster at {scheduler}"
     count = workers if workers is not None else default_workers()
     return f"on an embedded Dask cluster of {count} worker{'s' if count != 1 else ''}"
+
+
+def checked_runs_options(args: argparse.Namespace, command: str) -> tuple[LinkOptions, RunSettings]:
+    """The link options and judging settings every run of `command` (sweep, hunt) gets,
+    checked before any cluster starts: the cluster options, no --domain-id (each run
+    reserves its own), the node options, the status regex."""
+    from harness.cluster.client import check_cluster_options
+    from harness.runner.settings import RunSettings
+
+    check_cluster_options(args.scheduler, args.workers)
+    if args.domain_id is not None:
+        raise ConfigError(f"--domain-id: every run of a {command} reserves a domain of its own")
+    options = check_link_options(args)
+    check_status_regex(args)
+    judged = RunSettings(
+        status_pattern=args.status_regex, warning_when_clear=args.warning_when_clear
+    )
+    return options, judged

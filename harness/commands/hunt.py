@@ -19,14 +19,16 @@ from harness.commands.arguments import (
     add_judging_options,
     add_link_option,
     add_node_options,
-    check_link_options,
-    check_status_regex,
     given,
     positive,
     seed,
     whole_number,
 )
-from harness.commands.cluster_options import add_cluster_options, describe_cluster
+from harness.commands.cluster_options import (
+    add_cluster_options,
+    checked_runs_options,
+    describe_cluster,
+)
 from harness.errors import ConfigError
 from harness.report.console_text import print_safe as say
 
@@ -133,25 +135,16 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace, console: Console) -> int:
-    from harness.cluster.client import check_cluster_options
     from harness.hunt.search import HuntPlan, hunt, optuna_module
-    from harness.runner.settings import RunSettings
 
-    check_cluster_options(args.scheduler, args.workers)
-    if args.domain_id is not None:
-        raise ConfigError("--domain-id: every run of a hunt reserves a domain of its own")
     if args.link not in ("ros2", "inprocess"):
         raise ConfigError(f"--link {args.link}: hunt runs nodes over ros2 (or inprocess)")
-    options = check_link_options(args)
+    options, judged = checked_runs_options(args, "hunt")
     if args.link == "ros2":
         from harness.links.ros2 import node_command
 
         node_command(options)  # a missing node program is exit 2 now, not a failed run
-    check_status_regex(args)
     optuna_module()  # exit 2 now if it is missing, not after the cluster started
-    judged = RunSettings(
-        status_pattern=args.status_regex, warning_when_clear=args.warning_when_clear
-    )
     plan = HuntPlan(args.budget, args.time, args.seed, args.batch, args.shrink_budget)
     out = Path(args.out)
     _clear(out)

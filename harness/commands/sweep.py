@@ -15,13 +15,15 @@ from harness.commands.arguments import (
     add_judging_options,
     add_link_option,
     add_node_options,
-    check_link_options,
-    check_status_regex,
     given,
     name_list,
     whole_number,
 )
-from harness.commands.cluster_options import add_cluster_options, describe_cluster
+from harness.commands.cluster_options import (
+    add_cluster_options,
+    checked_runs_options,
+    describe_cluster,
+)
 from harness.errors import ConfigError
 from harness.report.console_text import print_safe as say
 
@@ -140,19 +142,10 @@ def run(args: argparse.Namespace, console: Console) -> int:
     from harness.campaign.parquet import check_parquet_available, write_parquet
     from harness.campaign.plan import plan
     from harness.campaign.results import columns_for, rows_to_resume
-    from harness.cluster.client import check_cluster_options
-    from harness.runner.settings import RunSettings
 
-    check_cluster_options(args.scheduler, args.workers)
-    if args.domain_id is not None:
-        raise ConfigError("--domain-id: every run of a sweep reserves a domain of its own")
+    options, judged = checked_runs_options(args, "sweep")
     if args.parquet:
         check_parquet_available()
-    options = check_link_options(args)
-    check_status_regex(args)
-    judged = RunSettings(
-        status_pattern=args.status_regex, warning_when_clear=args.warning_when_clear
-    )
     varied = _varied(args.vary)
     specs = plan(*_levels(args, varied))
     if len(specs) > MAX_RUNS:
