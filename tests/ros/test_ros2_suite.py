@@ -38,26 +38,34 @@ def test_correct_students_pass(variant: str) -> None:
     assert done.returncode == 0, done.stdout + done.stderr
 
 
-# Bug -> a phrase its explanation must contain.
+# Bug -> a shipped scenario that catches it, and a phrase its explanation must contain.
+# That the whole default suite catches each is shown in process (test_inprocess_suite.py)
+# and by the audit (tests/audit/): over DDS, one scenario each keeps the suite short.
 BUGS = {
-    "min_over_raw_ranges": "expected",
-    "no_range_min_filter": "expected no obstacle",
-    "angle_without_angle_min": "expected angle",
-    "angle_in_degrees": "looks like degrees",
-    "no_bool": "got no Bool",
-    "inverted_bool": "expected warning",
-    "threshold_hard_coded": "the node warns as if its threshold were between 0.4",
-    "answers_twice": "answered twice",
-    "unparseable": "obstacle: yes-ish",
+    "min_over_raw_ranges": ("out_of_range", "expected"),
+    "no_range_min_filter": ("out_of_range", "expected no obstacle"),
+    "angle_without_angle_min": ("approach_wall", "expected angle"),
+    "angle_in_degrees": ("obstacle_at_side", "looks like degrees"),
+    "no_bool": ("approach_wall", "got no Bool"),
+    "inverted_bool": ("approach_wall", "expected warning"),
+    "threshold_hard_coded": (
+        "obstacle_at_side",
+        "the node warns as if its threshold were between 0.4",
+    ),
+    "answers_twice": ("approach_wall", "answered twice"),
+    "unparseable": ("approach_wall", "obstacle: yes-ish"),
 }
 
 
-@pytest.mark.parametrize(("variant", "phrase"), BUGS.items())
-def test_buggy_student_is_caught_by_default_suite(variant: str, phrase: str) -> None:
-    """Each bug fails the default suite; the explanation names scenario, tick and expectation."""
-    done = fossbot_hil("run", "--node", student(variant))
+@pytest.mark.parametrize(("variant", "caught"), BUGS.items())
+def test_buggy_student_is_caught_over_dds(variant: str, caught: tuple[str, str]) -> None:
+    """Each bug fails a shipped scenario; the explanation names scenario, tick and
+    expectation."""
+    scenario, phrase = caught
+    done = fossbot_hil("run", scenario, "--node", student(variant))
     assert done.returncode == 1, done.stdout + done.stderr
     assert " tick " in done.stdout and phrase in done.stdout, done.stdout
+    assert f"{scenario}: t=" in done.stdout, done.stdout
 
 
 def test_crash_when_nothing_in_range_shows_exit_code_and_stderr() -> None:
