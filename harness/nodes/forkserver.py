@@ -162,24 +162,21 @@ class ForkServer:
 
     def _wait_ready(self) -> bool:
         with self._turn:
-            return self._wait_ready_now()
-
-    def _wait_ready_now(self) -> bool:
-        if not self._ready and self._socket is not None:
-            try:
-                message, _ = self._receive(READY_WAIT_S)
-            except (OSError, TimeoutError) as err:
-                self._fail(f"the fork server did not come up: {err}")
-                return False
-            kind, _, detail = message.partition(b" ")
-            if kind != b"ready":
-                self._fail(message.decode(errors="replace"))
-                return False
-            facts = json.loads(detail or b"{}")
-            self.version = str(facts.get("version", ""))
-            self.modules = dict(facts.get("modules", {}))
-            self._ready = True
-        return self._ready
+            if not self._ready and self._socket is not None:
+                try:
+                    message, _ = self._receive(READY_WAIT_S)
+                except (OSError, TimeoutError) as err:
+                    self._fail(f"the fork server did not come up: {err}")
+                    return False
+                kind, _, detail = message.partition(b" ")
+                if kind != b"ready":
+                    self._fail(message.decode(errors="replace"))
+                    return False
+                facts = json.loads(detail or b"{}")
+                self.version = str(facts.get("version", ""))
+                self.modules = dict(facts.get("modules", {}))
+                self._ready = True
+            return self._ready
 
     def ready(self) -> bool:
         """Wait (bounded) until the server has imported its module; False if it cannot."""
@@ -187,11 +184,15 @@ class ForkServer:
 
     def still_importing(self) -> bool:
         """Would a start wait for the server's imports now? (It has not said ready.)"""
-        with self._turn:
+        if not self._turn.acquire(blocking=False):
+            return not self._ready  # another thread is waiting for it or using it
+        try:
             if self._ready or self._socket is None:
                 return False
             readable, _, _ = select.select([self._socket], [], [], 0)
             return not readable
+        finally:
+            self._turn.release()
 
     def start(
         self,
@@ -211,8 +212,8 @@ class ForkServer:
         request["cwd"] = os.getcwd()
         if script is not None:
             request.update(script=script, sys_path=sys_path or [])
-        with self._turn:
-            if not self._wait_ready_now():
+        with self._turn:  # reentrant: the wait for ready takes its turn too
+            if not self._wait_ready():
                 return None
             assert self._socket is not None
             try:
