@@ -31,6 +31,7 @@ from harness.commands.cluster_options import (
 )
 from harness.errors import ConfigError
 from harness.report.console_text import print_safe as say
+from harness.safe_text import for_csv, shown
 
 if TYPE_CHECKING:
     from harness.hunt.search import Hunt, HuntPlan
@@ -135,7 +136,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace, console: Console) -> int:
-    from harness.hunt.search import HuntPlan, hunt, optuna_module
+    from harness.hunt.search import HuntPlan, optuna_module
 
     if args.link not in ("ros2", "inprocess"):
         raise ConfigError(f"--link {args.link}: hunt runs nodes over ros2 (or inprocess)")
@@ -154,8 +155,7 @@ def run(args: argparse.Namespace, console: Console) -> int:
         f"hunt: up to {plan.budget} runs{limit}, seed {plan.seed}, batches of {plan.batch}, "
         f"{describe_cluster(args.scheduler, args.workers)}; results in {out}",
     )
-    result = _search(console, args, plan, options, judged, hunt)
-    _write_runs(out, result)
+    result = _search(console, args, plan, options, judged)  # runs.csv written as it goes
     if result.found is None:
         _write_summary(out, args, result, None, None)
         for line in _nothing_found(result):
@@ -176,11 +176,12 @@ def _search(
     plan: HuntPlan,
     options: LinkOptions,
     judged: RunSettings,
-    hunt: Any,
 ) -> Hunt:
-    """The hunt on the cluster, with a progress bar of its search runs."""
+    """The hunt on the cluster, with a progress bar of its search runs; runs.csv is
+    rewritten after every batch, so an interrupted hunt keeps its runs."""
     from harness.cluster.client import dashboard, open_client
     from harness.cluster.progress import add_task, task_progress
+    from harness.hunt.search import hunt
     from harness.hunt.space import placed, robot_footprint
 
     robot = robot_footprint()
@@ -209,7 +210,7 @@ def _search(
             def on_batch(result: Hunt) -> None:
                 failed = sum(1 for o in result.runs if o.assessment and o.assessment.failed)
                 progress.update(bar, completed=len(result.runs), failed=failed, running=0)
-                _write_runs(Path(args.out), result)  # an interrupted hunt keeps its runs
+                _write_runs(Path(args.out), result)
 
             return hunt(plan, run_batch, feasible, on_batch)
 
@@ -297,8 +298,9 @@ def _write_counterexample(out: Path, result: Hunt, run_seed: int, command: list[
         for line in (
             f"Found by `fossbot-hil hunt --seed {run_seed}` in run {len(result.runs)} "
             f"and shrunk in {len(result.shrink_steps)} steps: {shrunk.candidate.describe()}.",
+            # the node's words, one escaped line: a line break would end the comment
             f"First failure (tick {shrunk.assessment.tick}): "
-            + shrunk.assessment.first_failure.replace("\n", " ")[:300],
+            + shown(shrunk.assessment.first_failure, 300),
             "Reproduce: " + shlex.join(command),
         )
     )
@@ -349,7 +351,10 @@ def _write_runs(out: Path, result: Hunt) -> None:
     import csv
     import io
 
-    rows = [{"run": index + 1, **o.as_row()} for index, o in enumerate(result.runs)]
+    rows = [
+        {"run": index + 1, **{k: for_csv(v) if isinstance(v, str) else v for k, v in row.items()}}
+        for index, row in enumerate(o.as_row() for o in result.runs)
+    ]
     if not rows:
         return
     buffer = io.StringIO()
@@ -399,13 +404,12 @@ def _write_summary(
         "command": shlex.join(command) if command else None,
         "reproduced": reproduced,
     }
-    out.mkdir(parents=True, exist_ok=True)
     write_atomically(out / "hunt.json", (json.dumps(summary, indent=2) + "\n").encode())
 
 
 def _nothing_found(result: Hunt) -> list[str]:
     runs = len(result.runs)
-    why = {"time": "the time limit", "budget": "the budget"}.get(result.stopped_by, "the budget")
+    why = "the time limit" if result.stopped_by == "time" else "the budget"
     lines = [
         f"no failing scenario in {runs} run{'s' if runs != 1 else ''} "
         f"({result.elapsed_s:.0f} s, stopped by {why}, {result.restarts} restarts)"

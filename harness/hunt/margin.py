@@ -75,8 +75,6 @@ def assess(result: RunResult) -> Assessment:
             result.first_failure or "; ".join(first.verdict.failures),
             len(result.records),
         )
-    if result.error is not None:  # an error after wrong answers is counted above
-        return Assessment(True, FAILED, ("error",), None, result.error, len(result.records))
     margin = run_margin([closeness(r, result.threshold) for r in result.records])
     return Assessment(False, margin, (), None, "", len(result.records))
 

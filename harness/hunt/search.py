@@ -115,6 +115,7 @@ def hunt(
             else:
                 study.tell(trial, outcome.assessment.margin)
         result.runs.extend(outcomes)
+        on_batch(result)
         for outcome in outcomes:
             if outcome.assessment is not None and outcome.assessment.margin < best:
                 best, best_at = outcome.assessment.margin, len(result.runs)
@@ -122,13 +123,11 @@ def hunt(
         if failing and _confirmed(failing[0], run_batch, result):
             result.found = failing[0]
             result.stopped_by = "found"
-            on_batch(result)
             break
         if len(result.runs) - best_at >= RESTART_AFTER:
             result.restarts += 1
             study = _study(optuna, plan.seed, result.restarts)
             best, best_at = float("inf"), len(result.runs)
-        on_batch(result)
     if result.found is not None:
         _shrink(result, run_batch, plan)
     result.elapsed_s = time.monotonic() - started
@@ -197,18 +196,13 @@ def _shrink(result: Hunt, run_batch: RunBatch, plan: HuntPlan) -> None:
                 break
             outcomes = run_batch([candidate for _, candidate in chunk])
             result.shrink_runs += len(chunk)
-            taken = next(
-                (
-                    (what, outcome)
-                    for (what, _), outcome in zip(chunk, outcomes, strict=True)
-                    if outcome.assessment is not None and way.same_way(outcome.assessment)
-                ),
-                None,
-            )
+            for (what, _), outcome in zip(chunk, outcomes, strict=True):
+                if outcome.assessment is not None and way.same_way(outcome.assessment):
+                    taken = (what, outcome)
+                    break
+                rejected.add(what)
             if taken is not None:
-                rejected.update(what for what, _ in chunk[: [w for w, _ in chunk].index(taken[0])])
                 break
-            rejected.update(what for what, _ in chunk)
         if taken is None:
             break
         result.shrink_steps.append(taken[0])

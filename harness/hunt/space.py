@@ -22,9 +22,9 @@ from collections.abc import Sequence
 from dataclasses import dataclass, fields, replace
 from typing import Any, Protocol
 
-from harness.scenario.footprint import Outline, disc, overlap, rectangle, robot_outlines
+from harness.scenario.footprint import Outline, overlap, robot_outlines
 from harness.scenario.model_files import parse_xml, robot_models_dir
-from harness.scenario.schema import RobotConfig
+from harness.scenario.schema import Box, Cylinder, RobotConfig, Wall
 
 OBSTACLES = ("none", "wall", "box", "cylinder")
 MOTIONS = ("still", "straight", "reverse", "turn")
@@ -133,19 +133,13 @@ def suggest(trial: Trial) -> Candidate:
 
 
 def obstacle_outline(candidate: Candidate) -> Outline | None:
-    """The obstacle's footprint, placed from the robot's start (at the origin, facing +x)."""
+    """The obstacle's footprint, placed from the robot's start (at the origin, facing +x):
+    the scenario schema's own outline of its file entry."""
     entry = obstacle_entry(candidate)
     if entry is None:
         return None
-    if entry["type"] == "wall":
-        (x0, y0), (x1, y1) = entry["start"], entry["end"]
-        centre = ((x0 + x1) / 2, (y0 + y1) / 2)
-        half = math.dist(entry["start"], entry["end"]) / 2
-        return rectangle(centre, half, WALL_THICKNESS / 2, math.atan2(y1 - y0, x1 - x0), 0.5)
-    if entry["type"] == "box":
-        side = entry["size"][0]
-        return rectangle(tuple(entry["position"]), side / 2, side / 2, entry["yaw"], 0.5)
-    return disc(tuple(entry["position"]), entry["radius"], 0.5)
+    kind = {"wall": Wall, "box": Box, "cylinder": Cylinder}[entry["type"]]
+    return kind.model_validate(entry).outline()
 
 
 def obstacle_entry(candidate: Candidate) -> dict[str, Any] | None:
