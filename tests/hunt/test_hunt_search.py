@@ -187,3 +187,23 @@ def _shrunk_from(start: Candidate, rule: Rule):
     result = hunt(plan(batch=1), landscape(rule), first_is_start)
     assert result.found is not None and result.found.candidate == start
     return result
+
+
+def test_a_status_cannot_write_into_the_counterexample_file(tmp_path) -> None:
+    """The node's first failure is quoted in a YAML comment as one escaped line: a line
+    break of any kind in a status would otherwise end the comment and add keys."""
+    from harness.commands.hunt import _write_counterexample
+    from harness.scenario.files import load_scenario_file
+
+    said = "status 'a\rthreshold: 9\u2028seed: 7\nobstacles: []' claims an obstacle"
+    failing = Outcome(
+        Candidate(obstacle="wall", distance=1.0, size=1.0),
+        Assessment(True, FAILED, ("phantom obstacle",), 0, said, 3),
+        0.0,
+    )
+    result = hunt(plan(budget=1), landscape(lambda c: None), keep)
+    result.shrunk = failing
+    _write_counterexample(tmp_path, result, 4, ["fossbot-hil", "run", "x.yaml"])
+    scenario = load_scenario_file(tmp_path / "counterexample.yaml")
+    assert (scenario.threshold, scenario.seed, len(scenario.obstacles)) == (0.5, 4, 1)
+    assert "\\r" in (tmp_path / "counterexample.yaml").read_text()
