@@ -105,11 +105,15 @@ class Observer:
         self.inbox: deque[Heard] = deque(maxlen=INBOX_LIMIT)
         self.heard: Counter[str] = Counter()  # messages of each kind, all told
         self.latest: dict[str, int] = {}  # newest source timestamp of each kind (O(1) checks)
-        self.status_sub = self.node.create_subscription(
-            String, status_topic, self._hear("status", lambda m: m.data), QOS
-        )
+        # The Bool's reader is announced before the String's: endpoint announcements are
+        # processed in order, so once a status has reached us the node has matched our
+        # Bool reader too, and its first Bool (published after that status) is not lost
+        # to a discovery still under way.
         self.warning_sub = self.node.create_subscription(
             Bool, warning_topic, self._hear("warning", lambda m: bool(m.data)), QOS
+        )
+        self.status_sub = self.node.create_subscription(
+            String, status_topic, self._hear("status", lambda m: m.data), QOS
         )
         # What spin and drain wait on and take from: (handle, message type, callback).
         self._subs = [

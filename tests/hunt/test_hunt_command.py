@@ -82,7 +82,7 @@ def test_hunt_finds_nothing_wrong_with_a_correct_node_in_100_runs(tmp_path: Path
     assert code == 0
     said = summary(out)
     assert not said["found"] and said["runs"] == 100 and said["stopped_by"] == "budget"
-    assert said["problems"] == 0 and not said["flaky"]
+    assert said["problems"] == 0 and not said["flaky"], json.dumps(said["flaky"], indent=1)
     assert not (out / "counterexample.yaml").exists()
     with (out / "runs.csv").open() as handle:
         rows = list(csv.DictReader(handle))
