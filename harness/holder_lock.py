@@ -146,6 +146,13 @@ class HolderLock:
         self.path = path
         self._key: str | None = str(path)
 
+    def fileno(self) -> int | None:
+        """The locked descriptor while held (None after `release`). A process given a
+        copy (fork, fd passing) holds the lock with us until its copy is closed."""
+        with _guard:
+            entry = _held.get(self._key) if self._key is not None else None
+            return None if entry is None else entry[0]
+
     def release(self) -> None:
         """Let go; safe to call twice. The last holder in this process frees the lock."""
         key, self._key = self._key, None

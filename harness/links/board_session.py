@@ -153,12 +153,15 @@ class BoardSession:
         assert self.port is not None
         path = self.port.slave_path
         env = self._environment()
+        assert self.domain is not None
+        held = self.domain.fileno()  # each process keeps the domain while it lives
         if self.options.board_commands:
             for text in self.options.board_commands:
                 command = board_command(text, path)
-                self._start(command.description, NodeProcess(command, [], env))
+                self._start(command.description, NodeProcess(command, [], env, held=held))
         else:
-            driver = NodeProcess(self._driver_command(), self._driver_arguments(path), env)
+            arguments = self._driver_arguments(path)
+            driver = NodeProcess(self._driver_command(), arguments, env, held=held)
             self._start(DRIVER_NAME, driver)
 
     def _start(self, name: str, process: NodeProcess) -> None:

@@ -304,7 +304,8 @@ class Ros2Link(Link):
     def _start_processes(self, env: dict[str, str]) -> None:
         """Start the node under test."""
         args = node_arguments(self.command, node_parameters(self.options))
-        self.process = NodeProcess(self.command, args, env)
+        held = None if self.domain is None else self.domain.fileno()
+        self.process = NodeProcess(self.command, args, env, held=held)
         self.process.start()
         self.node_start = f"{self.command.description}, {self.process.how}"
 
@@ -725,6 +726,8 @@ class Ros2Link(Link):
             obs.drain()
         self._sort(answers, obs.inbox, mine)
         obs.inbox.clear()
+        if len(answers.statuses) > 1 and answers.problem is None:
+            answers.problem = self._strangers()
         if self._copies > 1:  # the first scan went more than once: one answer is this tick's
             self._one_answer_of_the_copies(answers)
         self._copies = 1
@@ -740,6 +743,19 @@ class Ros2Link(Link):
             self._watch_silence(answers, tick, empty=not scan.valid_mask().any())
         self._watch_flood(answers)
         return answers
+
+    def _strangers(self) -> str | None:
+        """Why a scan got several answers, when it is not the node's doing: someone else
+        in this run's domain (then the run is the harness's problem, not the node's)."""
+        assert self.observer is not None and self.domain is not None
+        crowd = self.observer.strangers()
+        if not crowd:
+            return None
+        return (
+            f"another ROS node shares this run's domain ({self.domain.domain_id}): {crowd}; "
+            "the answers cannot be told apart (a node left running by an earlier run, or "
+            "one started with this ROS_DOMAIN_ID)"
+        )
 
     def _one_answer_of_the_copies(self, answers: Answers) -> None:
         """The first scan went out several times: keep the first copy's answer (the node saw

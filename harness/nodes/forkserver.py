@@ -30,8 +30,9 @@ Protocol, over a SOCK_SEQPACKET socket pair: the server sends ``ready JSON``
 (its Python version and where each module it imported came from) or
 ``error MESSAGE`` once; each request is JSON (argv, env, graces, cwd, and
 for a script its path and sys.path) with three descriptors (the status
-pipe, stdout, stderr); the answer is JSON (the supervisor's pid, or an
-error) with a pidfd of the supervisor.
+pipe, stdout, stderr) and optionally a fourth that the supervisor holds
+open until it ends (the run's domain lock); the answer is JSON (the
+supervisor's pid, or an error) with a pidfd of the supervisor.
 """
 
 from __future__ import annotations
@@ -308,15 +309,15 @@ def _serve(sock: socket.socket, module: str) -> int:
         if not readable:
             continue
         try:
-            message, fds, _, _ = socket.recv_fds(sock, MESSAGE_BYTES, 3)
+            message, fds, _, _ = socket.recv_fds(sock, MESSAGE_BYTES, 4)
         except OSError:
             return 0
         if not message:
             return 0
         try:
             request = json.loads(message)
-            if len(fds) != 3:
-                raise ValueError(f"expected 3 descriptors, got {len(fds)}")
+            if len(fds) not in (3, 4):
+                raise ValueError(f"expected 3 or 4 descriptors, got {len(fds)}")
             pid = os.fork()
         except (OSError, ValueError) as err:
             for fd in fds:
@@ -345,7 +346,7 @@ def _supervisor(sock: socket.socket, module: str, request: dict, fds: list[int])
         from harness.nodes.reaper import Reaper, supervise
 
         sock.close()
-        status_fd, out_fd, err_fd = fds
+        status_fd, out_fd, err_fd, *kept = fds  # kept: held open until the supervisor ends
         os.setsid()
         null = os.open(os.devnull, os.O_RDONLY)
         for fd, target in ((null, 0), (out_fd, 1), (err_fd, 2)):
@@ -354,20 +355,21 @@ def _supervisor(sock: socket.socket, module: str, request: dict, fds: list[int])
         int_grace, term_grace = request["graces"]
         reaper = Reaper(status_fd, float(int_grace), float(term_grace))
         parent = os.getppid()
-        code = supervise(reaper, parent, lambda: _fork_node(module, request, status_fd))
+        code = supervise(reaper, parent, lambda: _fork_node(module, request, [status_fd, *kept]))
     finally:
         os._exit(code)
 
 
-def _fork_node(module: str, request: dict, status_fd: int) -> int:
+def _fork_node(module: str, request: dict, supervisors: list[int]) -> int:
     """Fork the node: in the child, become what ``python -m MODULE ARGV`` (or
-    ``python SCRIPT ARGV``) would be."""
+    ``python SCRIPT ARGV``) would be, without the supervisor's descriptors."""
     pid = os.fork()
     if pid:
         return pid
     code = 1
     try:
-        os.close(status_fd)
+        for fd in supervisors:
+            os.close(fd)
         os.setsid()
         signal.pthread_sigmask(signal.SIG_SETMASK, [])  # the supervisor blocks its signals
         os.environ.clear()

@@ -170,8 +170,19 @@ def signal_name(number: int) -> str:
 class NodeProcess:
     """One running node under test, started under reaper.py (see there)."""
 
-    def __init__(self, command: NodeCommand, args: list[str], env: dict[str, str]) -> None:
+    def __init__(
+        self,
+        command: NodeCommand,
+        args: list[str],
+        env: dict[str, str],
+        *,
+        held: int | None = None,
+    ) -> None:
+        """`held`: a descriptor the node's supervisor holds open until the node and all
+        it started are gone (the run's domain lock: a node that outlives its harness,
+        killed, keeps its domain from the next run until it is stopped)."""
         self.command = command
+        self._held = held
         self.argv = [*command.argv, *args]
         self.env = {**os.environ, **command.env, **env, "PYTHONUNBUFFERED": "1"}
         self._popen: subprocess.Popen[bytes] | ForkedSupervisor | None = None  # the reaper
@@ -209,15 +220,16 @@ class NodeProcess:
             "--",
             *self.argv,
         ]
+        held = [] if self._held is None else [self._held]
         try:
-            self._popen = self._forked([status_w, out_w, err_w]) or subprocess.Popen(
+            self._popen = self._forked([status_w, out_w, err_w, *held]) or subprocess.Popen(
                 argv,
                 stdin=subprocess.DEVNULL,
                 stdout=out_w,
                 stderr=err_w,
                 env=self.env,
                 start_new_session=True,  # a Ctrl-C on the terminal is the harness's to handle
-                pass_fds=(status_w,),
+                pass_fds=(status_w, *held),
             )
         except OSError as error:
             for fd in (status_r, out_r, err_r):

@@ -24,6 +24,7 @@ it), ``leftover PID NAME`` for each process killed after the node, ``done``.
 
 from __future__ import annotations
 
+import contextlib
 import ctypes
 import os
 import signal
@@ -199,13 +200,23 @@ def spawn(argv: list[str]) -> int:
     )
 
 
+def _keep_descriptors_from_the_node() -> None:
+    """Close-on-exec for every descriptor above stderr: the node started by `spawn`
+    gets none of them (this process keeps them open)."""
+    for name in os.listdir("/proc/self/fd"):
+        fd = int(name)
+        if fd > 2:
+            with contextlib.suppress(OSError):  # the listing's own descriptor, gone
+                os.set_inheritable(fd, False)
+
+
 def supervise(reaper: Reaper, parent: int, launch: Callable[[], int]) -> int:
     """Become the node's subreaper, start it, relay its exit until asked to stop; stop it.
 
     `parent` is the process whose death stops everything (PDEATHSIG).
     Returns this process's exit code.
     """
-    os.set_inheritable(reaper.status_fd, False)  # the node must not hold the harness's pipe
+    _keep_descriptors_from_the_node()  # the harness's pipe, the run's domain lock
     signal.pthread_sigmask(signal.SIG_BLOCK, WATCHED)  # taken by sigwaitinfo, never async
     libc = ctypes.CDLL(None, use_errno=True)
     libc.prctl(PR_SET_CHILD_SUBREAPER, 1, 0, 0, 0)

@@ -40,6 +40,11 @@ class DomainReservation:
         self.domain_id = domain_id
         self._lock = lock
 
+    def fileno(self) -> int | None:
+        """The lock's descriptor (None: held by a process that started us, or released),
+        for the run's processes to hold with us."""
+        return None if self._lock is None else self._lock.fileno()
+
     def release(self) -> None:
         if self._lock is not None:
             self._lock.release()

@@ -218,6 +218,27 @@ class Observer:
             return self.scan_pub.get_subscription_count()
         return self.node.count_subscribers(self.scan_topic) - 1
 
+    def strangers(self) -> str:
+        """Who else shares this run's domain, when the graph shows someone: more than one
+        participant publishing the scans, or the status. '' when no one does.
+
+        A node left running by an earlier run (or started by hand with this
+        domain id) reads our scans and answers them, or sends scans of its own
+        to the node: either way the node seems to answer twice. An endpoint's
+        gid starts with its participant's GUID prefix (12 bytes), so endpoints
+        of one node count once whatever their number.
+        """
+        found = []
+        for topic in (self.scan_topic, self.status_topic):
+            infos = self.node.get_publishers_info_by_topic(topic)
+            participants = {bytes(i.endpoint_gid[:12]) for i in infos}
+            if len(participants) > 1:
+                names = sorted({f"{i.node_namespace.rstrip('/')}/{i.node_name}" for i in infos})
+                found.append(
+                    f"{len(participants)} ROS participants publish {topic} ({', '.join(names)})"
+                )
+        return "; ".join(found)
+
     # -- the graph: what the node under test offers ---------------------------
     def _others(self, infos: list[TopicEndpointInfo]) -> list[TopicEndpointInfo]:
         """Endpoints that are not this observer's."""
