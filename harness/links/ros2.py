@@ -58,6 +58,7 @@ POLL_S = 0.05  # longest single spin; liveness of the node is checked this often
 MIN_GRACE_S = 0.002  # wait for a Bool after the String while the order is unknown
 STOPPED_AFTER = 3  # consecutive missed deadlines end the run
 WARM_UP_RETRY_S = 0.5  # resend the first scan (or a warm-up scan) this often until answered
+BOOL_DISCOVERY_S = 0.25  # before the first scan: for a Bool writer the graph does not show yet
 FIRST_RETRY_MAX_S = 2.0  # the first scan's resends back off up to this interval
 CATCH_UP_S = 2.0  # after a missed deadline, wait this long (at least) for the late answer
 FLOOD_SCANS = 5  # a flood is judged over this many recent scans, in which a topic carried
@@ -339,8 +340,7 @@ class Ros2Link(Link):
         """
         assert self.observer is not None
         obs, opts = self.observer, self.options
-        if obs.node.count_publishers(opts.warning_topic) > 0:  # its first Bool must reach us
-            self._wait_for(lambda: obs.warning_publishers() > 0, WARM_UP_RETRY_S)
+        self._await_bool_writer()  # its first Bool must reach us
         self._counted = (obs.heard["status"], obs.heard["warning"])
         first_at = time.perf_counter()
         deadline = first_at + opts.ready_timeout
@@ -379,6 +379,24 @@ class Ros2Link(Link):
         if self.node_gone() is None:
             self._check_types()
         self._warmed_up = True
+
+    def _await_bool_writer(self) -> None:
+        """Before the first scan, our Bool reader matched to the node's Bool writer, or
+        its first Bool would be dropped as a stranger's.
+
+        A node's writers and readers are announced on two channels in no common
+        order, so ready (its scan reader and status writer matched) can come
+        before its Bool writer is known: wait for the match while the graph shows
+        a Bool writer, and a moment (BOOL_DISCOVERY_S) for one to show at all.
+        """
+        assert self.observer is not None
+        obs, topic = self.observer, self.options.warning_topic
+        if obs.warning_publishers() > 0:
+            return
+        if obs.node.count_publishers(topic) == 0:
+            self._wait_for(lambda: obs.node.count_publishers(topic) > 0, BOOL_DISCOVERY_S)
+        if obs.node.count_publishers(topic) > 0:
+            self._wait_for(lambda: obs.warning_publishers() > 0, WARM_UP_RETRY_S)
 
     def _copy(self, n: int) -> None:
         """Hook: copy `n` (0 first) of the first scan is about to go out."""
