@@ -12,6 +12,7 @@ ran. Ctrl-C (or SIGTERM) ends a session normally.
 from __future__ import annotations
 
 import math
+import threading
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -19,6 +20,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from harness.ctrl_c import remembered_ctrl_c
 from harness.errors import ConfigError, Interrupted, LinkError
 from harness.judge.records import RunResult, TickRecord
 from harness.lidar.scan import Scan
@@ -125,6 +127,7 @@ class LiveSession:
         self.result: RunResult | None = None
         self._external = False  # a node not started by us answers: judge it
         self._loop_started = 0.0
+        self._ctrl_c = threading.Event()  # set by Ctrl-C while the session runs
 
     def run(self) -> RunResult | None:
         """Run until the duration is reached, Ctrl-C, or the node stops; always clean up."""
@@ -136,7 +139,7 @@ class LiveSession:
         try:
             # The ros2 link starts the node, waits for it and explains what goes wrong.
             link = create_link("ros2", self.options) if self.settings.node else None
-            with LiveWorld(self.scenario) as world:
+            with LiveWorld(self.scenario) as world, remembered_ctrl_c() as self._ctrl_c:
                 if link is not None:
                     link.open()  # the node is up and reads /scan (bounded, explained)
                     observer, domain_id = link.observer, link.domain.domain_id
@@ -200,6 +203,8 @@ class LiveSession:
         self._moved(world, bridge)
         try:
             while duration is None or world.t < duration - 1e-9:
+                if self._ctrl_c.is_set():  # its KeyboardInterrupt was lost on the way
+                    raise KeyboardInterrupt
                 if world.steps >= scan_step:
                     self._scan(
                         world, observer, judge, rng, tick, judged=self._judging(observer, link)

@@ -16,13 +16,11 @@ stopped (rebuild), the watchers stop, and the exit code is 130 or 143.
 from __future__ import annotations
 
 import contextlib
-import signal
-import threading
 import time
-from collections.abc import Callable, Collection, Iterator, Sequence
-from types import FrameType
+from collections.abc import Callable, Collection, Sequence
 from typing import TYPE_CHECKING
 
+from harness.ctrl_c import remembered_ctrl_c
 from harness.errors import HarnessError, Interrupted
 from harness.judge.records import RunResult, TickRecord
 from harness.watch.changes import ChangeFeed, Changes
@@ -49,31 +47,6 @@ def _changed_names(changes: Changes) -> str:
     names = sorted({p.name for p in changes.paths})
     more = f" and {len(names) - SHOWN_CHANGES} more" if len(names) > SHOWN_CHANGES else ""
     return ", ".join(names[:SHOWN_CHANGES]) + more
-
-
-@contextlib.contextmanager
-def _remembered_ctrl_c() -> Iterator[threading.Event]:
-    """An event set by every Ctrl-C while the loop runs. Python swallows a
-    KeyboardInterrupt raised inside a weakref callback or a __del__ ("Exception
-    ignored in ..."): the loop then sees the event at its next wait and stops."""
-    pressed = threading.Event()
-    previous = signal.getsignal(signal.SIGINT)
-    if threading.current_thread() is not threading.main_thread() or previous == signal.SIG_IGN:
-        yield pressed
-        return
-
-    def on_ctrl_c(signum: int, frame: FrameType | None) -> None:
-        pressed.set()
-        if callable(previous):
-            previous(signum, frame)
-        else:
-            signal.default_int_handler(signum, frame)
-
-    signal.signal(signal.SIGINT, on_ctrl_c)
-    try:
-        yield pressed
-    finally:
-        signal.signal(signal.SIGINT, previous)
 
 
 class WatchLoop:
@@ -110,7 +83,7 @@ class WatchLoop:
         """The loop; returns the exit code when Ctrl-C or SIGTERM ends it."""
         feed = ChangeFeed(self.sources.watched, self.sources.matches)
         try:
-            with self.screen, feed, _remembered_ctrl_c() as pressed:
+            with self.screen, feed, remembered_ctrl_c() as pressed:
                 changes = Changes(frozenset(), time.monotonic())
                 while True:
                     self._round(changes)
