@@ -29,6 +29,7 @@ GROUND = {
     "atomic_write",
     "user_cache",
     "text_file",
+    "ctrl_c",
 }
 
 # Bottom to top; a package imports only from layers below its own.

@@ -233,10 +233,9 @@ class Observer:
             infos = self.node.get_publishers_info_by_topic(topic)
             participants = {bytes(i.endpoint_gid[:12]) for i in infos}
             if len(participants) > 1:
-                names = sorted({f"{i.node_namespace.rstrip('/')}/{i.node_name}" for i in infos})
-                found.append(
-                    f"{len(participants)} ROS participants publish {topic} ({', '.join(names)})"
-                )
+                named = {_full_name(i) for i in infos if i.node_name != UNKNOWN_NODE_NAME}
+                names = ", ".join(sorted(named)) or "discovery has not named their nodes yet"
+                found.append(f"{len(participants)} ROS participants publish {topic} ({names})")
         return "; ".join(found)
 
     # -- the graph: what the node under test offers ---------------------------
