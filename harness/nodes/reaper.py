@@ -200,11 +200,14 @@ def spawn(argv: list[str]) -> int:
     )
 
 
-def _keep_descriptors_from_the_node() -> None:
+def _keep_descriptors_from_the_node(status_fd: int) -> None:
     """Close-on-exec for every descriptor above stderr: the node started by `spawn`
     gets none of them (this process keeps them open)."""
-    for name in os.listdir("/proc/self/fd"):
-        fd = int(name)
+    try:
+        open_fds = [int(name) for name in os.listdir("/proc/self/fd")]
+    except OSError:  # no /proc (a sandbox without one): the harness's pipe at least
+        open_fds = [status_fd]
+    for fd in open_fds:
         if fd > 2:
             with contextlib.suppress(OSError):  # the listing's own descriptor, gone
                 os.set_inheritable(fd, False)
@@ -216,7 +219,7 @@ def supervise(reaper: Reaper, parent: int, launch: Callable[[], int]) -> int:
     `parent` is the process whose death stops everything (PDEATHSIG).
     Returns this process's exit code.
     """
-    _keep_descriptors_from_the_node()  # the harness's pipe, the run's domain lock
+    _keep_descriptors_from_the_node(reaper.status_fd)  # the harness's pipe, the domain lock
     signal.pthread_sigmask(signal.SIG_BLOCK, WATCHED)  # taken by sigwaitinfo, never async
     libc = ctypes.CDLL(None, use_errno=True)
     libc.prctl(PR_SET_CHILD_SUBREAPER, 1, 0, 0, 0)
