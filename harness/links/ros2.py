@@ -765,12 +765,13 @@ class Ros2Link(Link):
     def _strangers(self) -> str | None:
         """Why a scan got several answers, when it is not the node's doing: someone else
         in this run's domain (then the run is the harness's problem, not the node's)."""
-        assert self.observer is not None and self.domain is not None
+        assert self.observer is not None
         crowd = self.observer.strangers()
         if not crowd:
             return None
+        domain = f" ({self.domain.domain_id})" if self.domain is not None else ""
         return (
-            f"another ROS node shares this run's domain ({self.domain.domain_id}): {crowd}; "
+            f"another ROS node shares this run's domain{domain}: {crowd}; "
             "the answers cannot be told apart (a node left running by an earlier run, or "
             "one started with this ROS_DOMAIN_ID)"
         )

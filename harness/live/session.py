@@ -127,7 +127,6 @@ class LiveSession:
         self.result: RunResult | None = None
         self._external = False  # a node not started by us answers: judge it
         self._loop_started = 0.0
-        self._ctrl_c = threading.Event()  # set by Ctrl-C while the session runs
 
     def run(self) -> RunResult | None:
         """Run until the duration is reached, Ctrl-C, or the node stops; always clean up."""
@@ -139,7 +138,7 @@ class LiveSession:
         try:
             # The ros2 link starts the node, waits for it and explains what goes wrong.
             link = create_link("ros2", self.options) if self.settings.node else None
-            with LiveWorld(self.scenario) as world, remembered_ctrl_c() as self._ctrl_c:
+            with LiveWorld(self.scenario) as world, remembered_ctrl_c() as ctrl_c:
                 if link is not None:
                     link.open()  # the node is up and reads /scan (bounded, explained)
                     observer, domain_id = link.observer, link.domain.domain_id
@@ -149,7 +148,7 @@ class LiveSession:
                     observer = harness_observer(self.options, domain_id, publish_scans=True)
                 if self.on_ready is not None:
                     self.on_ready(domain_id)
-                self._loop(world, observer, self._judge(), rng, link)
+                self._loop(world, observer, self._judge(), rng, link, ctrl_c)
         except KeyboardInterrupt as err:  # Ctrl-C or SIGTERM while starting: a normal end too
             self.stats.stopped_by = f"{Interrupted.of(err).name} before the world ran"
         finally:
@@ -187,7 +186,10 @@ class LiveSession:
         judge: LiveJudge,
         rng: np.random.Generator,
         link: Any,
+        ctrl_c: threading.Event,
     ) -> None:
+        """Step, scan and judge until the duration, Ctrl-C (`ctrl_c`: one Python may have
+        swallowed) or the node's exit."""
         from harness.live.bridge import LiveBridge
 
         lidar_offset = _lidar_offset(world)
@@ -203,7 +205,7 @@ class LiveSession:
         self._moved(world, bridge)
         try:
             while duration is None or world.t < duration - 1e-9:
-                if self._ctrl_c.is_set():  # its KeyboardInterrupt was lost on the way
+                if ctrl_c.is_set():  # its KeyboardInterrupt was lost on the way
                     raise KeyboardInterrupt
                 if world.steps >= scan_step:
                     self._scan(

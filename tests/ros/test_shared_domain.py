@@ -12,7 +12,6 @@ from __future__ import annotations
 import os
 import subprocess
 import sys
-import textwrap
 import time
 from pathlib import Path
 
@@ -81,7 +80,7 @@ def test_a_killed_harness_leaves_its_domain_reserved_until_its_node_is_gone(
     tmp_path: Path, forked: str
 ) -> None:
     (tmp_path / "node.py").write_text(SLOW_TO_STOP)
-    (tmp_path / "dying_harness.py").write_text(textwrap.dedent(HARNESS_THAT_DIES))
+    (tmp_path / "dying_harness.py").write_text(HARNESS_THAT_DIES)
     harness = subprocess.Popen(
         [sys.executable, str(tmp_path / "dying_harness.py"), str(tmp_path / "node.py")],
         stdout=subprocess.PIPE,
