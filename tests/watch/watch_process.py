@@ -33,9 +33,14 @@ def descendants(pid: int) -> set[int]:
     todo = [pid]
     while todo:
         parent = todo.pop()
-        for task in Path(f"/proc/{parent}/task").glob("*"):
+        tasks = Path(f"/proc/{parent}/task")
+        try:
+            names = os.listdir(tasks)
+        except OSError:  # it exited while we looked
+            continue
+        for name in names:
             try:
-                children = {int(c) for c in (task / "children").read_text().split()}
+                children = {int(c) for c in (tasks / name / "children").read_text().split()}
             except OSError:
                 continue
             todo += sorted(children - found)
