@@ -41,7 +41,7 @@ from harness.report.folder_lock import lock_folder
 if TYPE_CHECKING:  # imported when grading starts (the parser is built for any command)
     from harness.grading.class_table import StudentGrade
     from harness.grading.grade import GradeConfig
-    from harness.grading.grading_file import GradingFile
+    from harness.grading.grading_file import GradebookSettings, GradingFile
     from harness.grading.roster import Roster
     from harness.grading.scoring import ScorePlan
     from harness.scenario.schema import Scenario
@@ -294,6 +294,7 @@ def run(args: argparse.Namespace, console: Console) -> int:
     )
     from harness.grading.discover import discover
     from harness.grading.grade import WORKER_RETRIES, GradeConfig, grade_class
+    from harness.grading.grading_file import GradebookSettings
     from harness.grading.hidden import HiddenScenario
     from harness.grading.roster import load_roster
     from harness.runner.planned_ticks import planned_ticks
@@ -403,7 +404,10 @@ def run(args: argparse.Namespace, console: Console) -> int:
         html_path = write_atomically(
             out / "grades.html", class_html(grades, names, meta=meta, max_score=plan.max_score)
         )
-        book_path = write_atomically(out / GRADEBOOK, _gradebook(grades, plan))
+        book = grading.gradebook if grading is not None else GradebookSettings()
+        book_path = write_atomically(
+            out / GRADEBOOK, _gradebook(grades, plan, book, rostered=roster is not None)
+        )
         console.print()
         console.print(class_rich_table(grades, names, width=console.width))
         console.print(scenario_legend(names), markup=False, highlight=False)
@@ -500,13 +504,19 @@ def scored_rows(
     return sorted(named, key=lambda g: (g.name.casefold(), g.name))
 
 
-def _gradebook(grades: list[StudentGrade], plan: ScorePlan) -> bytes:
+def _gradebook(
+    grades: list[StudentGrade], plan: ScorePlan, book: GradebookSettings, *, rostered: bool
+) -> bytes:
+    """gradebook.csv: with a roster, the roster's students alone (an id the LMS does not
+    know stops Moodle's import); without one, each folder's name as the id (what an LMS
+    export names the folders by)."""
     from harness.grading.gradebook import gradebook_csv
 
     return gradebook_csv(
-        [(g.student_id or g.name, g.full_name or g.name, g.points) for g in grades],
-        column="Lab 07",
+        [(g.student_id if rostered else g.name, g.full_name or g.name, g.points) for g in grades],
+        column=book.column,
         max_score=plan.max_score,
+        id_header=book.ids,
     )
 
 

@@ -13,6 +13,9 @@ points: 100                         # what a full pass earns (default: the sum o
 partial_credit: false               # true: a failed scenario earns its share of ticks held
 threshold: 0.5                      # the judging options, as on the command line
 timeout: 1.0
+gradebook:                          # gradebook.csv, for the LMS's import
+  column: Lab 07                    # the assignment's title in the LMS
+  ids: SIS User ID                  # where the roster's ids go (or SIS Login ID)
 ```
 
 Read with the scenarios' own bounded YAML loader and validated here (pure:
@@ -37,7 +40,7 @@ from harness.text_file import read_text_file
 if TYPE_CHECKING:
     from harness.grading.scoring import ScorePlan
 
-__all__ = ["GradingFile", "PlannedScenario", "load_grading_file"]
+__all__ = ["GradebookSettings", "GradingFile", "PlannedScenario", "load_grading_file"]
 
 MAX_GRADING_FILE_BYTES = 1 << 20
 
@@ -56,6 +59,23 @@ class PlannedScenario(_Strict):
     label: str | None = Field(default=None, min_length=1, max_length=80)
 
 
+class GradebookSettings(_Strict):
+    """gradebook.csv's assignment column and the column the roster's ids go in."""
+
+    column: str = Field(default="Lab 07", min_length=1, max_length=200)
+    ids: Literal["SIS User ID", "SIS Login ID"] = "SIS User ID"
+
+    @field_validator("column")
+    @classmethod
+    def _an_lms_title(cls, value: str) -> str:
+        from harness.grading.gradebook import check_column
+
+        try:
+            return check_column(value)
+        except ConfigError as error:
+            raise ValueError(str(error)) from None
+
+
 class GradingFile(_Strict):
     """What grade and run take from the grading file; None leaves an option as given."""
 
@@ -72,6 +92,7 @@ class GradingFile(_Strict):
     link: str | None = None
     package: str | None = None
     executable: str | None = None
+    gradebook: GradebookSettings = GradebookSettings()
     source: str = Field(default="", exclude=True)
 
     @field_validator("scenarios", mode="before")

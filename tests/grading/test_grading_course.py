@@ -9,6 +9,7 @@ cluster, a real zip file.
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import io
 import shutil
@@ -22,6 +23,7 @@ from gradescope_schema import check_gradescope, read_results
 from grading_class import STUDENT_NODE
 
 from harness.cli import main
+from harness.grading.discover import GRADES_MARKER
 
 REPO = Path(__file__).resolve().parents[2]
 HIDDEN = "narrow_corridor"
@@ -68,6 +70,7 @@ def course(tmp_path_factory: pytest.TempPathFactory) -> Path:
         "  - scenario: out_of_range\n    weight: 2\n"
         f"  - scenario: hidden/{HIDDEN}.yaml\n    weight: 3\n    hidden: true\n"
         "points: 60\n"
+        "gradebook: {column: 'Lab 07: LIDAR node', ids: SIS Login ID}\n"
     )
     (root / "course" / "roster.csv").write_text(
         "folder,id,name\nalex,s100,Alex A\nbea,s200,Bea B\ncarl,s300,Carl C\ndan,s400,Dan D\n"
@@ -77,8 +80,14 @@ def course(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
 @pytest.fixture(scope="module")
 def graded(course: Path) -> Path:
-    """`fossbot-hil grade` run from the instructor's folder, with relative paths."""
-    with pytest.MonkeyPatch.context() as patch:
+    """`fossbot-hil grade` run from the instructor's folder, with relative paths, into the
+    folder of an earlier grading (its output kept in grade_output.txt)."""
+    earlier = course / "grades"
+    earlier.mkdir()
+    (earlier / GRADES_MARKER).write_text("written by fossbot-hil grade\n")
+    (earlier / "grades.csv").write_text("student,passed\r\nalex,1/1\r\nbea,0/1\r\n")
+    said = io.StringIO()
+    with pytest.MonkeyPatch.context() as patch, contextlib.redirect_stdout(said):
         patch.chdir(course)
         code = main(
             [
@@ -94,7 +103,8 @@ def graded(course: Path) -> Path:
                 "grades",
             ]
         )
-    assert code == 0
+    (course / "grade_output.txt").write_text(said.getvalue())
+    assert code == 0, said.getvalue()
     return course / "grades"
 
 
@@ -133,11 +143,23 @@ def test_every_submission_has_a_row_even_a_refused_archive_or_a_loose_file(
     assert all(name in page for name in table)
 
 
-def test_the_gradebook_has_every_id_and_score(graded: Path) -> None:
-    text = (graded / "gradebook.csv").read_text(encoding="utf-8")
-    for student_id in ("s100", "s200", "s300", "s400"):
-        assert student_id in text
-    assert "60" in text
+def test_the_gradebook_has_the_roster_ids_and_scores_alone(graded: Path) -> None:
+    """The grading file's column and id column; a submission not on the roster has no
+    row (an id the LMS does not know stops Moodle's import)."""
+    table = list(csv.reader(io.StringIO((graded / "gradebook.csv").read_text(encoding="utf-8"))))
+    assert table[0] == [
+        "Student", "ID", "SIS User ID", "SIS Login ID", "Section", "Lab 07: LIDAR node"
+    ]  # fmt: skip
+    by_id = {row[3]: row for row in table[1:]}
+    assert sorted(by_id) == ["s100", "s200", "s300", "s400"]
+    assert by_id["s100"][0] == "Alex A" and by_id["s100"][5] == "60"
+    assert by_id["s400"][5] == "0"  # on the roster, nothing handed in
+    assert all(row[2] == "" for row in table[1:])  # the ids went under SIS Login ID
+
+
+def test_grading_into_an_earlier_grading_says_what_it_replaces(course: Path, graded: Path) -> None:
+    said = (course / "grade_output.txt").read_text()
+    assert "replacing the grading of 2 students from " in said, said
 
 
 def test_each_student_gets_a_gradescope_results_json_that_hides_the_hidden(graded: Path) -> None:

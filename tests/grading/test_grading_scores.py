@@ -98,6 +98,8 @@ def test_the_grading_file_names_files_relative_to_itself(tmp_path: Path) -> None
         ("- a\n", "expected a mapping with a 'scenarios' list"),
         ("scenarios: [a]\nthreshold: fast\n", "threshold"),
         ("scenarios: [a\n", "YAML"),
+        ("scenarios: [a]\ngradebook: {column: Student}\n", "Canvas reads that header"),
+        ("scenarios: [a]\ngradebook: {ids: Email}\n", "gradebook.ids"),
     ],
 )
 def test_a_bad_grading_file_is_one_line_naming_the_field(
@@ -110,6 +112,14 @@ def test_a_bad_grading_file_is_one_line_naming_the_field(
     assert message.startswith(f"--grading {path}: ")
     assert says in message
     assert "\n" not in message
+
+
+def test_the_grading_file_names_the_gradebook_columns(tmp_path: Path) -> None:
+    default = load_grading_file(write(tmp_path / "a.yaml", "scenarios: [a]\n")).gradebook
+    assert (default.column, default.ids) == ("Lab 07", "SIS User ID")
+    text = "scenarios: [a]\ngradebook: {column: Lab 7b, ids: SIS Login ID}\n"
+    given = load_grading_file(write(tmp_path / "b.yaml", text)).gradebook
+    assert (given.column, given.ids) == ("Lab 7b", "SIS Login ID")
 
 
 def test_a_missing_grading_file_is_a_usage_error(tmp_path: Path) -> None:
