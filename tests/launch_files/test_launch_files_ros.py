@@ -9,6 +9,7 @@ run's ROS graph. The advice never fails a scenario.
 from __future__ import annotations
 
 import json
+import os
 import shutil
 import subprocess
 import sys
@@ -103,4 +104,51 @@ def test_the_fixed_launch_file_says_nothing(lab_workspace: Path) -> None:
         EXECUTABLE,
     )
     assert done.returncode == 0, done.stdout + done.stderr
+    assert "note:" not in done.stdout, done.stdout
+
+
+def ros2_stand_in(folder: Path, workspace: Path, log: Path) -> Path:
+    """A `ros2` with a launch verb that starts the package's installed node with the
+    launch arguments as its parameters, logging what it was given: `ros2 launch` is
+    not on the package index, so this machine has none (the real one is used wherever
+    ROS 2 is sourced)."""
+    program = folder / "ros2"
+    node = workspace / "install" / PACKAGE / "lib" / PACKAGE / EXECUTABLE
+    program.write_text(
+        f"#!{sys.executable}\n"
+        "import os, sys\n"
+        "args = sys.argv[1:]\n"
+        "if args[:2] == ['launch', '--help']:\n"
+        "    sys.exit(0)\n"
+        f"with open({str(log)!r}, 'a') as handle:\n"
+        "    handle.write(' '.join(args) + '\\n')\n"
+        "parameters = [word for item in args[3:] for word in ('-p', item)]\n"
+        f"os.execv({str(node)!r}, [{str(node)!r}, '--ros-args', *parameters])\n"
+    )
+    program.chmod(0o755)
+    return program
+
+
+def test_launch_starts_the_node_through_ros2_launch_with_the_harness_parameters(
+    lab_workspace: Path, tmp_path: Path
+) -> None:
+    """--launch PACKAGE FILE: the node is `ros2 launch PACKAGE FILE` with the harness's
+    parameters as the launch arguments the file declares (threshold, use_sim_time)."""
+    use_launch_file(lab_workspace, lab_package_source() / "launch" / LAB_LISTING.name)
+    bin_folder = tmp_path / "bin"
+    bin_folder.mkdir()
+    log = tmp_path / "ros2_launch.log"
+    ros2_stand_in(bin_folder, lab_workspace, log)
+    command = [sys.executable, "-m", "harness.cli", "run", "approach_wall", "--threshold", "0.4"]
+    command += ["--workspace", str(lab_workspace), "--launch", PACKAGE, LAB_LISTING.name]
+    environment = {**os.environ, "PATH": f"{bin_folder}{os.pathsep}{os.environ['PATH']}"}
+    done = subprocess.run(
+        command, capture_output=True, text=True, timeout=180, check=False, env=environment
+    )
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert "1 of 1 scenario passed" in done.stdout, done.stdout
+    assert f"node: ros2 launch {PACKAGE} {LAB_LISTING.name}" in done.stdout, done.stdout
+    launched = log.read_text().split()
+    assert launched[:3] == ["launch", PACKAGE, LAB_LISTING.name], launched
+    assert {"use_sim_time:=true", "threshold:=0.4"} <= set(launched[3:]), launched
     assert "note:" not in done.stdout, done.stdout
