@@ -76,10 +76,12 @@ def test_hunt_finds_shrinks_and_reproduces_a_planted_mistake(mistake: str, tmp_p
         assert not scenario.obstacles or "no valid return" in explanation
 
 
-def test_hunt_finds_nothing_wrong_with_a_correct_node_in_100_runs(tmp_path: Path) -> None:
+def test_hunt_finds_nothing_wrong_with_a_correct_node_in_100_runs(tmp_path: Path, capsys) -> None:
     out = tmp_path / "hunt"
     code = hunt(out, "--node", mutant_command("correct"), "--budget", "100", "--workers", "2")
     assert code == 0
+    said_out = capsys.readouterr().out
+    assert "no failing scenario in 100 runs (" in said_out and "stopped by the budget" in said_out
     said = summary(out)
     assert not said["found"] and said["runs"] == 100 and said["stopped_by"] == "budget"
     assert said["problems"] == 0 and not said["flaky"], json.dumps(said["flaky"], indent=1)
