@@ -20,17 +20,19 @@ HANGS = (
     "signal.signal(signal.SIGTERM, signal.SIG_IGN)  # and never comes up\n"
     "while True:\n    time.sleep(1)\n"
 )
-# Walks up its ancestors to the Dask worker process (a nanny's spawned child, or a
-# `dask worker --no-nanny`) and kills it, as a node gone badly wrong might.
+# Walks up its ancestors to the Dask worker process (the embedded cluster's, forked by
+# multiprocessing's fork server; a nanny's spawned child; or a `dask worker --no-nanny`)
+# and kills it, as a node gone badly wrong might.
 KILLS_ITS_WORKER = """\
 import os
 import signal
 
+WORKER_MARKS = (b"multiprocessing.forkserver", b"spawn_main", b"dask_worker")
 pid = os.getppid()
 while pid > 1:
     with open(f"/proc/{pid}/cmdline", "rb") as handle:
         command = handle.read().replace(b"\\0", b" ")
-    if b"spawn_main" in command or b"dask_worker" in command:
+    if any(mark in command for mark in WORKER_MARKS):
         os.kill(pid, signal.SIGKILL)
         break
     with open(f"/proc/{pid}/stat", "rb") as handle:

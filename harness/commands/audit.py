@@ -152,7 +152,12 @@ def run(args: argparse.Namespace, console: Console) -> int:
     )
     started = time.monotonic()
     with (
-        open_client(args.scheduler, args.workers, worker_wait=args.worker_wait) as client,
+        open_client(
+            args.scheduler,
+            args.workers,
+            worker_wait=args.worker_wait,
+            preload=("harness.audit.task",),  # each batch runs its nodes from its own process
+        ) as client,
         task_progress(shown, "nodes", failed="did not finish") as progress,
     ):
         bar = add_task(progress, "nodes", len(mutants) + 1)

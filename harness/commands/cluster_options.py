@@ -20,6 +20,8 @@ if TYPE_CHECKING:
     from harness.runner.settings import RunSettings
 
 workers = whole_number("workers", 1, 1_000)
+# What a worker that runs scenarios itself (sweep, hunt) imports before it is forked.
+WARM_WORKER = "harness.runner.warm_worker"
 
 
 def add_cluster_options(parser: argparse.ArgumentParser, *, unit: str = "runs") -> None:

@@ -324,7 +324,11 @@ def run(args: argparse.Namespace, console: Console) -> int:
     with contextlib.ExitStack() as stack:
         client = stack.enter_context(
             open_client(
-                args.scheduler, args.workers, retries=WORKER_RETRIES, worker_wait=args.worker_wait
+                args.scheduler,
+                args.workers,
+                retries=WORKER_RETRIES,
+                worker_wait=args.worker_wait,
+                preload=("harness.grading.grade",),  # each student runs in a process of its own
             )
         )
         if sandbox is not None and args.scheduler:

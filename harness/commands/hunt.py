@@ -25,6 +25,7 @@ from harness.commands.arguments import (
     whole_number,
 )
 from harness.commands.cluster_options import (
+    WARM_WORKER,
     add_cluster_options,
     checked_runs_options,
     describe_cluster,
@@ -196,7 +197,12 @@ def _search(
             return None
         return candidate
 
-    with open_client(args.scheduler, args.workers, worker_wait=args.worker_wait) as client:
+    with open_client(
+        args.scheduler,
+        args.workers,
+        worker_wait=args.worker_wait,
+        preload=(WARM_WORKER, "harness.hunt.task"),
+    ) as client:
         link = dashboard(client)
         if link:
             say(console, f"Dask dashboard: {link}")

@@ -20,6 +20,7 @@ from harness.commands.arguments import (
     whole_number,
 )
 from harness.commands.cluster_options import (
+    WARM_WORKER,
     add_cluster_options,
     checked_runs_options,
     describe_cluster,
@@ -235,7 +236,12 @@ def _run_all(
     from harness.cluster.progress import add_task, task_progress
     from harness.cluster.window import Window
 
-    with open_client(args.scheduler, args.workers, worker_wait=args.worker_wait) as client:
+    with open_client(
+        args.scheduler,
+        args.workers,
+        worker_wait=args.worker_wait,
+        preload=(WARM_WORKER, "harness.campaign.task"),
+    ) as client:
         table = ResultsTable(path, resume=args.resume, columns=columns)
         link = dashboard(client)
         if link:
