@@ -13,13 +13,31 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
+import yaml
 from command_line import COMMAND
 
 REPO = Path(__file__).resolve().parents[2]
 STUDENT_NODE = REPO / "tests" / "ros" / "student_node.py"
 STUDENT_FUNCTIONS = REPO / "tests" / "student_functions.py"
-SCENARIOS = ("obstacle_at_side", "out_of_range")  # short ones: 45 and 64 ticks
+# The pages' scenarios: two shipped ones with the same world, LIDAR, faults and topics,
+# driven for a dozen ticks instead of 45 and 64 (a report's page is laid out the same,
+# and its plots and animations drawn the same, whatever the length of the run).
+SHORTENED: dict[str, tuple[str, dict[str, Any]]] = {  # name -> (shipped scenario, changes)
+    "side_post": (  # obstacle_at_side, from 0.5 m before the post to 0.5 m past it
+        "obstacle_at_side",
+        {
+            "robot": {"start": {"x": 0.5}},
+            "motion": {"segments": [{"linear": 0.5, "until": {"distance": 1.0}}]},
+        },
+    ),
+    "nothing_in_range": (  # out_of_range, turning one radian instead of a full turn
+        "out_of_range",
+        {"motion": {"segments": [{"angular": 1.0, "until": {"turn": 1.0}}]}},
+    ),
+}
+SCENARIOS = tuple(SHORTENED)
 STUDENTS = {"alice": "correct", "bob": "min_over_raw_ranges"}  # name -> student_node variant
 WIDTH, HEIGHT = 1280, 800
 BUILD_WAIT_S = 400  # the commands' own timeouts, and a wait for another worker's
@@ -88,19 +106,33 @@ def command(*args: str, cwd: Path, timeout: float) -> tuple[int, str]:
     return code, f"$ fossbot-hil {' '.join(args)}  ({took:.1f} s)\n{said}"
 
 
+def scenario_files(folder: Path) -> list[str]:
+    """SHORTENED's scenarios, written as scenario files into `folder`."""
+    folder.mkdir(parents=True, exist_ok=True)
+    paths = []
+    for name, (shipped, changes) in SHORTENED.items():
+        data = yaml.safe_load((REPO / "scenarios" / f"{shipped}.yaml").read_text())
+        data.update(changes, description=f"{shipped}, shortened: {data['description']}"[:200])
+        path = folder / f"{name}.yaml"
+        path.write_text(yaml.safe_dump(data, sort_keys=False))
+        paths.append(str(path))
+    return paths
+
+
 def make_run(folder: Path) -> list[tuple[int, str]]:
     """index.html of a run compared with a baseline (the widest table a run has):
-    obstacle_at_side passes, out_of_range fails (min over the raw ranges) and is new."""
+    side_post passes, nothing_in_range fails (min over the raw ranges) and is new."""
+    scenarios = scenario_files(folder / "scenario-files")
     inprocess = ("--link", "inprocess")
     baseline = command(
-        "run", *inprocess, SCENARIOS[0], "--out", "baseline", cwd=folder, timeout=120
+        "run", *inprocess, scenarios[0], "--out", "baseline", cwd=folder, timeout=120
     )
     processor = f"{STUDENT_FUNCTIONS}:min_over_raw_ranges"
     run = command(
         "run",
         *inprocess,
         *("--processor", processor, "--baseline", "baseline", "--animate"),
-        *SCENARIOS,
+        *scenarios,
         *("--out", "run"),
         cwd=folder,
         timeout=150,
@@ -109,14 +141,16 @@ def make_run(folder: Path) -> list[tuple[int, str]]:
 
 
 def make_class(folder: Path) -> list[tuple[int, str]]:
-    """grades.html and each student's report: alice is right, bob fails out_of_range."""
+    """grades.html and each student's report: alice is right, bob fails nothing_in_range.
+    One Dask worker: the students one after the other, the same steps as at once."""
+    scenarios = ",".join(scenario_files(folder / "scenario-files"))
     classroom = folder / "class"
     for name, variant in STUDENTS.items():
         (classroom / name).mkdir(parents=True)
         (classroom / name / "lidar_node.py").write_text(
             f"import sys\n\nsys.argv[1:1] = [{variant!r}]\n" + STUDENT_NODE.read_text()
         )
-    options = ("--workers", "2", "--scenario", ",".join(SCENARIOS), "--no-audit")
+    options = ("--workers", "1", "--scenario", scenarios, "--no-audit")
     return [command("grade", "class", "--out", "grades", *options, cwd=folder, timeout=200)]
 
 

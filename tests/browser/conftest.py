@@ -3,7 +3,8 @@
 The pages come from real commands, made once per test session (and once for
 all pytest-xdist workers, under a file lock): a `fossbot-hil run --out` over
 the inprocess link (one scenario passing, one failing, with animations), and
-a `fossbot-hil grade` of two script students over ROS 2. A local HTTP server
+a `fossbot-hil grade` of two script students over ROS 2, both on two shipped
+scenarios shortened to a dozen ticks (browser_pages.SHORTENED). A local HTTP server
 serves them, so a link works only if it is relative and points at a file
 inside the folder the command wrote: an absolute path or a link out of the
 folder fails as it would on a web server or in a CI artifact.
