@@ -1,6 +1,6 @@
 """`fossbot-hil audit` as an instructor runs it: real mutant nodes over a real ROS 2 graph,
-on the embedded Dask cluster, with small budgets (two or three mistakes, two or three
-scenarios). The full library through the default suite is in the issue notes and
+on the embedded Dask cluster, with small budgets (two mistakes, two short scenarios, one
+worker). The full library through the default suite is in the issue notes and
 docs/audit.md: it takes about 200 s on 2 cores."""
 
 from __future__ import annotations
@@ -11,16 +11,58 @@ import subprocess
 from pathlib import Path
 
 import pytest
-from command_line import COMMAND, fossbot_hil
+from command_line import COMMAND
 
 from harness.audit import MUTANTS
+from harness.cli import main
+
+# Short versions of shipped scenarios (a few seconds each, not 10 to 14): the audit runs
+# every mistake through every scenario, once per seed.
+WALL_AHEAD = """\
+description: Drive at a wall 0.6 m ahead until very close (approach_wall, short).
+lidar:
+  preset: gazebo
+obstacles:
+  - type: wall
+    start: [0.6, -2.0]
+    end: [0.6, 2.0]
+    thickness: 0.1
+motion:
+  segments:
+    - linear: 0.2
+      until: {obstacle_ahead_below: 0.2}
+    - until: {duration: 0.5}
+threshold: 0.5
+"""
+DRIVE_AWAY = """\
+description: Start near a wall and drive 1 m away from it (drive_past_10m, short).
+lidar:
+  preset: gazebo
+obstacles:
+  - type: wall
+    start: [-0.4, -3.0]
+    end: [-0.4, 3.0]
+    thickness: 0.1
+motion:
+  segments:
+    - linear: 1.0
+      until: {distance: 1.0}
+    - until: {duration: 0.5}
+threshold: 0.5
+"""
+
+
+def scenario_file(tmp_path: Path, name: str, text: str) -> str:
+    path = tmp_path / f"{name}.yaml"
+    path.write_text(text)
+    return str(path)
 
 
 def audit(tmp_path: Path, *args: str, timeout: float = 240) -> subprocess.CompletedProcess[str]:
-    """The command in `tmp_path`, with its own cache folder there."""
+    """The command in `tmp_path`, with its own cache folder there, on one worker."""
     env = {**os.environ, "FOSSBOT_HIL_CACHE_DIR": str(tmp_path / "cache")}
     return subprocess.run(
-        [*COMMAND, "audit", *args, "--out", str(tmp_path / "audit")],
+        [*COMMAND, "audit", *args, "--workers", "1", "--out", str(tmp_path / "audit")],
         capture_output=True,
         text=True,
         timeout=timeout,
@@ -41,31 +83,33 @@ def audit(tmp_path: Path, *args: str, timeout: float = 240) -> subprocess.Comple
         (["--threshold", "-1"], "--threshold"),
     ],
 )
-def test_usage_errors_exit_2_in_one_line(args: list[str], says: str) -> None:
-    done = fossbot_hil("audit", *args, timeout=60)
-    assert done.returncode == 2, done.stdout + done.stderr
-    lines = done.stderr.strip().splitlines()
-    assert len(lines) == 1 and says in lines[0], done.stderr
-    assert "Traceback" not in done.stderr
+def test_usage_errors_exit_2_in_one_line(
+    args: list[str], says: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    assert main(["audit", *args]) == 2
+    err = capsys.readouterr().err
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and says in lines[0], err
+    assert "Traceback" not in err
 
 
-def test_list_names_every_mistake_in_the_library() -> None:
-    done = fossbot_hil("audit", "--list", timeout=60)
-    assert done.returncode == 0, done.stderr
-    listed = [line.split()[0] for line in done.stdout.splitlines() if line.strip()]
+def test_list_names_every_mistake_in_the_library(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["audit", "--list"]) == 0
+    out = capsys.readouterr().out
+    listed = [line.split()[0] for line in out.splitlines() if line.strip()]
     assert listed == [m.name for m in MUTANTS] and len(listed) >= 20
 
 
 @pytest.mark.ros
 @pytest.mark.timeout(240)
 def test_json_gives_kills_survivors_coverage_and_flips(tmp_path: Path) -> None:
-    """approach_wall + drive_past_10m, twice each: drive_past_10m's warning must clear, so
-    it kills the latched warning; neither delivers a NaN beside a valid return, so the
-    node that does not filter NaN survives, and the coverage says why."""
+    """wall_ahead + drive_away, twice each: drive_away's warning must clear, so it kills
+    the latched warning; neither delivers a NaN beside a valid return, so the node that
+    does not filter NaN survives, and the coverage says why."""
     done = audit(
         tmp_path,
-        "approach_wall",
-        "drive_past_10m",
+        scenario_file(tmp_path, "wall_ahead", WALL_AHEAD),
+        scenario_file(tmp_path, "drive_away", DRIVE_AWAY),
         "--mutant",
         "warning_latched,nan_not_filtered",
         "--repeat",
@@ -75,7 +119,7 @@ def test_json_gives_kills_survivors_coverage_and_flips(tmp_path: Path) -> None:
     assert done.returncode == 1, done.stdout + done.stderr  # a mistake survived
     data = json.loads(done.stdout)
     assert {m["name"]: m["killed_by"] for m in data["mutants"]} == {
-        "warning_latched": ["drive_past_10m"],
+        "warning_latched": ["drive_away"],
         "nan_not_filtered": [],
     }
     assert data["survivors"] == ["nan_not_filtered"]
@@ -94,14 +138,12 @@ def test_json_gives_kills_survivors_coverage_and_flips(tmp_path: Path) -> None:
 @pytest.mark.ros
 @pytest.mark.timeout(240)
 def test_a_suite_where_no_warning_clears_lets_the_latched_warning_pass(tmp_path: Path) -> None:
-    """approach_wall, out_of_range and rotate_beside_wall never go from near to far: the
-    matrix names the latched warning a survivor, with the kind of scenario that would
-    catch it."""
+    """wall_ahead (an approach) and out_of_range never go from near to far: the matrix
+    names the latched warning a survivor, with the kind of scenario that would catch it."""
     done = audit(
         tmp_path,
-        "approach_wall",
+        scenario_file(tmp_path, "wall_ahead", WALL_AHEAD),
         "out_of_range",
-        "rotate_beside_wall",
         "--mutant",
         "warning_latched,angle_in_degrees",
     )
