@@ -42,9 +42,15 @@ _SPLIT = ("inprocess_s", "startup_s", "ticking_s", "stop_s", "process_s")
 
 
 def measure_suite(
-    workload: Workload, *, cli: bool, suite_runs: int, student_split: bool = True
+    workload: Workload,
+    *,
+    cli: bool,
+    suite_runs: int,
+    student_split: bool = True,
+    suite: Sequence[str] = (),
 ) -> StageResult:
-    """The lab trio in this process (and as a command); the shipped suite as users run it."""
+    """The lab trio in this process (and as a command); the shipped suite as users run it
+    (`suite`: only these of its scenarios, by name; empty: all of them)."""
     source, colcon = lab_package_source(), colcon_program()  # before anything is measured
     scenarios = list(workload.scenarios)
     started = time.perf_counter()
@@ -58,16 +64,22 @@ def measure_suite(
         "cli_wall_s": cli_wall_s([s.name for s in scenarios]) if cli else None,
     }
     with tempfile.TemporaryDirectory(prefix="fossbot-hil-bench-") as folder:
-        extra.update(_shipped_suite(suite_runs, student_split, Path(folder), source, colcon))
+        extra.update(_shipped_suite(suite_runs, student_split, Path(folder), source, colcon, suite))
     return StageResult("suite", scans, seconds, simulated, extra=extra)
 
 
 def _shipped_suite(
-    runs: int, student_split: bool, folder: Path, source: Path, colcon: str
+    runs: int,
+    student_split: bool,
+    folder: Path,
+    source: Path,
+    colcon: str,
+    names: Sequence[str] = (),
 ) -> Figures:
-    """The shipped suite three ways from spawn to exit (median of `runs`), and two splits."""
+    """The shipped suite (or its scenarios `names`) three ways from spawn to exit (median
+    of `runs`), and two splits."""
     workspace = build_lab_workspace(folder, source, colcon)
-    shipped = shipped_scenarios()
+    shipped = [s for s in shipped_scenarios() if not names or s.name in names]
     bundled = _split("suite", "the bundled node", shipped, LinkOptions())
     student = (
         _split("student_suite", "the workspace node", shipped, workspace.link_options())
@@ -76,9 +88,9 @@ def _shipped_suite(
     )
     walls = alternate(
         {
-            "suite": [],
-            "student_suite": workspace.run_args(),
-            "inprocess_suite": ["--link", "inprocess"],
+            "suite": [*names],
+            "student_suite": [*names, *workspace.run_args()],
+            "inprocess_suite": [*names, "--link", "inprocess"],
         },
         runs,
     )

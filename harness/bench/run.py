@@ -57,6 +57,12 @@ class BenchPlan:
         return not self.quick
 
     @property
+    def suite_scenarios(self) -> tuple[str, ...]:
+        """The suite stage's scenarios: the lab trio and the whole shipped suite (quick:
+        approach_wall alone, for both)."""
+        return ("approach_wall",) if self.quick else ()
+
+    @property
     def suite_runs(self) -> int:
         """`fossbot-hil run` of the shipped suite, each of its three kinds (bundled node,
         workspace node, inprocess link): the median of three (quick: one)."""
@@ -107,10 +113,11 @@ def _measure(name: str, plan: BenchPlan) -> StageResult:
         from harness.bench.lab_suite import measure_suite
 
         return measure_suite(
-            lab_workload(1, LAB_TRIO),
+            lab_workload(1, plan.suite_scenarios or LAB_TRIO),
             cli=plan.suite_cli,
             suite_runs=plan.suite_runs,
             student_split=plan.suite_student_split,
+            suite=plan.suite_scenarios,
         )
     raise ValueError(name)
 
