@@ -3,12 +3,14 @@ Dask's own `dask scheduler` / `dask worker` commands, one worker killed (-9) mid
 in each.
 
 Every run must be in the results exactly once, with the verdicts a one-machine
-sweep of the same seeds gives. A node that hangs, and one that kills its
-worker every time, each cost their own runs only, as ERROR rows.
+sweep of the same seeds gives (four runs of a short wall approach: clean and noisy,
+two seeds). A node that hangs, and one that kills its worker every time, each cost
+their own runs only, as ERROR rows.
 """
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import os
 import signal
@@ -26,17 +28,30 @@ from dask_cluster import children, dask_cluster
 
 pytestmark = [pytest.mark.ros, pytest.mark.slow, pytest.mark.timeout(300)]
 
-SWEEP = [
-    "sweep",
-    "--scenario",
-    "approach_wall,obstacle_at_side",
-    "--faults",
-    "clean,noisy",
-    "--seed-count",
-    "2",
-    "--timeout",
-    "5",  # a generous per-scan deadline: a busy machine must not turn into a late answer
-]
+# approach_wall in 16 ticks instead of 95: what costs is each run's node, not its ticks.
+NEAR_WALL = """\
+description: Drive at a near wall until very close, crossing the warning threshold.
+lidar:
+  preset: gazebo
+obstacles:
+  - {type: wall, start: [0.8, -2.0], end: [0.8, 2.0], thickness: 0.1}
+motion:
+  segments:
+    - linear: 0.4
+      until: {obstacle_ahead_below: 0.2}
+threshold: 0.5
+"""
+
+
+@pytest.fixture(scope="module")
+def sweep_args(tmp_path_factory: pytest.TempPathFactory) -> list[str]:
+    """The sweep every cluster runs: 4 runs (clean and noisy, seeds 0 and 1)."""
+    scenario = tmp_path_factory.mktemp("scenario") / "near_wall.yaml"
+    scenario.write_text(NEAR_WALL)
+    return [
+        *("sweep", "--scenario", str(scenario), "--faults", "clean,noisy", "--seed-count", "2"),
+        *("--timeout", "5"),  # a generous per-scan deadline: a busy machine is not late
+    ]
 
 
 def _rows(folder: Path) -> list[dict[str, str]]:
@@ -49,37 +64,43 @@ def _verdicts(rows: list[dict[str, str]]) -> dict[str, tuple[str, str, str]]:
 
 
 @pytest.fixture(scope="module")
-def one_machine(tmp_path_factory: pytest.TempPathFactory) -> dict[str, tuple[str, str, str]]:
+def one_machine(
+    sweep_args: list[str], tmp_path_factory: pytest.TempPathFactory
+) -> dict[str, tuple[str, str, str]]:
     """The verdicts of the sweep on one worker: what every cluster must give."""
     out = tmp_path_factory.mktemp("one") / "sweep"
-    done = fossbot_hil(*SWEEP, "--workers", "1", "--out", str(out), timeout=240)
+    done = fossbot_hil(*sweep_args, "--workers", "1", "--out", str(out), timeout=240)
     assert done.returncode in (0, 1), done.stdout + done.stderr
     expected = _verdicts(_rows(out))
-    assert len(expected) == 8
+    assert len(expected) == 4
     return expected
 
 
 def _local_workers(pid: int) -> list[int]:
-    """The embedded cluster's worker processes: the command's spawned children."""
+    """The embedded cluster's worker processes: the children of the multiprocessing fork
+    server the command started (or the command's spawned children)."""
     found = []
     for child in children(pid):
         try:
             command = Path(f"/proc/{child}/cmdline").read_bytes()
         except OSError:
             continue
-        if b"spawn_main" in command:
+        if b"multiprocessing.forkserver" in command:
+            with contextlib.suppress(OSError):
+                found += children(child)
+        elif b"spawn_main" in command:
             found.append(child)
     return found
 
 
 def test_an_external_cluster_loses_nothing_when_a_worker_is_killed(
-    one_machine: dict[str, tuple[str, str, str]], tmp_path: Path
+    sweep_args: list[str], one_machine: dict[str, tuple[str, str, str]], tmp_path: Path
 ) -> None:
     expected = one_machine
     out = tmp_path / "cluster"
     with dask_cluster(2, nanny=False) as (address, workers):
         sweep = subprocess.Popen(
-            [*COMMAND, *SWEEP, "--scheduler", address, "--out", str(out)],
+            [*COMMAND, *sweep_args, "--scheduler", address, "--out", str(out)],
             stdout=subprocess.PIPE,
             stderr=subprocess.STDOUT,
             text=True,
@@ -94,17 +115,17 @@ def test_an_external_cluster_loses_nothing_when_a_worker_is_killed(
     assert sweep.returncode in (0, 1), output
     rows = _rows(out)
     keys = [r["key"] for r in rows]
-    assert len(keys) == len(set(keys)) == 8, output  # every run, exactly once
+    assert len(keys) == len(set(keys)) == 4, output  # every run, exactly once
     assert _verdicts(rows) == expected
     assert (out / "summary.txt").read_text().strip()
 
 
 def test_the_embedded_default_loses_nothing_when_a_worker_is_killed_and_resumes(
-    one_machine: dict[str, tuple[str, str, str]], tmp_path: Path
+    sweep_args: list[str], one_machine: dict[str, tuple[str, str, str]], tmp_path: Path
 ) -> None:
     out = tmp_path / "sweep"
     sweep = subprocess.Popen(
-        [*COMMAND, *SWEEP, "--out", str(out)],  # no --workers: one per core
+        [*COMMAND, *sweep_args, "--out", str(out)],  # no --workers: one per core
         stdout=subprocess.PIPE,
         stderr=subprocess.STDOUT,
         text=True,
@@ -125,12 +146,12 @@ def test_the_embedded_default_loses_nothing_when_a_worker_is_killed_and_resumes(
     assert "on an embedded Dask cluster of" in output and "Dask dashboard: http" in output
     rows = _rows(out)
     keys = [r["key"] for r in rows]
-    assert len(keys) == len(set(keys)) == 8, output  # every run, exactly once
+    assert len(keys) == len(set(keys)) == 4, output  # every run, exactly once
     assert _verdicts(rows) == one_machine
 
     kept = (out / "results.csv").read_text().splitlines()[:4]  # header and three rows
     (out / "results.csv").write_text("\n".join(kept) + "\n")
-    again = fossbot_hil(*SWEEP, "--workers", "2", "--out", str(out), "--resume", timeout=240)
+    again = fossbot_hil(*sweep_args, "--workers", "1", "--out", str(out), "--resume", timeout=240)
     assert "(3 done already)" in again.stdout, again.stdout + again.stderr
     assert _verdicts(_rows(out)) == one_machine
 
@@ -142,11 +163,12 @@ def _node(tmp_path: Path, source: str) -> str:
 
 
 def test_a_hanging_node_costs_only_its_runs(tmp_path: Path) -> None:
-    """A node that never comes up and ignores SIGTERM: each run ends at its deadline."""
+    """A node that never comes up and ignores SIGTERM: each run ends at its deadline, and
+    the one worker goes on to the next."""
     out = tmp_path / "sweep"
     done = fossbot_hil(
-        *("sweep", "--scenario", "approach_wall", "--seed-count", "2", "--workers", "2"),
-        *("--node", _node(tmp_path, HANGS), "--ready-timeout", "3", "--out", str(out)),
+        *("sweep", "--scenario", "approach_wall", "--seed-count", "2", "--workers", "1"),
+        *("--node", _node(tmp_path, HANGS), "--ready-timeout", "1", "--out", str(out)),
         timeout=240,
     )
     assert done.returncode == 1, done.stdout + done.stderr
@@ -155,8 +177,13 @@ def test_a_hanging_node_costs_only_its_runs(tmp_path: Path) -> None:
     assert all(r["first_failure"] for r in rows), rows
 
 
-def test_a_node_that_kills_its_worker_every_time_is_an_error_row(tmp_path: Path) -> None:
+def test_a_node_that_kills_its_worker_every_time_is_an_error_row(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
     """Dask gives up on the run after its retries; the sweep writes its row and ends."""
+    # One retry, as docs/grading.md advises a lab's scheduler (Dask's default is 3): each
+    # try costs a worker.
+    monkeypatch.setenv("DASK_DISTRIBUTED__SCHEDULER__ALLOWED_FAILURES", "1")
     out = tmp_path / "sweep"
     done = fossbot_hil(
         *("sweep", "--scenario", "approach_wall", "--workers", "1"),

@@ -1,8 +1,9 @@
 """`fossbot-hil grade` on a real class: colcon builds, real nodes over DDS, two at a time.
 
-One grading run (module scope) of four students over the three lab
-scenarios: a good workspace, a package with a bug, a package that does not
-build, and a single-file node. The tests read its outputs.
+One grading run (module scope) of four students over three short scenarios
+shaped like the lab's three (approach_wall, drive_past_10m, out_of_range): a
+good workspace, a package with a bug, a package that does not build, and a
+single-file node. The tests read its outputs.
 """
 
 from __future__ import annotations
@@ -18,7 +19,7 @@ from pathlib import Path
 import pytest
 from command_line import COMMAND
 from grading_class import (
-    LAB_SCENARIOS,
+    REPO,
     broken_setup_package,
     good_workspace,
     range_min_bug_package,
@@ -27,6 +28,48 @@ from grading_class import (
 )
 
 pytestmark = [pytest.mark.ros, pytest.mark.slow, pytest.mark.timeout(240)]
+
+# The lab's scenarios in 46 ticks instead of 293: what costs is each student's build and
+# nodes, not the ticks. Each still catches what its lab scenario does.
+WALL_AHEAD = """\
+description: Drive at a near wall until very close, crossing the warning threshold.
+lidar:
+  preset: gazebo
+obstacles:
+  - {type: wall, start: [0.8, -2.0], end: [0.8, 2.0], thickness: 0.1}
+motion:
+  segments:
+    - linear: 0.4
+      until: {obstacle_ahead_below: 0.2}
+threshold: 0.5
+"""
+DRIVE_AWAY = """\
+description: Start near a wall and drive away beyond range_max, where every beam reads +inf.
+lidar:
+  preset: gazebo
+  range_max: 2.0
+obstacles:
+  - {type: wall, start: [-0.4, -3.0], end: [-0.4, 3.0], thickness: 0.1}
+motion:
+  segments:
+    - linear: 2.0
+      until: {distance: 2.5}
+    - until: {duration: 0.5}
+threshold: 0.5
+"""
+OUT_OF_RANGE = "nothing_in_range"  # out_of_range, a sixth of its turn
+LAB_SCENARIOS = ("wall_ahead", "drive_away", OUT_OF_RANGE)
+
+
+def _scenario_files(folder: Path) -> list[Path]:
+    """The three scenarios as files in `folder`, in LAB_SCENARIOS' order."""
+    out_of_range = (REPO / "harness" / "scenarios" / "out_of_range.yaml").read_text()
+    assert "until: {turn: 6.3}" in out_of_range
+    texts = [WALL_AHEAD, DRIVE_AWAY, out_of_range.replace("turn: 6.3", "turn: 1.0")]
+    folder.mkdir()
+    for name, text in zip(LAB_SCENARIOS, texts, strict=True):
+        (folder / f"{name}.yaml").write_text(text)
+    return [folder / f"{name}.yaml" for name in LAB_SCENARIOS]
 
 
 @dataclass
@@ -49,6 +92,7 @@ def graded(tmp_path_factory: pytest.TempPathFactory) -> Graded:
     script_student(classroom / "dave")
     before = {p.name: snapshot(p) for p in classroom.iterdir()}
     here = tmp_path_factory.mktemp("grader")
+    scenarios = _scenario_files(here / "scenarios")
     out = here / "grades"
     started = time.monotonic()
     done = subprocess.run(
@@ -61,7 +105,7 @@ def graded(tmp_path_factory: pytest.TempPathFactory) -> Graded:
             "--jobs",
             "2",
             "--scenario",
-            ",".join(LAB_SCENARIOS),
+            ",".join(str(path) for path in scenarios),
             "--no-audit",  # test_grading_audit.py has the audit's
         ],
         cwd=here,
@@ -93,10 +137,11 @@ def test_good_student_passes_every_scenario(graded: Graded) -> None:
 
 
 def test_buggy_student_fails_with_the_oracles_explanation(graded: Graded) -> None:
-    """The range_min bug passes two scenarios and fails out_of_range, explained in words."""
+    """The range_min bug passes two scenarios and fails out_of_range's, explained in words."""
     bob = graded.rows["bob"]
     assert [bob[s] for s in LAB_SCENARIOS] == ["PASS", "PASS", "FAIL"], bob
-    assert bob["first_failure"].startswith("out_of_range: t=0.00 s tick 0: expected no obstacle")
+    said = f"{OUT_OF_RANGE}: t=0.00 s tick 0: expected no obstacle"
+    assert bob["first_failure"].startswith(said), bob
     assert "below range_min" in bob["first_failure"]
 
 
@@ -171,9 +216,9 @@ def test_each_student_has_a_partial_score_and_the_node_they_ran(graded: Graded) 
     # carol's package did not build: every tick the suite has counts as not held
     assert graded.rows["carol"]["ticks_held"].startswith("0/") and graded.rows["carol"]["node"]
     assert graded.rows["carol"]["ticks_held"].endswith("(0%)")
-    held, judged = (int(n) for n in bob["out_of_range ticks"].split("/"))
+    held, judged = (int(n) for n in bob[f"{OUT_OF_RANGE} ticks"].split("/"))
     assert 0 <= held < judged, bob
-    whole = alice["approach_wall ticks"].split("/")
+    whole = alice[f"{LAB_SCENARIOS[0]} ticks"].split("/")
     assert whole[0] == whole[1] and alice["ticks_held"].endswith("(100%)"), alice
     assert bob["ticks_held"].split(" ")[1] not in ("(100%)", "(0%)"), bob
 
@@ -192,8 +237,8 @@ def test_each_graded_student_has_a_linked_report(graded: Graded) -> None:
 
 def test_run_log_lists_the_verdicts_once(graded: Graded) -> None:
     log = (graded.out / "students" / "bob" / "run.log").read_text(encoding="utf-8")
-    assert "out_of_range: judged (" in log
-    assert sum(line.split()[:1] == ["out_of_range"] for line in log.splitlines()) == 1, log
+    assert f"{OUT_OF_RANGE}: judged (" in log
+    assert sum(line.split()[:1] == [OUT_OF_RANGE] for line in log.splitlines()) == 1, log
 
 
 def test_each_student_has_a_junit_report(graded: Graded) -> None:
@@ -203,7 +248,7 @@ def test_each_student_has_a_junit_report(graded: Graded) -> None:
         cases = root.findall(".//testcase")
         assert [c.get("name") for c in cases] == list(LAB_SCENARIOS), name
     bob = ET.parse(graded.out / "students" / "bob" / "junit.xml").getroot()
-    failure = bob.find(".//testcase[@name='out_of_range']/failure")
+    failure = bob.find(f".//testcase[@name='{OUT_OF_RANGE}']/failure")
     assert failure is not None and "expected no obstacle" in (failure.get("message") or "")
 
 

@@ -1,6 +1,6 @@
 """A class with a hostile hand-in, graded in the sandbox through the embedded cluster and
-an external Dask scheduler: none of its attacks succeeds, the honest students' rows are
-those of an unsandboxed grading, and the hostile student gets a row that says what the
+an external Dask scheduler: none of its attacks succeeds, the honest student's row is
+that of an unsandboxed grading, and the hostile student gets a row that says what the
 sandbox refused.
 
 Real parts: bubblewrap, colcon building the hostile package (its setup.py runs), the
@@ -32,11 +32,27 @@ pytestmark = [
 ]  # needs bubblewrap (`apt install bubblewrap`; .ci/run installs it): grade says so if not
 
 REPO = Path(__file__).resolve().parents[2]
-HONEST_MARK = f"HONEST-{uuid.uuid4().hex[:8]}"  # in the honest students' nodes
+HONEST_MARK = f"HONEST-{uuid.uuid4().hex[:8]}"  # in the honest student's node
 SECRET_MARK = f"SECRET-{uuid.uuid4().hex[:8]}"  # in the hidden scenario file
 HIDDEN_NAME = "secret_corridor"
 LEFTOVER = f"hostile-leftover-{uuid.uuid4().hex[:8]}"
-HONEST = {"ana": "correct", "ben": "angle_in_degrees"}
+# One honest student, who fails the wall (degrees) and passes the hidden scenario: a
+# FAIL with its explanation and a PASS, to match the unsandboxed grading.
+HONEST = {"ben": "angle_in_degrees"}
+VISIBLE = "near_wall"
+# approach_wall in 16 ticks instead of 95: what costs is each student, not the ticks.
+NEAR_WALL = """\
+description: Drive at a near wall until very close, crossing the warning threshold.
+lidar:
+  preset: gazebo
+obstacles:
+  - {type: wall, start: [0.8, -2.0], end: [0.8, 2.0], thickness: 0.1}
+motion:
+  segments:
+    - linear: 0.4
+      until: {obstacle_ahead_below: 0.2}
+threshold: 0.5
+"""
 SANDBOX_MB = 1024
 GRADE = ["grade", "class", "--grading", "course/grading.yaml", "--no-audit"]
 GRADE += ["--ready-timeout", "20", "--timeout", "5", "--sandbox-memory", str(SANDBOX_MB)]
@@ -77,8 +93,9 @@ def listener() -> Iterator[Listener]:
 
 
 def make_course(root: Path, listener: Listener, *, hostile: bool) -> Path:
-    """class/ (ana, ben and maybe eve, the hostile one), course/grading.yaml with a hidden
-    scenario in course/hidden/."""
+    """class/ (ben and maybe eve, the hostile one), course/grading.yaml with a short
+    wall approach and a hidden scenario in course/hidden/ (out_of_range, a sixth of its
+    turn)."""
     for name, variant in HONEST.items():
         (root / "class" / name).mkdir(parents=True)
         source = f"# {HONEST_MARK}\n" + variant_source(variant)
@@ -86,22 +103,22 @@ def make_course(root: Path, listener: Listener, *, hostile: bool) -> Path:
     hidden = root / "course" / "hidden" / f"{HIDDEN_NAME}.yaml"
     hidden.parent.mkdir(parents=True)
     text = (REPO / "harness" / "scenarios" / "out_of_range.yaml").read_text()
-    hidden.write_text(
-        f"# {SECRET_MARK}\n" + text.replace("name: out_of_range", f"name: {HIDDEN_NAME}")
-    )
+    assert "until: {turn: 6.3}" in text
+    hidden.write_text(f"# {SECRET_MARK}\n" + text.replace("turn: 6.3", "turn: 1.0"))
+    (root / "course" / f"{VISIBLE}.yaml").write_text(NEAR_WALL)
     (root / "course" / "grading.yaml").write_text(
-        "scenarios:\n  - approach_wall\n"
+        f"scenarios:\n  - {VISIBLE}.yaml\n"
         f"  - scenario: hidden/{HIDDEN_NAME}.yaml\n    hidden: true\n"
     )
     if hostile:
         out = root / "grades"
         targets = {
             "secrets": [HONEST_MARK, SECRET_MARK],
-            "read": [str(root / "class" / "ana" / "lidar_node.py"), str(hidden)],
+            "read": [str(root / "class" / "ben" / "lidar_node.py"), str(hidden)],
             "write": [
                 str(out / "grades.csv"),
-                str(out / "students" / "ana" / "junit.xml"),
-                str(root / "class" / "ana" / "lidar_node.py"),
+                str(out / "students" / "ben" / "junit.xml"),
+                str(root / "class" / "ben" / "lidar_node.py"),
                 str(hidden),
             ],
             "own": [str(root / "class" / "eve"), str(out / "students" / "eve")],
@@ -174,20 +191,20 @@ def check_contained(root: Path, before: dict[str, bytes], listener_connections: 
 
 @pytest.fixture(scope="module")
 def unsandboxed(tmp_path_factory: pytest.TempPathFactory, listener: Listener) -> dict:
-    """The honest students alone, graded without the sandbox: the rows to match."""
+    """The honest student alone, graded without the sandbox: the row to match."""
     root = make_course(tmp_path_factory.mktemp("plain"), listener, hostile=False)
-    done = grade(root, "--no-sandbox")
+    done = grade(root, "--no-sandbox", "--workers", "1")  # one student: one worker
     assert "warning: --no-sandbox" in done.stdout
     return rows(root / "grades")
 
 
 def check_rows(table: dict[str, dict[str, str]], unsandboxed: dict[str, dict[str, str]]) -> None:
-    assert sorted(table) == ["ana", "ben", "eve"]
+    assert sorted(table) == ["ben", "eve"]
     for name in HONEST:
-        for column in ("approach_wall", HIDDEN_NAME, "passed", "first_failure", "score"):
+        for column in (VISIBLE, HIDDEN_NAME, "passed", "first_failure", "score"):
             assert table[name][column] == unsandboxed[name][column], (name, column)
     eve = table["eve"]
-    assert eve["approach_wall"] == "ERROR", eve
+    assert eve[VISIBLE] == "ERROR", eve
     assert "Read-only file system" in eve["first_failure"], eve
     assert "(the sandbox refused a write outside the student's own folders)" in eve["first_failure"]
     assert str(Path("/tmp")) + "/pytest" not in eve["first_failure"], eve  # no instructor path
@@ -210,7 +227,7 @@ def test_external_cluster_contains_the_hostile_hand_in(
 ) -> None:
     root = make_course(tmp_path, listener, hostile=True)
     before = {"class": snapshot(root / "class"), "course": snapshot(root / "course")}
-    with dask_cluster(2, nanny=True, env=GRADING_ENV) as (address, _):
+    with dask_cluster(1, nanny=True, env=GRADING_ENV) as (address, _):
         grade(root, "--scheduler", address)
     check_rows(rows(root / "grades"), unsandboxed)
     check_contained(root, before, listener.connections)
