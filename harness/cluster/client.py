@@ -18,7 +18,8 @@ WORKER_WAIT_S = 30.0  # for an external cluster without workers to get one (--wo
 ONE_TASK_PER_THREAD = 1.0
 # The embedded cluster's workers are forked from one multiprocessing fork server that has
 # imported Dask and what the command's tasks import (`preload`), instead of each spawning
-# a fresh Python that imports them again: a sweep of 2 workers took 7.8 CPU-s, not 10.3.
+# a fresh Python that imports them again: a sweep of 2 runs on 2 workers took 7.6 CPU-s,
+# not 8.8. What it imports must start no thread (tests/test_warm_worker.py).
 WORKER_START = "forkserver"
 
 

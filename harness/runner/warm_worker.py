@@ -1,17 +1,20 @@
 """What a Dask worker that runs scenarios imports before it is forked: the run's side
-(the simulation, the LIDAR, the judge, the ROS 2 link and its message types).
+(the simulation, the LIDAR, the judge, the report).
 
 Importing this module is the whole of it. Commands whose tasks run scenarios in the
 worker itself (sweep, hunt) name it to ``open_client``, whose embedded cluster forks
 its workers from one multiprocessing fork server that has imported it: a cluster of
 N workers pays these imports once instead of N times, and a worker Dask restarts
-after a crash comes back warm. Nothing here starts a thread, a ROS context or a
-simulation: those belong to each task.
+after a crash comes back warm. Nothing here may start a thread, a ROS context or a
+simulation: a fork keeps only the thread that forks, so a worker would inherit the
+locks other threads held. That leaves rclpy out: importing it starts two threads of
+its middleware's (a worker forked with them hung in a rehearsal), so each worker
+imports it itself. numpy's OpenBLAS thread is Dask's own preload's too, and forks
+safely (OpenBLAS resets its pool in the child).
 """
 
 from __future__ import annotations
 
-import contextlib
 import importlib
 
 WARM_MODULES = (
@@ -19,14 +22,8 @@ WARM_MODULES = (
     "harness.sim.bullet",  # pybullet, its banner swallowed
     "harness.runner.scenario_run",
     "harness.runner.suite",
-    "harness.links.ros2",
     "harness.report.summary",
-    "rclpy",
-    "rclpy.node",
-    "sensor_msgs.msg",
-    "std_msgs.msg",
 )
 
 for _name in WARM_MODULES:
-    with contextlib.suppress(ImportError):  # without the ros extra: the inprocess link alone
-        importlib.import_module(_name)
+    importlib.import_module(_name)
