@@ -306,8 +306,9 @@ def test_realtime_pacing_at_115200_baud(
         "serial_realtime_period_jitter_p99_ms", round(pacing.period_jitter_p99_ms, 3)
     )
     record_testsuite_property("serial_realtime_period_mean_ms", round(pacing.period_mean_ms, 3))
-    # Loose sanity bounds only: this is a measurement, reported above.
-    assert abs(seen / nominal - 1) < 0.2
+    # Loose sanity bounds only: this is a measurement, reported above. The reader's own
+    # rate is reported, not bounded: it times this test's thread, which a loaded machine
+    # holds back (a rehearsal's full suite read 25 % slow while the server kept its pace).
     assert abs(pacing.mean_rate_error_pct) < 20
     starts = [d.started_at for d in deliveries]
     assert all(abs((b - a) - period) < 0.2 * period for a, b in pairwise(starts))
