@@ -12,28 +12,13 @@ from pathlib import Path
 
 import pytest
 from command_line import COMMAND
+from short_scenarios import WALL_AHEAD
 
 from harness.audit import MUTANTS
 from harness.cli import main
 
-# Short versions of shipped scenarios (a few seconds each, not 10 to 14): the audit runs
-# every mistake through every scenario, once per seed.
-WALL_AHEAD = """\
-description: Drive at a wall 0.6 m ahead until very close (approach_wall, short).
-lidar:
-  preset: gazebo
-obstacles:
-  - type: wall
-    start: [0.6, -2.0]
-    end: [0.6, 2.0]
-    thickness: 0.1
-motion:
-  segments:
-    - linear: 0.2
-      until: {obstacle_ahead_below: 0.2}
-    - until: {duration: 0.5}
-threshold: 0.5
-"""
+# drive_past_10m in 1.5 s: its warning must clear (the audit runs every mistake through
+# every scenario, once per seed).
 DRIVE_AWAY = """\
 description: Start near a wall and drive 1 m away from it (drive_past_10m, short).
 lidar:

@@ -11,6 +11,7 @@ import sys
 from pathlib import Path
 
 import pytest
+from short_scenarios import WALL_AHEAD
 
 from harness.audit import MUTANTS, Mutant, mutant_command, mutant_named
 from harness.audit.mutants import CONTROL, NODE_SCRIPT
@@ -167,25 +168,6 @@ def test_an_unknown_mutant_never_starts_and_the_result_says_why() -> None:
     said = f"{result.error}\n{result.diagnostics}"
     assert "exited with code 2" in said, said
     assert "unknown mutant 'no_such_mistake'" in said, said
-
-
-# approach_wall in 2.5 s instead of 9.5 s: a wall in range on every scan.
-WALL_AHEAD = """\
-description: Drive at a wall 0.6 m ahead until very close, crossing the warning threshold.
-lidar:
-  preset: gazebo
-obstacles:
-  - type: wall
-    start: [0.6, -2.0]
-    end: [0.6, 2.0]
-    thickness: 0.1
-motion:
-  segments:
-    - linear: 0.2
-      until: {obstacle_ahead_below: 0.2}
-    - until: {duration: 0.5}
-threshold: 0.5
-"""
 
 
 @pytest.mark.ros

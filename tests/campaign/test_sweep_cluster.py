@@ -25,22 +25,9 @@ import pytest
 from cluster_nodes import HANGS, KILLS_ITS_WORKER
 from command_line import COMMAND, fossbot_hil
 from dask_cluster import children, dask_cluster
+from short_scenarios import NEAR_WALL
 
 pytestmark = [pytest.mark.ros, pytest.mark.slow, pytest.mark.timeout(300)]
-
-# approach_wall in 16 ticks instead of 95: what costs is each run's node, not its ticks.
-NEAR_WALL = """\
-description: Drive at a near wall until very close, crossing the warning threshold.
-lidar:
-  preset: gazebo
-obstacles:
-  - {type: wall, start: [0.8, -2.0], end: [0.8, 2.0], thickness: 0.1}
-motion:
-  segments:
-    - linear: 0.4
-      until: {obstacle_ahead_below: 0.2}
-threshold: 0.5
-"""
 
 
 @pytest.fixture(scope="module")

@@ -13,27 +13,9 @@ from pathlib import Path
 import pytest
 from command_line import COMMAND
 from grading_class import script_student
+from short_scenarios import WALL_AHEAD
 
 pytestmark = [pytest.mark.ros, pytest.mark.slow, pytest.mark.timeout(300)]
-
-# approach_wall in 2.5 s instead of 9.5 s (the audit runs the whole library through it):
-# a wall ahead, the warning threshold crossed on the way, standing still close to it.
-WALL_AHEAD = """\
-description: Drive at a wall 0.6 m ahead until very close, crossing the warning threshold.
-lidar:
-  preset: gazebo
-obstacles:
-  - type: wall
-    start: [0.6, -2.0]
-    end: [0.6, 2.0]
-    thickness: 0.1
-motion:
-  segments:
-    - linear: 0.2
-      until: {obstacle_ahead_below: 0.2}
-    - until: {duration: 0.5}
-threshold: 0.5
-"""
 
 
 def grade(tmp_path: Path, scenario: Path, out: str) -> subprocess.CompletedProcess[str]:

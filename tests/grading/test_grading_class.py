@@ -26,23 +26,12 @@ from grading_class import (
     script_student,
     snapshot,
 )
+from short_scenarios import NEAR_WALL
 
 pytestmark = [pytest.mark.ros, pytest.mark.slow, pytest.mark.timeout(240)]
 
 # The lab's scenarios in 46 ticks instead of 293: what costs is each student's build and
 # nodes, not the ticks. Each still catches what its lab scenario does.
-WALL_AHEAD = """\
-description: Drive at a near wall until very close, crossing the warning threshold.
-lidar:
-  preset: gazebo
-obstacles:
-  - {type: wall, start: [0.8, -2.0], end: [0.8, 2.0], thickness: 0.1}
-motion:
-  segments:
-    - linear: 0.4
-      until: {obstacle_ahead_below: 0.2}
-threshold: 0.5
-"""
 DRIVE_AWAY = """\
 description: Start near a wall and drive away beyond range_max, where every beam reads +inf.
 lidar:
@@ -65,7 +54,7 @@ def _scenario_files(folder: Path) -> list[Path]:
     """The three scenarios as files in `folder`, in LAB_SCENARIOS' order."""
     out_of_range = (REPO / "harness" / "scenarios" / "out_of_range.yaml").read_text()
     assert "until: {turn: 6.3}" in out_of_range
-    texts = [WALL_AHEAD, DRIVE_AWAY, out_of_range.replace("turn: 6.3", "turn: 1.0")]
+    texts = [NEAR_WALL, DRIVE_AWAY, out_of_range.replace("turn: 6.3", "turn: 1.0")]
     folder.mkdir()
     for name, text in zip(LAB_SCENARIOS, texts, strict=True):
         (folder / f"{name}.yaml").write_text(text)

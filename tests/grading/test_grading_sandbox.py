@@ -24,6 +24,7 @@ from cluster_nodes import variant_source
 from command_line import COMMAND
 from dask_cluster import GRADING_ENV, dask_cluster
 from hostile_student import hostile_package, reports
+from short_scenarios import NEAR_WALL
 
 pytestmark = [
     pytest.mark.ros,
@@ -40,19 +41,6 @@ LEFTOVER = f"hostile-leftover-{uuid.uuid4().hex[:8]}"
 # FAIL with its explanation and a PASS, to match the unsandboxed grading.
 HONEST = {"ben": "angle_in_degrees"}
 VISIBLE = "near_wall"
-# approach_wall in 16 ticks instead of 95: what costs is each student, not the ticks.
-NEAR_WALL = """\
-description: Drive at a near wall until very close, crossing the warning threshold.
-lidar:
-  preset: gazebo
-obstacles:
-  - {type: wall, start: [0.8, -2.0], end: [0.8, 2.0], thickness: 0.1}
-motion:
-  segments:
-    - linear: 0.4
-      until: {obstacle_ahead_below: 0.2}
-threshold: 0.5
-"""
 SANDBOX_MB = 1024
 GRADE = ["grade", "class", "--grading", "course/grading.yaml", "--no-audit"]
 GRADE += ["--ready-timeout", "20", "--timeout", "5", "--sandbox-memory", str(SANDBOX_MB)]
