@@ -84,19 +84,12 @@ def open_client(
 
 
 def _warm_worker_start(preload: Sequence[str]) -> None:
-    """Have the fork server the workers start from import `preload` too, after Dask's own
-    list (distributed and its packages). It starts with the first worker and lasts as
-    long as this process: later clusters of the same process share it, as it is."""
-    from multiprocessing import forkserver
-
+    """Have the fork server the workers start from import `preload` beside distributed
+    (which imports the packages Dask's own list names). It starts with the first worker
+    and lasts as long as this process: later clusters of the same process share it."""
     from distributed.utils import get_mp_context
 
-    context = get_mp_context()  # sets Dask's preload list the first time
-    server = getattr(forkserver, "_forkserver", None)
-    modules = list(getattr(server, "_preload_modules", None) or ["distributed"])
-    added = [name for name in preload if name not in modules]
-    if added:
-        context.set_forkserver_preload([*modules, *added])
+    get_mp_context().set_forkserver_preload(["distributed", *preload])
 
 
 def check_scheduler(address: str) -> None:

@@ -15,15 +15,9 @@ safely (OpenBLAS resets its pool in the child).
 
 from __future__ import annotations
 
-import importlib
+import numpy  # noqa: F401
 
-WARM_MODULES = (
-    "numpy",
-    "harness.sim.bullet",  # pybullet, its banner swallowed
-    "harness.runner.scenario_run",
-    "harness.runner.suite",
-    "harness.report.summary",
-)
-
-for _name in WARM_MODULES:
-    importlib.import_module(_name)
+import harness.report.summary  # noqa: F401
+import harness.runner.scenario_run  # noqa: F401
+import harness.runner.suite  # noqa: F401
+import harness.sim.bullet  # noqa: F401  (pybullet, its banner swallowed)
