@@ -16,11 +16,12 @@ WORKER_WAIT_S = 30.0  # for an external cluster without workers to get one (--wo
 # queued task down with it (Dask counts those as suspects, and gives up on a
 # task suspected `allowed-failures` + 1 times).
 ONE_TASK_PER_THREAD = 1.0
-# The embedded cluster's workers are forked from one multiprocessing fork server that has
-# imported Dask and what the command's tasks import (`preload`), instead of each spawning
-# a fresh Python that imports them again: a sweep of 2 runs on 2 workers took 7.6 CPU-s,
-# not 8.8. What it imports must start no thread (tests/test_warm_worker.py).
-WORKER_START = "forkserver"
+# How the embedded cluster's workers start. "forkserver" (each forked from one process that
+# imported Dask and the command's `preload`) saved about 1.2 CPU-s a 2-worker cluster, but a
+# forked sweep worker hung in two rehearsals (once with rclpy preloaded, once without), so
+# the workers spawn a fresh Python each until that is understood; `preload` is used only
+# with "forkserver".
+WORKER_START = "spawn"
 
 
 def default_workers() -> int:
@@ -71,7 +72,8 @@ def open_client(
         limits["distributed.scheduler.allowed-failures"] = retries
     limits["distributed.worker.multiprocessing-method"] = WORKER_START
     with dask.config.set(limits):  # read by the scheduler and the nannies, which start here
-        _warm_worker_start(preload)
+        if WORKER_START == "forkserver":
+            _warm_worker_start(preload)
         cluster = LocalCluster(
             n_workers=count,
             threads_per_worker=1,
