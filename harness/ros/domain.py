@@ -17,6 +17,10 @@ id (a test that reserved a domain for the board it simulates) runs in
 that reservation. The reservation excludes only other fossbot-hil runs on
 this machine: joining a board's graph over the network (``--ros-network
 --domain-id 0``) is what an explicit id is for.
+
+Once reserved, the domain's shared-memory ports that a killed process left
+half-made are cleared (``harness.ros.shm_ports``): a participant that met
+one would wait for it forever.
 """
 
 from __future__ import annotations
@@ -27,6 +31,7 @@ from pathlib import Path
 
 from harness.errors import ConfigError, LinkError
 from harness.holder_lock import Held, HolderLock, shared_folder, take
+from harness.ros.shm_ports import clear_half_made_ports
 
 # 0 is everyone's default; ids above 101 can collide with ephemeral ports on Linux.
 FIRST_ID, LAST_ID = 1, 101
@@ -96,7 +101,7 @@ def reserve_domain(preferred: int | None = None) -> DomainReservation:
         domain_id = FIRST_ID + (start + offset) % span
         lock = _try_lock(domain_id)
         if lock is not None:
-            return DomainReservation(domain_id, lock)
+            return _reserved(domain_id, lock)
     raise LinkError(f"no free ROS domain id in {FIRST_ID}..{LAST_ID}: too many runs at once")
 
 
@@ -117,6 +122,12 @@ def _reserve_explicit(domain_id: int) -> DomainReservation:
         raise ConfigError(
             f"ROS domain {domain_id}: cannot use its lock file {path}: {err.strerror or err}"
         ) from None
+    return _reserved(domain_id, lock)
+
+
+def _reserved(domain_id: int, lock: HolderLock) -> DomainReservation:
+    """The reservation of `domain_id`, its half-made shared-memory ports cleared first."""
+    clear_half_made_ports(domain_id)
     return DomainReservation(domain_id, lock)
 
 

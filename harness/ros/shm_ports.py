@@ -1,0 +1,60 @@
+"""Fast DDS shared-memory ports left half-made by a killed process (pure: no rclpy).
+
+Fast DDS gives each port of a domain a shared-memory segment,
+``/dev/shm/fastrtps_port<N>``, made by whichever participant needs it first:
+the file is created empty, sized, then marked ready. A process killed
+between those steps (a node or worker SIGKILLed mid-start) leaves the file
+empty or never marked, and from then on every participant of that domain
+that takes the same port waits for it to be marked, forever: its process no
+longer answers SIGINT or SIGTERM. A node "never becomes ready"; a harness
+participant hangs its whole run.
+
+A run clears the half-made ports of the domain it reserved before any
+participant of its own starts there. Only files that have stayed half-made
+for `ABANDONED_AFTER_S` are removed: making one takes microseconds, so a
+younger one may be another program's, still being made. The next
+participant that needs the port makes it again.
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from pathlib import Path
+
+__all__ = ["ABANDONED_AFTER_S", "clear_half_made_ports", "domain_ports"]
+
+SHM_DIR = Path("/dev/shm")
+PORT_BASE, DOMAIN_GAIN = 7400, 250  # RTPS's port formula: a domain owns 250 ports
+READY = (2).to_bytes(4, "little")  # the segment's first word once it is made
+ABANDONED_AFTER_S = 10.0
+
+
+def domain_ports(domain_id: int) -> range:
+    """Every port number the RTPS formula can give a participant of `domain_id`."""
+    first = PORT_BASE + DOMAIN_GAIN * domain_id
+    return range(first, first + DOMAIN_GAIN)
+
+
+def clear_half_made_ports(
+    domain_id: int, *, shm_dir: Path = SHM_DIR, now: float | None = None
+) -> list[str]:
+    """Remove `domain_id`'s port segments that were abandoned half-made; their names."""
+    now = time.time() if now is None else now
+    removed = []
+    for port in domain_ports(domain_id):
+        path = shm_dir / f"fastrtps_port{port}"
+        try:
+            with path.open("rb") as segment:
+                stat = os.fstat(segment.fileno())
+                head = segment.read(len(READY))
+        except OSError:  # no such port (the usual case), or not ours to read
+            continue
+        if head == READY or now - stat.st_mtime < ABANDONED_AFTER_S:
+            continue
+        try:
+            path.unlink()
+        except OSError:  # another user's file in the shared folder: theirs to clear
+            continue
+        removed.append(path.name)
+    return removed
