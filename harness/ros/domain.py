@@ -101,7 +101,8 @@ def reserve_domain(preferred: int | None = None) -> DomainReservation:
         domain_id = FIRST_ID + (start + offset) % span
         lock = _try_lock(domain_id)
         if lock is not None:
-            return _reserved(domain_id, lock)
+            clear_half_made_ports(domain_id, older_than=0.0)  # ours alone: all abandoned
+            return DomainReservation(domain_id, lock)
     raise LinkError(f"no free ROS domain id in {FIRST_ID}..{LAST_ID}: too many runs at once")
 
 
@@ -122,12 +123,7 @@ def _reserve_explicit(domain_id: int) -> DomainReservation:
         raise ConfigError(
             f"ROS domain {domain_id}: cannot use its lock file {path}: {err.strerror or err}"
         ) from None
-    return _reserved(domain_id, lock)
-
-
-def _reserved(domain_id: int, lock: HolderLock) -> DomainReservation:
-    """The reservation of `domain_id`, its half-made shared-memory ports cleared first."""
-    clear_half_made_ports(domain_id)
+    clear_half_made_ports(domain_id)  # other programs may share it: only old ones
     return DomainReservation(domain_id, lock)
 
 

@@ -10,10 +10,12 @@ longer answers SIGINT or SIGTERM. A node "never becomes ready"; a harness
 participant hangs its whole run.
 
 A run clears the half-made ports of the domain it reserved before any
-participant of its own starts there. Only files that have stayed half-made
-for `ABANDONED_AFTER_S` are removed: making one takes microseconds, so a
-younger one may be another program's, still being made. The next
-participant that needs the port makes it again.
+participant of its own starts there; the next participant that needs such a
+port makes it again. In a domain the harness chose, every half-made port is
+abandoned: whatever a run before left there is gone once its reservation
+could be taken. In a domain the user named, other programs may be making a
+port right now, so only files that have stayed half-made for
+`ABANDONED_AFTER_S` go (making one takes microseconds).
 """
 
 from __future__ import annotations
@@ -37,9 +39,14 @@ def domain_ports(domain_id: int) -> range:
 
 
 def clear_half_made_ports(
-    domain_id: int, *, shm_dir: Path = SHM_DIR, now: float | None = None
+    domain_id: int,
+    *,
+    older_than: float = ABANDONED_AFTER_S,
+    shm_dir: Path = SHM_DIR,
+    now: float | None = None,
 ) -> list[str]:
-    """Remove `domain_id`'s port segments that were abandoned half-made; their names."""
+    """Remove `domain_id`'s port segments left half-made at least `older_than` seconds
+    ago; their names."""
     now = time.time() if now is None else now
     removed = []
     for port in domain_ports(domain_id):
@@ -50,7 +57,7 @@ def clear_half_made_ports(
                 head = segment.read(len(READY))
         except OSError:  # no such port (the usual case), or not ours to read
             continue
-        if head == READY or now - stat.st_mtime < ABANDONED_AFTER_S:
+        if head == READY or now - stat.st_mtime < older_than:
             continue
         try:
             path.unlink()

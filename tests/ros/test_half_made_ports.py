@@ -49,6 +49,14 @@ def test_only_abandoned_half_made_ports_of_the_domain_are_removed(tmp_path: Path
     assert ready.exists() and being_made.exists() and other_domain.exists()
 
 
+def test_in_a_domain_of_the_harnesss_own_no_half_made_port_is_young_enough(
+    tmp_path: Path,
+) -> None:
+    """A domain the harness chose has no other program in it: any half-made port goes."""
+    port = segment(tmp_path, domain_ports(7)[11], b"", NOW)
+    assert clear_half_made_ports(7, older_than=0.0, shm_dir=tmp_path, now=NOW) == [port.name]
+
+
 def test_a_domain_owns_the_rtps_port_range() -> None:
     assert domain_ports(0) == range(7400, 7650)
     assert domain_ports(79)[11] == 27161  # participant 0's user-traffic port
