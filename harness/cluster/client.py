@@ -16,12 +16,12 @@ WORKER_WAIT_S = 30.0  # for an external cluster without workers to get one (--wo
 # queued task down with it (Dask counts those as suspects, and gives up on a
 # task suspected `allowed-failures` + 1 times).
 ONE_TASK_PER_THREAD = 1.0
-# How the embedded cluster's workers start. "forkserver" (each forked from one process that
-# imported Dask and the command's `preload`) saved about 1.2 CPU-s a 2-worker cluster, but a
-# forked sweep worker hung in two rehearsals (once with rclpy preloaded, once without), so
-# the workers spawn a fresh Python each until that is understood; `preload` is used only
-# with "forkserver".
-WORKER_START = "spawn"
+# How the embedded cluster's workers start: each forked from one process that imported Dask
+# and the command's `preload` (about 1.2 CPU-s less a 2-worker cluster than spawning a fresh
+# Python each). Workers that hung once were waiting on a Fast DDS port a killed process had
+# left half-made, whichever way they started (harness.ros.shm_ports). "spawn" is the
+# fallback; `preload` is used only with "forkserver".
+WORKER_START = "forkserver"
 
 
 def default_workers() -> int:
