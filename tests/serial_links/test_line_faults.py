@@ -84,9 +84,10 @@ def run_on_line(
     return LineRun(result, line.flipped, line.dropped, line.noise_bytes)
 
 
-# Each scan's deadline: the run is in real time, and a loaded machine has held the answer
-# to the revolution after a lost one (the driver restarting its scan) back 3.7 s.
-DEADLINE_S = 5.0
+# Each scan's deadline: the run is in real time, and on a loaded machine the answer to the
+# revolution after a lost one (the driver restarting its scan) has come 3.7 and 5.8 s late
+# (never here when idle). Each lost revolution waits it out too: a run loses a few.
+DEADLINE_S = 10.0
 
 # Rates that keep a run short and right. ldlidar's driver checks each packet's
 # CRC and loses only the damaged packet; the bundled rplidar driver restarts
@@ -103,7 +104,7 @@ CASES = {
 
 
 @pytest.mark.ros
-@pytest.mark.timeout(90)
+@pytest.mark.timeout(150)
 @pytest.mark.parametrize(("link", "kind"), list(CASES), ids=[f"{a}-{b}" for a, b in CASES])
 def test_reference_node_passes_a_damaged_line(link: str, kind: str) -> None:
     """The line is damaged (counted), the reference node still passes, and every
