@@ -101,7 +101,7 @@ def reserve_domain(preferred: int | None = None) -> DomainReservation:
         domain_id = FIRST_ID + (start + offset) % span
         lock = _try_lock(domain_id)
         if lock is not None:
-            clear_half_made_ports(domain_id, older_than=0.0)  # ours alone: all abandoned
+            clear_half_made_ports(domain_id, shared=False)
             return DomainReservation(domain_id, lock)
     raise LinkError(f"no free ROS domain id in {FIRST_ID}..{LAST_ID}: too many runs at once")
 
@@ -123,7 +123,7 @@ def _reserve_explicit(domain_id: int) -> DomainReservation:
         raise ConfigError(
             f"ROS domain {domain_id}: cannot use its lock file {path}: {err.strerror or err}"
         ) from None
-    clear_half_made_ports(domain_id)  # other programs may share it: only old ones
+    clear_half_made_ports(domain_id, shared=True)  # a named id: others may be in it
     return DomainReservation(domain_id, lock)
 
 

@@ -11,11 +11,12 @@ participant hangs its whole run.
 
 A run clears the half-made ports of the domain it reserved before any
 participant of its own starts there; the next participant that needs such a
-port makes it again. In a domain the harness chose, every half-made port is
-abandoned: whatever a run before left there is gone once its reservation
-could be taken. In a domain the user named, other programs may be making a
-port right now, so only files that have stayed half-made for
-`ABANDONED_AFTER_S` go (making one takes microseconds).
+port makes it again. In a domain the harness chose, every port not marked
+ready goes: whatever a run before left there is gone once its reservation
+could be taken, so even a port that was whole is only made again. A domain
+the user named is shared with other programs, which may be making a port
+right now or use another Fast DDS whose mark differs: there only files that
+have stayed empty for `ABANDONED_AFTER_S` go (making one takes microseconds).
 """
 
 from __future__ import annotations
@@ -39,14 +40,10 @@ def domain_ports(domain_id: int) -> range:
 
 
 def clear_half_made_ports(
-    domain_id: int,
-    *,
-    older_than: float = ABANDONED_AFTER_S,
-    shm_dir: Path = SHM_DIR,
-    now: float | None = None,
+    domain_id: int, *, shared: bool, shm_dir: Path = SHM_DIR, now: float | None = None
 ) -> list[str]:
-    """Remove `domain_id`'s port segments left half-made at least `older_than` seconds
-    ago; their names."""
+    """Remove `domain_id`'s half-made port segments; their names. `shared`: other programs
+    may be in the domain (an id the user named), so only ones long empty."""
     now = time.time() if now is None else now
     removed = []
     for port in domain_ports(domain_id):
@@ -57,7 +54,11 @@ def clear_half_made_ports(
                 head = segment.read(len(READY))
         except OSError:  # no such port (the usual case), or not ours to read
             continue
-        if head == READY or now - stat.st_mtime < older_than:
+        if shared:
+            abandoned = not head and now - stat.st_mtime >= ABANDONED_AFTER_S
+        else:
+            abandoned = head != READY
+        if not abandoned:
             continue
         try:
             path.unlink()

@@ -36,25 +36,28 @@ def segment(folder: Path, port: int, content: bytes, mtime: float) -> Path:
     return path
 
 
-def test_only_abandoned_half_made_ports_of_the_domain_are_removed(tmp_path: Path) -> None:
-    first = domain_ports(7)[0]
-    empty = segment(tmp_path, first + 11, b"", OLD)
-    unmarked = segment(tmp_path, first + 13, bytes(64), OLD)
-    ready = segment(tmp_path, first + 15, READY + bytes(60), OLD)
-    being_made = segment(tmp_path, first + 17, b"", NOW - 1)
-    other_domain = segment(tmp_path, domain_ports(8)[0] + 11, b"", OLD)
-    removed = clear_half_made_ports(7, shm_dir=tmp_path, now=NOW)
-    assert sorted(removed) == sorted([empty.name, unmarked.name])
-    assert not empty.exists() and not unmarked.exists()
-    assert ready.exists() and being_made.exists() and other_domain.exists()
-
-
-def test_in_a_domain_of_the_harnesss_own_no_half_made_port_is_young_enough(
+def test_in_a_domain_of_its_own_the_harness_removes_every_port_not_marked_ready(
     tmp_path: Path,
 ) -> None:
-    """A domain the harness chose has no other program in it: any half-made port goes."""
-    port = segment(tmp_path, domain_ports(7)[11], b"", NOW)
-    assert clear_half_made_ports(7, older_than=0.0, shm_dir=tmp_path, now=NOW) == [port.name]
+    first = domain_ports(7)[0]
+    empty = segment(tmp_path, first + 11, b"", NOW)
+    unmarked = segment(tmp_path, first + 13, bytes(64), NOW)
+    ready = segment(tmp_path, first + 15, READY + bytes(60), OLD)
+    other_domain = segment(tmp_path, domain_ports(8)[0] + 11, b"", OLD)
+    removed = clear_half_made_ports(7, shared=False, shm_dir=tmp_path, now=NOW)
+    assert sorted(removed) == sorted([empty.name, unmarked.name])
+    assert ready.exists() and other_domain.exists()
+
+
+def test_in_a_named_domain_only_ports_long_empty_are_removed(tmp_path: Path) -> None:
+    """Other programs may be making a port there, or mark theirs another way."""
+    first = domain_ports(7)[0]
+    long_empty = segment(tmp_path, first + 11, b"", OLD)
+    being_made = segment(tmp_path, first + 13, b"", NOW - 1)
+    marked_otherwise = segment(tmp_path, first + 15, bytes(64), OLD)
+    removed = clear_half_made_ports(7, shared=True, shm_dir=tmp_path, now=NOW)
+    assert removed == [long_empty.name]
+    assert being_made.exists() and marked_otherwise.exists()
 
 
 def test_a_domain_owns_the_rtps_port_range() -> None:
