@@ -156,6 +156,7 @@ class Ros2Link(Link):
         self._silent_empty = 0  # of those, scans with no valid return
         self._silent_bools = 0  # Bools the node published for them (so it is not stuck)
         self._answered_empty = False  # the node answered a scan with no valid return
+        self._late_in_streak: tuple[int, float] | None = None  # (tick, after) of a late answer
         self._copies = 1  # copies of the scan just sent (the first one is resent until answered)
         self._alive_until = 0.0  # perf_counter until which the node counts as running
         self._counted = (0, 0)  # statuses and Bools heard, all told, when the last collect ended
@@ -877,6 +878,7 @@ class Ros2Link(Link):
         (`empty`: this scan had no valid return)."""
         if not answers.timed_out:
             self._silent_scans = self._silent_empty = self._silent_bools = 0
+            self._late_in_streak = None
             self._answered_empty = self._answered_empty or (empty and bool(answers.statuses))
             return
         self._silent_scans += 1
@@ -884,14 +886,25 @@ class Ros2Link(Link):
         self._silent_bools += sum(
             1 for r in answers.late if r.tick == tick and isinstance(r.value, bool)
         )
+        came_late = [r for r in answers.late if r.tick == tick and isinstance(r.value, str)]
+        if came_late:
+            self._late_in_streak = (tick, came_late[0].after)
         if self._silent_scans < STOPPED_AFTER or answers.problem is not None:
             return
         deadline = f"the {self.options.scan_timeout:g} s deadline"
-        came_late = [r for r in answers.late if r.tick == tick and isinstance(r.value, str)]
         if came_late:
             answers.problem = (
                 f"node answers too late: {self._silent_scans} scans in a row missed {deadline} "
                 f"(the last answer came after {came_late[0].after:.2f} s)"
+            )
+        elif self._late_in_streak is not None:
+            # Slow, not stopped: an earlier scan of the streak was answered, late, and this
+            # one's answer had not come when the harness stopped waiting for it.
+            late_tick, after = self._late_in_streak
+            answers.problem = (
+                f"node answers too late: {self._silent_scans} scans in a row missed {deadline} "
+                f"(tick {late_tick}'s answer came after {after:.2f} s; the last scan's had not "
+                "come when the harness stopped waiting)"
             )
         elif self._silent_empty == self._silent_scans and not self._answered_empty:
             answers.problem = (
