@@ -1,8 +1,13 @@
 """Short scenario files for tests that start many nodes for another point: what costs
 there is each node's start and link, not the ticks. Each is shaped like the shipped
-approach_wall (a wall ahead, the warning threshold crossed on the way)."""
+approach_wall (a wall ahead, the warning threshold crossed on the way), but the last,
+nothing in range."""
 
 from __future__ import annotations
+
+from pathlib import Path
+
+SHIPPED = Path(__file__).resolve().parents[1] / "harness" / "scenarios"
 
 # approach_wall in 2.5 s instead of 9.5 s: a wall 0.6 m ahead, then standing still close.
 WALL_AHEAD = """\
@@ -34,3 +39,10 @@ motion:
       until: {obstacle_ahead_below: 0.2}
 threshold: 0.5
 """
+
+
+def nothing_in_range() -> str:
+    """out_of_range with a sixth of its turn: every beam +inf, a few ticks."""
+    text = (SHIPPED / "out_of_range.yaml").read_text()
+    assert "until: {turn: 6.3}" in text
+    return text.replace("turn: 6.3", "turn: 1.0")

@@ -1,7 +1,7 @@
 """What the embedded cluster's workers are forked with: a fork keeps only the thread that
 forks, so the modules its fork server imports first (harness.cluster.client's `preload`,
 named by each command) must start no thread a worker could inherit the locks of: no
-rclpy (its import starts two threads of its middleware's). numpy's OpenBLAS thread is in
+rclpy (its import starts LTTng-UST's two listener threads). numpy's OpenBLAS thread is in
 Dask's own preload and forks safely."""
 
 from __future__ import annotations

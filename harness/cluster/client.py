@@ -16,11 +16,11 @@ WORKER_WAIT_S = 30.0  # for an external cluster without workers to get one (--wo
 # queued task down with it (Dask counts those as suspects, and gives up on a
 # task suspected `allowed-failures` + 1 times).
 ONE_TASK_PER_THREAD = 1.0
-# How the embedded cluster's workers start: each forked from one process that imported Dask
-# and the command's `preload` (about 1.2 CPU-s less a 2-worker cluster than spawning a fresh
-# Python each). Workers that hung once were waiting on a Fast DDS port a killed process had
-# left half-made, whichever way they started (harness.ros.shm_ports). "spawn" is the
-# fallback; `preload` is used only with "forkserver".
+# The embedded cluster's workers are forked from one multiprocessing fork server that has
+# imported Dask and what the command's tasks import (`preload`), instead of each spawning a
+# fresh Python: about 1.2 CPU-s less a 2-worker cluster. (Workers that hung, forked or
+# spawned, were waiting on a Fast DDS port a killed process had left half-made:
+# harness.ros.shm_ports.)
 WORKER_START = "forkserver"
 
 
@@ -72,8 +72,7 @@ def open_client(
         limits["distributed.scheduler.allowed-failures"] = retries
     limits["distributed.worker.multiprocessing-method"] = WORKER_START
     with dask.config.set(limits):  # read by the scheduler and the nannies, which start here
-        if WORKER_START == "forkserver":
-            _warm_worker_start(preload)
+        _warm_worker_start(preload)
         cluster = LocalCluster(
             n_workers=count,
             threads_per_worker=1,

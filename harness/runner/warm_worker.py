@@ -7,9 +7,9 @@ its workers from one multiprocessing fork server that has imported it: a cluster
 N workers pays these imports once instead of N times, and a worker Dask restarts
 after a crash comes back warm. Nothing here may start a thread, a ROS context or a
 simulation: a fork keeps only the thread that forks, so a worker would inherit the
-locks other threads held. That leaves rclpy out: importing it starts two threads of
-its middleware's (a worker forked with them hung in a rehearsal), so each worker
-imports it itself. numpy's OpenBLAS thread is Dask's own preload's too, and forks
+locks other threads held. That leaves rclpy out: importing it starts the two listener
+threads of LTTng-UST (the tracing library its middleware's wheels bundle), so each
+worker imports it itself. numpy's OpenBLAS thread is Dask's own preload's too, and forks
 safely (OpenBLAS resets its pool in the child).
 """
 

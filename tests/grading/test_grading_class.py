@@ -19,14 +19,13 @@ from pathlib import Path
 import pytest
 from command_line import COMMAND
 from grading_class import (
-    REPO,
     broken_setup_package,
     good_workspace,
     range_min_bug_package,
     script_student,
     snapshot,
 )
-from short_scenarios import NEAR_WALL
+from short_scenarios import NEAR_WALL, nothing_in_range
 
 pytestmark = [pytest.mark.ros, pytest.mark.slow, pytest.mark.timeout(240)]
 
@@ -52,9 +51,7 @@ LAB_SCENARIOS = ("wall_ahead", "drive_away", OUT_OF_RANGE)
 
 def _scenario_files(folder: Path) -> list[Path]:
     """The three scenarios as files in `folder`, in LAB_SCENARIOS' order."""
-    out_of_range = (REPO / "harness" / "scenarios" / "out_of_range.yaml").read_text()
-    assert "until: {turn: 6.3}" in out_of_range
-    texts = [NEAR_WALL, DRIVE_AWAY, out_of_range.replace("turn: 6.3", "turn: 1.0")]
+    texts = [NEAR_WALL, DRIVE_AWAY, nothing_in_range()]
     folder.mkdir()
     for name, text in zip(LAB_SCENARIOS, texts, strict=True):
         (folder / f"{name}.yaml").write_text(text)

@@ -24,7 +24,7 @@ from cluster_nodes import variant_source
 from command_line import COMMAND
 from dask_cluster import GRADING_ENV, dask_cluster
 from hostile_student import hostile_package, reports
-from short_scenarios import NEAR_WALL
+from short_scenarios import NEAR_WALL, nothing_in_range
 
 pytestmark = [
     pytest.mark.ros,
@@ -32,7 +32,6 @@ pytestmark = [
     pytest.mark.timeout(300),
 ]  # needs bubblewrap (`apt install bubblewrap`; .ci/run installs it): grade says so if not
 
-REPO = Path(__file__).resolve().parents[2]
 HONEST_MARK = f"HONEST-{uuid.uuid4().hex[:8]}"  # in the honest student's node
 SECRET_MARK = f"SECRET-{uuid.uuid4().hex[:8]}"  # in the hidden scenario file
 HIDDEN_NAME = "secret_corridor"
@@ -90,9 +89,7 @@ def make_course(root: Path, listener: Listener, *, hostile: bool) -> Path:
         (root / "class" / name / "lidar_node.py").write_text(source)
     hidden = root / "course" / "hidden" / f"{HIDDEN_NAME}.yaml"
     hidden.parent.mkdir(parents=True)
-    text = (REPO / "harness" / "scenarios" / "out_of_range.yaml").read_text()
-    assert "until: {turn: 6.3}" in text
-    hidden.write_text(f"# {SECRET_MARK}\n" + text.replace("turn: 6.3", "turn: 1.0"))
+    hidden.write_text(f"# {SECRET_MARK}\n" + nothing_in_range())
     (root / "course" / f"{VISIBLE}.yaml").write_text(NEAR_WALL)
     (root / "course" / "grading.yaml").write_text(
         f"scenarios:\n  - {VISIBLE}.yaml\n"
