@@ -38,6 +38,10 @@ class Answers:
     # Earlier driver scans the node answered during this exchange (a revolution the
     # line made late, or split), each with its own answers: judged on their own.
     earlier: list[tuple[Scan, Answers]] = field(default_factory=list)
+    # The node owed answers to scans before this one when it went (a board's idle stream,
+    # copies of the first scan) and answers in order: of its answers, late ones included,
+    # the newest is this tick's (see take_late).
+    owed_before: bool = False
 
     def clipped(self, limit: int = TEXT_LIMIT) -> Answers:
         """A copy to keep in a record: each text clipped to `limit` (its length noted)
@@ -90,9 +94,11 @@ class Answers:
         """Adopt the late answers that belong to `tick`; return the others.
 
         An answer to a scan whose deadline had passed stays late: it must
-        not turn a timeout into a pass.
+        not turn a timeout into a pass. When the node `owed_before`, a late
+        status is a newer answer than the ones held: it is this tick's, and
+        those become late answers of no tick.
         """
-        rest = []
+        rest, adopted = [], False
         for item in late:
             if item.tick != tick:
                 rest.append(item)
@@ -102,4 +108,7 @@ class Answers:
                 self.warnings.append(item)
             else:
                 self.statuses.append(item)
+                adopted = True
+        if adopted and self.owed_before:
+            self.keep_only(sorted(self.statuses, key=lambda r: r.source_ns)[-1:])
         return rest

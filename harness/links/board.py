@@ -384,8 +384,10 @@ class BoardLink(Ros2Link):
         if idle and pids:
             # The node and the board's software run here: wait (bounded) until every
             # thread of theirs sleeps, so none has a revolution left to answer.
+            # A node that answered none of the stream may be asleep in its first
+            # callback with the rest queued: asleep is not done for it.
             done = self._wait_for(Quiescence(pids), IDLE_LAST_ANSWER_S) is None
-            self._idle_owed = not done
+            self._idle_owed = not (done and answered)
             self._wait_for(lambda: False, max(self._grace(), IDLE_IN_FLIGHT_S))
         elif idle and answered:
             # A node lagging on a loaded machine answers older scans after the last one
@@ -548,7 +550,9 @@ class BoardLink(Ros2Link):
         Line faults: more statuses than driver scans heard may mean a late scan's
         answer overtook the scan on its way to us (two topics, two readers). Wait a
         moment for it; a node that simply answers twice costs that moment."""
-        if self._after_idle and self._idle_owed:
+        if self._after_idle and (self._idle_owed or self._copies > 1):
+            # A copy went unanswered: the node was behind, and still answers the idle
+            # stream's scans and the copies, in order, after the first status came.
             self._wait_for(self._statuses_quiet, IDLE_LAST_ANSWER_S)
         if self._line_damage is not None and self._statuses() > len(self._driver_scans()):
             self._wait_for(lambda: len(self._driver_scans()) >= self._statuses(), SCAN_CATCH_UP_S)
@@ -575,6 +579,7 @@ class BoardLink(Ros2Link):
         if self._after_idle:
             self._after_idle = False
             _set_aside_answers_to_the_idle_stream(answers, len(self._heard_scans))
+            answers.owed_before = True  # its answers still to come are newer: this tick's
         _pair_with_driver_scans(answers, self._heard_scans)
         if self._repeat_at is not None:  # answers to the device's repeats answer no tick
             answers.first_answer_only()
