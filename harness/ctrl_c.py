@@ -3,13 +3,16 @@
 Python swallows a KeyboardInterrupt raised inside a weakref callback or a
 ``__del__`` ("Exception ignored in ..."). A loop that must end on Ctrl-C
 (watch, sim) checks the event at each turn and raises KeyboardInterrupt
-itself when the signal's own one was lost on the way.
+itself when the signal's own one was lost on the way; Python's "Exception
+ignored" report of the lost one (a traceback on the user's screen) is not
+printed.
 """
 
 from __future__ import annotations
 
 import contextlib
 import signal
+import sys
 import threading
 from collections.abc import Iterator
 from types import FrameType
@@ -32,8 +35,18 @@ def remembered_ctrl_c() -> Iterator[threading.Event]:
         else:
             signal.default_int_handler(signum, frame)
 
+    previous_hook = sys.unraisablehook
+
+    def on_unraisable(unraisable: sys.UnraisableHookArgs) -> None:
+        kind = unraisable.exc_type
+        lost = kind is not None and issubclass(kind, KeyboardInterrupt)
+        if not (lost and pressed.is_set()):  # a lost Ctrl-C: the loop raises it again
+            previous_hook(unraisable)
+
     signal.signal(signal.SIGINT, on_ctrl_c)
+    sys.unraisablehook = on_unraisable
     try:
         yield pressed
     finally:
         signal.signal(signal.SIGINT, previous)
+        sys.unraisablehook = previous_hook
