@@ -14,6 +14,7 @@ import time
 from pathlib import Path
 
 import pytest
+from command_line import REAL_TIME_DEADLINE
 from far_end import REFERENCE_NODE, FarEnd, bundled_driver
 
 pytestmark = [pytest.mark.ros, pytest.mark.timeout(120)]
@@ -51,8 +52,7 @@ def test_run_against_a_board_on_a_serial_port(far_end: FarEnd, tmp_path: Path) -
     """--port with --domain-id: real-time emulation into the board, its answers judged."""
     scenario = tmp_path / "facing_wall.yaml"
     scenario.write_text(SHORT)
-    # Real time: a loaded machine has held a node's answer back 3 s; latency is not the point.
-    harness = start_harness(far_end, scenario, "--timeout", "5")
+    harness = start_harness(far_end, scenario, *REAL_TIME_DEADLINE)
     far_end.start(harness, bundled_driver(far_end.cable.board_end), REFERENCE_NODE)
     out, err = harness.communicate(timeout=90)
     assert harness.returncode == 0, out + err

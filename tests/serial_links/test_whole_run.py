@@ -25,6 +25,7 @@ import sys
 from pathlib import Path
 
 import pytest
+from command_line import REAL_TIME_DEADLINE
 from far_end import REFERENCE_NODE, FarEnd, bundled_driver
 from third_party import roboticia_site
 
@@ -44,9 +45,6 @@ WHOLE_SUITES = os.environ.get("FOSSBOT_HIL_WHOLE_SUITES") == "1"
 THREE = ("approach_wall", "out_of_range", "obstacle_at_side")
 BOARD_SUITE: tuple[str, ...] = () if WHOLE_SUITES else THREE
 BOARD_COUNT = len(BOARD_SUITE) or DEFAULT_SUITE
-# Each status's deadline: these runs are in real time, where a loaded CI machine has held a
-# node's answer back 3 s; what they show is the device living for the run, not latency.
-DEADLINE = ("--timeout", "5")
 
 # Short and lopsided (a wall ahead, a post on the left): a turned or mirrored
 # board scan cannot look like the robot's view.
@@ -116,7 +114,7 @@ def with_roboticia(env: dict[str, str] | None = None) -> dict[str, str]:
 
 def harness(*args: str, env: dict[str, str] | None = None) -> subprocess.Popen[str]:
     return subprocess.Popen(
-        [sys.executable, "-m", "harness.cli", "run", *args, *DEADLINE],
+        [sys.executable, "-m", "harness.cli", "run", *args, *REAL_TIME_DEADLINE],
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
