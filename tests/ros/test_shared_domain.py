@@ -25,9 +25,20 @@ from harness.nodes.process import FORK_SERVER_SETTING, NodeProcess
 from harness.ros.domain import discovery_environment, reserve_domain
 from harness.runner.scenario_run import run
 from harness.runner.settings import RunSettings
-from harness.scenario.files import resolve_scenario
+from harness.scenario.files import parse_scenario
 
 pytestmark = [pytest.mark.ros, pytest.mark.timeout(120)]
+
+# Three minutes by a wall (1,800 scans, about 6 s in lockstep): the stranger, up before the
+# run, must still discover the run's new participant, which took from 0 to 464 scans here
+# (30 runs; 3 of 12 beyond approach_wall's 95). The run ends at the first scan it answers.
+BY_A_WALL = {
+    "description": "Stand 0.8 m from a wall for three minutes.",
+    "lidar": {"preset": "gazebo"},
+    "obstacles": [{"type": "wall", "start": [0.8, -2.0], "end": [0.8, 2.0], "thickness": 0.1}],
+    "motion": {"segments": [{"until": {"duration": 180.0}}]},
+    "threshold": 0.5,
+}
 
 
 def test_a_stranger_answering_the_scans_is_named() -> None:
@@ -36,8 +47,14 @@ def test_a_stranger_answering_the_scans_is_named() -> None:
     stranger = NodeProcess(reference_node(), ros_arguments(()), environment)
     try:
         stranger.start()
+        # Up, as a node left running is: its topics made (its log line), or a loaded
+        # machine can finish the short run before the stranger reads a scan.
+        end = time.monotonic() + 30
+        while "/scan -> /lidar_status" not in stranger.tail():
+            assert time.monotonic() < end and stranger.returncode() is None, stranger.tail()
+            time.sleep(0.05)  # bounded poll: until it logs its topics
         result = run(
-            resolve_scenario("approach_wall"),
+            parse_scenario(BY_A_WALL),
             "ros2",
             LinkOptions(domain_id=domain.domain_id),
             RunSettings(),
