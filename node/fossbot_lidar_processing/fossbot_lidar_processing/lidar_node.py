@@ -8,8 +8,10 @@ fossbot_lidar_processing fossbot_lidar_node``) or, from the harness, as
 
 from __future__ import annotations
 
+import os
 import signal
 import sys
+import threading
 from typing import Any
 
 import rcl_interfaces.msg
@@ -34,7 +36,7 @@ __all__ = ['EXIT_CONFIG_ERROR', 'EXIT_OK', 'ConfigError', 'LidarProcessingNode',
 
 NODE_NAME = 'fossbot_lidar_node'
 EXIT_OK = 0
-SPIN_STEP_S = 0.1  # longest a stop request waits to be noticed
+SPIN_STEP_S = 0.1  # longest a stop request waits to be noticed, should the wake-up miss
 EXIT_CONFIG_ERROR = 2
 
 # Reliable, keep-last 10: what `create_subscription(LaserScan, topic, cb, 10)`
@@ -143,6 +145,32 @@ class LidarProcessingNode(Node):
             logger.debug(f'{text}; warning={report.warning}')
 
 
+def wake_on_signals(node: Node) -> None:
+    """
+    End the executor's spin as soon as a signal arrives, so a stop is noticed at once.
+
+    A Python signal handler runs only once the main thread is back in
+    Python, and the executor's wait does not return for a signal: the stop
+    would wait out the spin step. Python writes each signal's number to
+    the wake-up descriptor from its C handler, at once; a thread reading
+    it triggers a guard condition of the node, whose (empty) callback ends
+    the spin, and the handler runs.
+    """
+    guard = node.create_guard_condition(lambda: None)
+    read_fd, write_fd = os.pipe()
+    os.set_blocking(write_fd, False)
+    signal.set_wakeup_fd(write_fd, warn_on_full_buffer=False)
+
+    def wake() -> None:
+        try:
+            while os.read(read_fd, 64):
+                guard.trigger()
+        except Exception:  # noqa: BLE001 - shut down meanwhile: the loop has ended anyway
+            return
+
+    threading.Thread(target=wake, name='wake-on-signal', daemon=True).start()
+
+
 def main(args: list[str] | None = None) -> int:
     """
     Run the node until SIGINT or SIGTERM; return the process exit code.
@@ -152,8 +180,9 @@ def main(args: list[str] | None = None) -> int:
     """
     # rclpy's own signal handlers are off: they shut the context down from
     # under the executor, which surfaces as assorted exceptions and, in a
-    # narrow window, a spin that never wakes. Ours only note the request;
-    # the executor is spun in bounded steps that look at the note.
+    # narrow window, a spin that never wakes. Ours only note the request,
+    # and wake_on_signals wakes the executor for it; the executor is spun
+    # in bounded steps that look at the note.
     stopping = False
 
     def on_signal(signum: int, frame: object) -> None:
@@ -167,6 +196,7 @@ def main(args: list[str] | None = None) -> int:
         rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
         executor = SingleThreadedExecutor()
         node = LidarProcessingNode()
+        wake_on_signals(node)
         executor.add_node(node)
         while not stopping and rclpy.ok():
             executor.spin_once(timeout_sec=SPIN_STEP_S)
