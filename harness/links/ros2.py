@@ -215,6 +215,8 @@ class Ros2Link(Link):
         self.start()
         if self._start_error is not None:
             raise self._start_error
+        if self.process is not None:
+            self.process.await_started()  # started ahead without waiting for it
         assert self.observer is not None
         opts = self.options
         deadline = time.monotonic() + opts.ready_timeout
@@ -308,7 +310,7 @@ class Ros2Link(Link):
         args = node_arguments(self.command, node_parameters(self.options))
         held = None if self.domain is None else self.domain.fileno()
         self.process = NodeProcess(self.command, args, env, held=held)
-        self.process.start()
+        self.process.start(wait=False)  # open() waits: the next links start meanwhile
         self.node_start = f"{self.command.description}, {self.process.how}"
 
     def _make_observer(self, domain_id: int) -> Observer:

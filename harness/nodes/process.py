@@ -198,11 +198,16 @@ class NodeProcess:
         self.stop_problem: str | None = None
         self._done = False  # the reaper finished its stop (its last event)
         self._stop_requested = False
-        self.started_at = 0.0
+        self.started_at = 0.0  # monotonic: when `start` set it on its way
+        self._start_by: float | None = None  # monotonic deadline of the start, until seen
         self.how = "started as a command"  # how `start` started it, for the user
 
-    def start(self) -> None:
-        """Start the node under the reaper; wait (bounded) until it runs or cannot."""
+    def start(self, *, wait: bool = True) -> None:
+        """Start the node under the reaper; wait (bounded) until it runs or cannot.
+
+        With `wait` false, return once it is on its way: `await_started` waits (a
+        link started ahead does not hold the run up while the node forks).
+        """
         status_r, status_w = os.pipe()
         out_r, out_w = os.pipe()
         err_r, err_w = os.pipe()
@@ -245,13 +250,21 @@ class NodeProcess:
             "stderr": OutputTail(err_r, "node-stderr"),
         }
         _LIVE.add(self)
-        end = time.monotonic() + START_WAIT_S
+        self.started_at = time.monotonic()
+        self._start_by = self.started_at + START_WAIT_S
+        if wait:
+            self.await_started()
+
+    def await_started(self) -> None:
+        """Wait (bounded) until the reaper says the node runs; ConfigError if it cannot."""
+        if self.node_pid is not None or self._start_by is None:
+            return
         while self.node_pid is None and self.start_error is None and self._status_fd is not None:
-            left = end - time.monotonic()
+            left = self._start_by - time.monotonic()
             if left <= 0:
                 break
             self._read_events(min(POLL_S, left))
-        self.started_at = time.monotonic()
+        self._start_by = None
         if self.node_pid is None:
             why = self.start_error or (
                 f"its supervisor ({REAPER.name}) did not report within {START_WAIT_S:g} s; "

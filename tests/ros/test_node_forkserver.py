@@ -15,6 +15,7 @@ from pathlib import Path
 import pytest
 from child_process import alive
 
+from harness.errors import ConfigError
 from harness.links.base import LinkOptions
 from harness.nodes.command import NodeCommand, reference_node, ros_arguments
 from harness.nodes.forkserver import ForkedSupervisor, ForkServer, _exit_code
@@ -184,6 +185,42 @@ def test_overlapping_scenarios_get_fresh_nodes_in_their_own_domains() -> None:
     assert all(not alive(pid) for _, pid, _ in seen if pid)  # all stopped and reaped
     # Overlapped: the next scenarios' nodes were started before the first one was ready.
     assert starts[1] < seen[0][0] and starts[2] < seen[0][0]
+
+
+def test_a_start_not_awaited_reports_its_node_once_awaited() -> None:
+    """`start(wait=False)` returns before the supervisor has said the node runs (a suite
+    starts the next links meanwhile); `await_started` then waits for that word."""
+    with started_node_unawaited() as process:
+        process.await_started()
+        assert process.node_pid is not None and alive(process.node_pid)
+        process.await_started()  # again: nothing more to wait for
+
+
+def test_a_node_that_cannot_start_is_reported_when_awaited(tmp_path: Path) -> None:
+    """A start not awaited that fails (no such program) is a ConfigError naming it, raised
+    by `await_started`, as `start` raises it when it waits."""
+    missing = tmp_path / "no_such_node"
+    process = NodeProcess(NodeCommand((str(missing),), description="no_such_node"), [], {})
+    process.start(wait=False)
+    try:
+        with pytest.raises(ConfigError, match="cannot start no_such_node"):
+            process.await_started()
+    finally:
+        process.stop()
+
+
+@contextlib.contextmanager
+def started_node_unawaited() -> Iterator[NodeProcess]:
+    """The reference node, started without waiting, in a domain of its own."""
+    domain = reserve_domain(None)
+    environment = {"ROS_DOMAIN_ID": str(domain.domain_id), **discovery_environment(network=False)}
+    process = NodeProcess(reference_node(), ros_arguments(()), environment)
+    try:
+        process.start(wait=False)
+        yield process
+    finally:
+        process.stop()
+        domain.release()
 
 
 THREADED = textwrap.dedent(
