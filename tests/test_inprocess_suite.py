@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import time
 from pathlib import Path
 
 import pytest
@@ -110,3 +111,32 @@ def test_other_bugs_get_no_threshold_hint(fn: str) -> None:
     results = [run(name, f"{STUDENTS}:{fn}") for name in ("approach_wall", "rotate_beside_wall")]
     assert not all(r.ok for r in results)
     assert all("as if its threshold" not in (r.first_failure or "") for r in results)
+
+
+def test_a_suite_opens_each_link_once_its_world_is_built(monkeypatch) -> None:
+    """A node still coming up does so while the scenario's world is built: the link is
+    opened inside the world, and the wait for it counts as start-up, not as the run."""
+    from harness.links.base import LinkOptions as Options
+    from harness.links.inprocess import InprocessLink
+    from harness.runner.suite import run_suite
+    from harness.sim.simulation import Simulation
+
+    events: list[str] = []
+    entered, opened = Simulation.__enter__, InprocessLink.open
+
+    def enter(self):
+        events.append("world")
+        return entered(self)
+
+    def slow_open(self):
+        events.append("open")
+        time.sleep(0.2)  # a node that takes its time to come up
+        opened(self)
+
+    monkeypatch.setattr(Simulation, "__enter__", enter)
+    monkeypatch.setattr(InprocessLink, "open", slow_open)
+    scenarios = [resolve_scenario(n) for n in ("approach_wall", "out_of_range")]
+    results = run_suite(scenarios, "inprocess", Options())
+    assert events == ["world", "open", "world", "open"]
+    assert all(r.ok for r in results), [r.first_failure for r in results]
+    assert all(r.startup_s >= 0.2 for r in results)

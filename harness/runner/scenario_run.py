@@ -44,8 +44,14 @@ def run_scenario(
     settings: RunSettings = RunSettings(),
     *,
     on_tick: Callable[[TickRecord], None] | None = None,
+    open_link: bool = False,
 ) -> RunResult:
-    """Run `scenario` through an already opened `link` and judge every tick."""
+    """Run `scenario` through `link` and judge every tick.
+
+    The link is open already, or with `open_link` it is opened here once the
+    world is built: a node still coming up does so meanwhile. Its wait is the
+    result's `startup_s`; a LinkError from the open propagates (`run_through`).
+    """
     from harness.sim.simulation import Simulation  # imports pybullet
 
     started = time.perf_counter()
@@ -61,13 +67,17 @@ def run_scenario(
     periods = scan_periods(drift, scenario.lidar_spec.rate_hz, seed) if drift else None
     try:
         with Simulation(scenario, gui=settings.gui) as sim:
+            if open_link:
+                opening = time.perf_counter()
+                link.open()
+                result.startup_s = time.perf_counter() - opening
             frames = (
                 Frame(s.tick, s.t, s.x, s.y, s.yaw, _emit(profile, s, sim.spec, rng, bool(drift)))
                 for s in sim.ticks(periods)
             )
             judge_frames(frames, link, oracle, result, on_tick=on_tick, link_faults=profile.link)
-    finally:  # an interrupted run reports its time too
-        result.wall_s = time.perf_counter() - started
+    finally:  # an interrupted run reports its time too; waiting for the link is start-up
+        result.wall_s = time.perf_counter() - started - result.startup_s
     return result
 
 
@@ -110,21 +120,28 @@ def run_through(
     link: Link,
     body: Callable[[Link], RunResult],
     not_started: Callable[[str, str], RunResult],
+    *,
+    body_opens: bool = False,
 ) -> RunResult:
     """Open `link` (waiting until it is ready) and run `body` through it; the caller closes it.
 
-    The result says how long the run waited for the link to come up.
+    The result says how long the run waited for the link to come up. With
+    `body_opens`, the body opens the link itself (``run_scenario(open_link=True)``:
+    after building its world) and says how long it waited.
     """
     started = time.perf_counter()
     try:
-        link.open()
+        if not body_opens:
+            link.open()
         ready = time.perf_counter() - started
         result = body(link)
     except LinkError as err:
-        ready = time.perf_counter() - started
         result = not_started(str(err), link.diagnostics())
         result.not_started = True
-    result.startup_s = ready
+        result.startup_s = time.perf_counter() - started
+        return result
+    if not body_opens:
+        result.startup_s = ready
     return result
 
 

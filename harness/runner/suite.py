@@ -86,8 +86,11 @@ def run_suite(
                 taking = time.perf_counter() - started
                 result = run_through(
                     link,
-                    lambda link, s=scenario: run_scenario(s, link, settings, on_tick=on_tick),
+                    lambda link, s=scenario: run_scenario(
+                        s, link, settings, on_tick=on_tick, open_link=True
+                    ),
                     not_started_as(scenario, link_name, settings),
+                    body_opens=True,
                 )
                 result.startup_s += taking  # starting links is start-up too
                 if result.not_started:
