@@ -73,7 +73,7 @@ def test_with_overlap_links_start_ahead_and_close_behind_in_order() -> None:
 
 
 def test_drain_closes_links_started_ahead_and_never_taken() -> None:
-    links, log = pipeline(5, overlap=True)
+    links, log = pipeline(AHEAD + 3, overlap=True)
     link = links.take(0)
     links.retire(link, lambda waited: None)
     links.drain()  # e.g. the node did not start: the rest are not run

@@ -85,8 +85,16 @@ class Observer:
             )
             # No /rosout: the harness logs nothing there, and a suite has several
             # of these nodes at once (one per domain), whose rosout publishers
-            # would clash by name within this process.
-            self.node = rclpy.create_node("fossbot_hil", context=self.context, enable_rosout=False)
+            # would clash by name within this process. No parameter services:
+            # nobody sets the harness's parameters, and their dozen endpoints are
+            # that many more for a starting node to discover before it is
+            # matched both ways.
+            self.node = rclpy.create_node(
+                "fossbot_hil",
+                context=self.context,
+                enable_rosout=False,
+                start_parameter_services=False,
+            )
         self.scan_topic, self.status_topic = scan_topic, status_topic
         self.warning_topic = warning_topic
         # Either we publish the scans (ros2 link) or a board's driver does and
