@@ -10,12 +10,13 @@ from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import LaserScan
 
 from harness.lidar.scan import Scan
+from harness.ros.cdr import stamp_parts
 
 
 def stamp(seconds: float) -> Time:
     """A builtin_interfaces/Time for a simulation time in seconds."""
-    nanoseconds = round(seconds * 1e9)
-    return Time(sec=nanoseconds // 1_000_000_000, nanosec=nanoseconds % 1_000_000_000)
+    sec, nanosec = stamp_parts(seconds)
+    return Time(sec=sec, nanosec=nanosec)
 
 
 def clock_message(seconds: float) -> Clock:

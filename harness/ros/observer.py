@@ -32,8 +32,9 @@ from std_msgs.msg import Bool, String
 
 from harness.lidar.scan import Scan
 from harness.ros.announcements import harness_announcements
+from harness.ros.cdr import clock_cdr, scan_cdr
 from harness.ros.domain import discovery_environment
-from harness.ros.messages import clock_message, scan_from_message, scan_message
+from harness.ros.messages import scan_from_message
 
 QOS = QoSProfile(depth=50, reliability=ReliabilityPolicy.RELIABLE)
 INBOX_LIMIT = 10_000  # messages kept between two collects: more is a flood, not answers
@@ -132,7 +133,7 @@ class Observer:
         self._wait_set = WaitSet(len(self._subs), 0, 0, 0, 0, 0, self.context.handle)
 
     def publish_clock(self, seconds: float) -> None:
-        self.clock_pub.publish(clock_message(seconds))
+        self.clock_pub.publish(clock_cdr(seconds))
 
     def _hear(self, kind: str, value_of: Callable[[Any], str | bool | Scan]):
         def callback(msg: object, info: dict) -> None:
@@ -147,8 +148,8 @@ class Observer:
         """Publish /clock (`clock`, default the scan's stamp) then the scan;
         return the send time in system-clock ns."""
         assert self.scan_pub is not None, "this observer watches a driver's scans"
-        msg = scan_message(scan)
-        self.clock_pub.publish(clock_message(scan.stamp if clock is None else clock))
+        msg = scan_cdr(scan)  # serialized here: rclpy publishes the bytes as they are
+        self.clock_pub.publish(clock_cdr(scan.stamp if clock is None else clock))
         sent = time.time_ns()
         self.scan_pub.publish(msg)
         return sent

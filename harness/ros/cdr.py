@@ -1,0 +1,66 @@
+"""The scan and the clock as the CDR bytes rmw publishes (pure: no rclpy).
+
+Publishing a message object makes rclpy copy it, field by field, into its C
+struct and then serialize that; publishing bytes hands them to the DDS writer
+as they are (rclpy's raw publish). For the scan, built here with one copy of
+each array, that is about half the cost of a send. The layout is XCDR1,
+little-endian, as rmw_fastrtps writes it: a 4-byte encapsulation header, then
+each field aligned to its size from the end of the header. `tests/ros` checks
+the bytes against rclpy's own serialization.
+"""
+
+from __future__ import annotations
+
+import struct
+
+import numpy as np
+
+from harness.lidar.scan import Scan
+
+__all__ = ["clock_cdr", "scan_cdr", "stamp_parts"]
+
+ENCAPSULATION = b"\x00\x01\x00\x00"  # CDR, little-endian
+FLOAT32 = np.dtype("<f4")
+
+
+def stamp_parts(seconds: float) -> tuple[int, int]:
+    """builtin_interfaces/Time (sec, nanosec) for a simulation time in seconds."""
+    nanoseconds = round(seconds * 1e9)
+    return nanoseconds // 1_000_000_000, nanoseconds % 1_000_000_000
+
+
+def clock_cdr(seconds: float) -> bytes:
+    """rosgraph_msgs/Clock at `seconds`."""
+    return ENCAPSULATION + struct.pack("<iI", *stamp_parts(seconds))
+
+
+def scan_cdr(scan: Scan) -> bytes:
+    """sensor_msgs/LaserScan with the scan's fields, ranges and intensities as float32."""
+    frame_id = scan.frame_id.encode() + b"\0"
+    header = struct.pack("<iII", *stamp_parts(scan.stamp), len(frame_id)) + frame_id
+    header += b"\0" * (-len(header) % 4)  # the float32 fields align to 4
+    fields = np.array(
+        [
+            scan.angle_min,
+            scan.angle_max,
+            scan.angle_increment,
+            scan.time_increment,
+            scan.scan_time,
+            scan.range_min,
+            scan.range_max,
+        ],
+        FLOAT32,
+    )
+    ranges = np.asarray(scan.ranges, FLOAT32)
+    intensities = np.asarray(scan.intensities, FLOAT32)
+    return b"".join(
+        (
+            ENCAPSULATION,
+            header,
+            fields.tobytes(),
+            struct.pack("<I", ranges.size),
+            ranges.tobytes(),
+            struct.pack("<I", intensities.size),
+            intensities.tobytes(),
+        )
+    )
