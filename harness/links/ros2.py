@@ -38,7 +38,6 @@ from typing import TYPE_CHECKING
 
 from harness.errors import ConfigError, LinkError
 from harness.judge.answers import Answers, Received
-from harness.launch_files.run_check import Asked, LaunchCheck
 from harness.links.base import Link, LinkOptions, register
 from harness.nodes.command import (
     NodeCommand,
@@ -51,6 +50,7 @@ from harness.nodes.process import NodeProcess, prepare_start, start_would_wait
 from harness.ros.domain import DomainReservation, discovery_environment, reserve_domain
 
 if TYPE_CHECKING:  # numpy and rclpy are imported when the first link starts, after its node
+    from harness.launch_files.run_check import Asked, LaunchCheck  # read for --package, --launch
     from harness.lidar.scan import Scan
     from harness.ros.observer import Heard, Observer
 
@@ -60,6 +60,9 @@ STOPPED_AFTER = 3  # consecutive missed deadlines end the run
 WARM_UP_RETRY_S = 0.5  # resend the first scan (or a warm-up scan) this often until answered
 BOOL_DISCOVERY_S = 0.25  # before the first scan: for a Bool writer the graph does not show yet
 FIRST_RETRY_MAX_S = 2.0  # the first scan's resends back off up to this interval
+# Once ready, for discovery to name the node reading the scans (Observer.scan_readers_named);
+# a participant that never names itself (no ROS node) is sent its first scan after this.
+NAMED_WAIT_S = 0.5
 CATCH_UP_S = 2.0  # after a missed deadline, wait this long (at least) for the late answer
 FLOOD_SCANS = 5  # a flood is judged over this many recent scans, in which a topic carried
 FLOOD_PER_SCAN = 5  # more than this many messages a scan,
@@ -101,15 +104,18 @@ def node_parameters(options: LinkOptions) -> tuple[str, ...]:
 
 def launch_check(options: LinkOptions) -> LaunchCheck | None:
     """The run's launch files (read, not run), when a package or `--launch` names them."""
+    by_package = bool(options.package and options.executable and not options.node)
+    if not (options.launch or by_package):
+        return None
+    from harness.launch_files.run_check import LaunchCheck  # the file readers: only for these
+
     if options.launch:
         package, file = options.launch
         passed = ["use_sim_time", *(p.split(":=", 1)[0] for p in node_parameters(options))]
         return LaunchCheck.for_run(
             package, None, options.workspace, launched=Path(file).name, passed=passed
         )
-    if options.package and options.executable and not options.node:
-        return LaunchCheck.for_run(options.package, options.executable, options.workspace)
-    return None
+    return LaunchCheck.for_run(options.package, options.executable, options.workspace)
 
 
 def harness_observer(options: LinkOptions, domain_id: int, *, publish_scans: bool) -> Observer:
@@ -234,6 +240,9 @@ class Ros2Link(Link):
                 clock_due = time.monotonic() + POLL_S
             self.observer.spin(POLL_S)
             self.observer.inbox.clear()  # nothing heard before it is ready is an answer
+        if self.publishes_scans:  # its side matched too: the first scan is not repaired late
+            self._wait_for(self.observer.scan_readers_named, NAMED_WAIT_S)
+            self.observer.inbox.clear()
         self.startup_s = time.perf_counter() - started
 
     def _clock_before_ready(self) -> bool:
