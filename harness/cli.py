@@ -50,10 +50,10 @@ def _without_defaults(parser: argparse.ArgumentParser) -> None:
                 _without_defaults(sub)
 
 
-def given_options(argv: Sequence[str] | None) -> frozenset[str]:
+def given_options(parser: argparse.ArgumentParser, argv: Sequence[str] | None) -> frozenset[str]:
     """The option names (argparse dests) given on the command line, whatever their value:
-    a file's setting yields to the command line only where the user typed one."""
-    parser = build_parser()
+    a file's setting yields to the command line only where the user typed one. Parsing
+    again with `parser`'s defaults taken away (it is not used with them after)."""
     _without_defaults(parser)
     return frozenset(vars(parser.parse_args(argv)))
 
@@ -80,11 +80,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     if not console.is_terminal:
         console = Console(highlight=False, width=200)  # files and pipes: no wrapping
     try:
-        args = build_parser().parse_args(argv)
-        args.given = given_options(argv)  # what the user typed, apart from the defaults
+        parser = build_parser()
+        args = parser.parse_args(argv)
         if args.command is None:
-            build_parser().print_help()
+            parser.print_help()
             return EXIT_USAGE
+        args.given = given_options(parser, argv)  # what the user typed, apart from defaults
         handlers = {m.NAME: m.run for m in command_modules()}
         return handlers[args.command](args, console)
     except ConfigError as err:
