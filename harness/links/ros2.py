@@ -55,6 +55,7 @@ if TYPE_CHECKING:  # numpy and rclpy are imported when the first link starts, af
     from harness.ros.observer import Heard, Observer
 
 POLL_S = 0.05  # longest single spin; liveness of the node is checked this often
+READY_POLL_S = 0.005  # spins while waiting for the graph, whose changes wake no spin
 MIN_GRACE_S = 0.002  # wait for a Bool after the String while the order is unknown
 STOPPED_AFTER = 3  # consecutive missed deadlines end the run
 WARM_UP_RETRY_S = 0.5  # resend the first scan (or a warm-up scan) this often until answered
@@ -238,10 +239,10 @@ class Ros2Link(Link):
             if self._clock_before_ready() and time.monotonic() >= clock_due:
                 self.observer.publish_clock(0.0)  # a node may wait for /clock before it subscribes
                 clock_due = time.monotonic() + POLL_S
-            self.observer.spin(POLL_S)
+            self.observer.spin(READY_POLL_S)
             self.observer.inbox.clear()  # nothing heard before it is ready is an answer
         if self.publishes_scans:  # its side matched too: the first scan is not repaired late
-            self._wait_for(self.observer.scan_readers_named, NAMED_WAIT_S)
+            self._wait_for(self.observer.scan_readers_named, NAMED_WAIT_S, poll=READY_POLL_S)
             self.observer.inbox.clear()
         self.startup_s = time.perf_counter() - started
 
@@ -698,13 +699,16 @@ class Ros2Link(Link):
             return f"node {self.command.description} {self.process.exit_summary(when)}"
         return None
 
-    def _wait_for(self, done: Callable[[], bool], seconds: float) -> str | None:
+    def _wait_for(
+        self, done: Callable[[], bool], seconds: float, *, poll: float = POLL_S
+    ) -> str | None:
         """Spin until `done()`; None if it came, else "timeout" or why the node is gone.
 
         The node's liveness is checked once per POLL_S (each check is a few
         system calls, which cost more than the spin when the answer is
         already there) and once more when the wait runs out, so a node that
-        died is never reported as a timeout.
+        died is never reported as a timeout. A spin ends when a message
+        arrives or after `poll`: shorter for what no message announces (the graph).
         """
         assert self.observer is not None
         end = time.perf_counter() + seconds
@@ -719,7 +723,7 @@ class Ros2Link(Link):
                 self._alive_until = now + POLL_S
                 if timed_out:
                     return "timeout"
-            self.observer.spin(min(POLL_S, end - now))
+            self.observer.spin(min(poll, end - now))
         return None
 
     def collect(self, scan: Scan, tick: int, *, may_be_ignored: bool = False) -> Answers:
