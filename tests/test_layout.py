@@ -56,6 +56,8 @@ PURE = [
     "harness.devices",
     "harness.ros.domain",
     "harness.ros.names",
+    "harness.ros.cdr",
+    "harness.ros.shm_ports",
     "harness.launch_files",
     "harness.nodes.package_folder",
     "harness.sim.motion",

@@ -5,6 +5,7 @@
   ``parameters``: which parameters a running node declares (asked over
   ListParameters). These import rclpy;
 - ``domain``: a ROS_DOMAIN_ID reserved per run, so parallel runs never see
-  each other; ``names``: topic and parameter names as ROS checks them.
-  Both are pure, for the command line to use without rclpy.
+  each other; ``names``: topic and parameter names as ROS checks them;
+  ``cdr``: the scan and clock as the bytes rmw publishes. These are pure:
+  the command line uses the first two without rclpy.
 """
