@@ -9,12 +9,13 @@ still gets a fresh node, and lockstep verdicts do not depend on timing.
 The suite waits for every link to close (every process reaped, every
 domain released) before it returns, and reports results in scenario order.
 
-Why five ahead: a node is matched from the harness's side first (it is
-"ready"), and for about 0.6 s after it starts, the first scan sent to it may
-wait 0.1-0.4 s for Fast DDS to match the node's side and repair it. Short
-scenarios (0.1-0.2 s each) reach a link started three ahead inside that
-window; five ahead, its node is old enough. Nodes waiting their turn are
-idle (an executor asleep on its wait set).
+Why five ahead: for up to about 0.6 s after a node starts, its side of the
+graph may not have matched the harness's yet, and its link waits for that
+before the first scan (``Ros2Link.open``; sent earlier, the scan would wait
+0.1-0.4 s for Fast DDS to repair it). Short scenarios (0.1-0.2 s each)
+reach a link started three ahead inside that window; five ahead, its node
+is mostly old enough. Nodes waiting their turn are idle (an executor
+asleep on its wait set).
 """
 
 from __future__ import annotations
