@@ -47,7 +47,12 @@ from harness.nodes.command import (
     shell_node,
 )
 from harness.nodes.process import NodeProcess, prepare_start, start_would_wait
-from harness.ros.domain import DomainReservation, discovery_environment, reserve_domain
+from harness.ros.domain import (
+    DomainReservation,
+    NoFreeDomain,
+    discovery_environment,
+    reserve_domain,
+)
 
 if TYPE_CHECKING:  # numpy and rclpy are imported when the first link starts, after its node
     from harness.launch_files.run_check import Asked, LaunchCheck  # read for --package, --launch
@@ -174,6 +179,7 @@ class Ros2Link(Link):
         self.startup_s = 0.0
         self._started = False
         self._start_error: Exception | None = None
+        self._no_domain: NoFreeDomain | None = None  # why start() could not start it yet
 
     # -- life cycle -------------------------------------------------------
     @classmethod
@@ -196,13 +202,22 @@ class Ros2Link(Link):
         (each in its own domain); `open` then waits for readiness.
         A failure to start is kept and raised by `open`, so a link started
         ahead reports it when its own scenario comes, as if started then.
+        With no domain free (this machine's other runs hold them all), the
+        link is left unstarted: `open` tries again when its scenario comes.
         """
         if self._started:
             return
-        self._started = True
         opts = self.options
         try:
             self.domain = reserve_domain(opts.domain_id)
+        except NoFreeDomain as err:
+            self._no_domain = err
+            return
+        except Exception as err:  # raised again by open()
+            self._started, self._start_error = True, err
+            return
+        self._started = True
+        try:
             env = {
                 "ROS_DOMAIN_ID": str(self.domain.domain_id),
                 **discovery_environment(network=opts.ros_network),
@@ -220,6 +235,9 @@ class Ros2Link(Link):
         """Start (unless started ahead) and wait, bounded, until the node is ready."""
         started = time.perf_counter()
         self.start()
+        if not self._started:  # no domain free, now either
+            assert self._no_domain is not None
+            raise self._no_domain
         if self._start_error is not None:
             raise self._start_error
         if self.process is not None:

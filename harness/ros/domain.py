@@ -38,6 +38,10 @@ FIRST_ID, LAST_ID = 1, 101
 LOCK_DIR = Path(tempfile.gettempdir()) / "fossbot-hil-domains"
 
 
+class NoFreeDomain(LinkError):
+    """Every automatic id is held (by this machine's runs): a moment later one may be free."""
+
+
 class DomainReservation:
     """An id held until `release()` (or process exit)."""
 
@@ -103,7 +107,7 @@ def reserve_domain(preferred: int | None = None) -> DomainReservation:
         if lock is not None:
             clear_half_made_ports(domain_id, shared=False)
             return DomainReservation(domain_id, lock)
-    raise LinkError(f"no free ROS domain id in {FIRST_ID}..{LAST_ID}: too many runs at once")
+    raise NoFreeDomain(f"no free ROS domain id in {FIRST_ID}..{LAST_ID}: too many runs at once")
 
 
 def _reserve_explicit(domain_id: int) -> DomainReservation:

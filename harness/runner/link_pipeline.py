@@ -9,13 +9,16 @@ still gets a fresh node, and lockstep verdicts do not depend on timing.
 The suite waits for every link to close (every process reaped, every
 domain released) before it returns, and reports results in scenario order.
 
-Why five ahead: for up to about 0.6 s after a node starts, its side of the
+Why four ahead: for up to about 0.6 s after a node starts, its side of the
 graph may not have matched the harness's yet, and its link waits for that
 before the first scan (``Ros2Link.open``; sent earlier, the scan would wait
 0.1-0.4 s for Fast DDS to repair it). Short scenarios (0.1-0.2 s each)
-reach a link started three ahead inside that window; five ahead, its node
-is mostly old enough. Nodes waiting their turn are idle (an executor
-asleep on its wait set).
+reach a link started three ahead inside that window; four ahead, its node
+is mostly old enough (five was no faster). Nodes waiting their turn are
+idle (an executor asleep on its wait set), but each holds a ROS domain:
+a suite holds up to AHEAD + BEHIND + 1 of the 101, so about 14 suites fit
+on one machine at once (a grading cluster runs one per core). A link
+started ahead that finds no domain free waits for its turn to take one.
 """
 
 from __future__ import annotations
@@ -26,7 +29,7 @@ from collections.abc import Callable
 
 from harness.links.base import Link
 
-AHEAD = 5  # links started beyond the one running (see the module's docstring)
+AHEAD = 4  # links started beyond the one running (see the module's docstring)
 BEHIND = 2  # finished links left stopping before the suite waits for the oldest
 
 Closed = Callable[[float], None]  # told the seconds the suite waited for the close

@@ -187,6 +187,28 @@ def test_overlapping_scenarios_get_fresh_nodes_in_their_own_domains() -> None:
     assert starts[1] < seen[0][0] and starts[2] < seen[0][0]
 
 
+def test_a_link_started_ahead_without_a_free_domain_starts_at_its_turn(monkeypatch) -> None:
+    """No domain free when a link is started ahead (this machine's other runs hold them
+    all) is not its scenario's failure: the link takes one when its scenario comes."""
+    from harness.links import ros2
+    from harness.ros.domain import NoFreeDomain
+
+    calls: list[bool] = []  # True: refused
+
+    def scarce(preferred=None):
+        refuse = len(calls) == 1  # the first link started ahead
+        calls.append(refuse)
+        if refuse:
+            raise NoFreeDomain("no free ROS domain id in 1..101: too many runs at once")
+        return reserve_domain(preferred)
+
+    monkeypatch.setattr(ros2, "reserve_domain", scarce)
+    names = ["approach_wall", "out_of_range"]
+    results = run_suite([resolve_scenario(n) for n in names], "ros2", LinkOptions())
+    assert all(r.ok for r in results), [r.first_failure or r.error for r in results]
+    assert calls == [False, True, False]  # refused ahead, taken at its turn
+
+
 def test_a_start_not_awaited_reports_its_node_once_awaited() -> None:
     """`start(wait=False)` returns before the supervisor has said the node runs (a suite
     starts the next links meanwhile); `await_started` then waits for that word."""
