@@ -322,8 +322,8 @@ class NodeProcess:
             except BlockingIOError:
                 return
             if not chunk:  # the reaper has exited
-                os.close(fd)
-                self._status_fd = None
+                self._status_fd = None  # first: a Ctrl-C landing after the close leaves no
+                os.close(fd)  # stale number, which another pipe may take (EBADF, or worse)
                 return
             *lines, self._partial = (self._partial + chunk).split(b"\n")
             for line in lines:

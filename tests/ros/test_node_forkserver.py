@@ -231,6 +231,30 @@ def test_a_node_that_cannot_start_is_reported_when_awaited(tmp_path: Path) -> No
         process.stop()
 
 
+def test_a_ctrl_c_as_the_reapers_pipe_closes_leaves_no_stale_descriptor(monkeypatch) -> None:
+    """A KeyboardInterrupt that lands just after the reaper's pipe is closed must not
+    leave its number behind: another pipe may take it, and the stop at exit then waited
+    on a closed descriptor (EBADF, a traceback after Ctrl-C in run --watch)."""
+    from harness.nodes import process as process_module
+
+    node = NodeProcess(NodeCommand((sys.executable, "-c", "pass"), description="ends"), [], {})
+    node.start()
+    status_fd = node._status_fd
+    closed = os.close
+
+    def close_then_interrupt(fd: int) -> None:
+        closed(fd)
+        if fd == status_fd:
+            raise KeyboardInterrupt
+
+    monkeypatch.setattr(process_module.os, "close", close_then_interrupt)
+    with pytest.raises(KeyboardInterrupt):
+        node.stop()  # a link's close, when Ctrl-C comes
+    monkeypatch.undo()
+    assert node._status_fd is None
+    node.stop()  # again, as at exit: nothing stale to wait on
+
+
 @contextlib.contextmanager
 def started_node_unawaited() -> Iterator[NodeProcess]:
     """The reference node, started without waiting, in a domain of its own."""
