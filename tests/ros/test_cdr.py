@@ -10,7 +10,25 @@ from sensor_msgs.msg import LaserScan
 
 from harness.lidar.scan import Scan
 from harness.ros.cdr import clock_cdr, scan_cdr
-from harness.ros.messages import clock_message, scan_message
+from harness.ros.messages import stamp
+
+
+def clock_message(seconds: float) -> Clock:
+    return Clock(clock=stamp(seconds))
+
+
+def scan_message(scan: Scan) -> LaserScan:
+    """The same scan as a LaserScan object, filled as an rclpy user fills one."""
+    msg = LaserScan()
+    msg.header.stamp = stamp(scan.stamp)
+    msg.header.frame_id = scan.frame_id
+    msg.angle_min, msg.angle_max = float(scan.angle_min), float(scan.angle_max)
+    msg.angle_increment, msg.time_increment = float(scan.angle_increment), scan.time_increment
+    msg.scan_time = float(scan.scan_time)
+    msg.range_min, msg.range_max = float(scan.range_min), float(scan.range_max)
+    msg.ranges = scan.ranges.tolist()
+    msg.intensities = scan.intensities.tolist()
+    return msg
 
 
 def scan(frame_id: str, beams: int, intensities: int) -> Scan:

@@ -37,13 +37,13 @@ def wait_until(condition, seconds: float) -> bool:
 
 
 @contextlib.contextmanager
-def started_node() -> Iterator[NodeProcess]:
+def started_node(*, wait: bool = True) -> Iterator[NodeProcess]:
     """The reference node, started in a domain of its own; stopped and released after."""
     domain = reserve_domain(None)
     environment = {"ROS_DOMAIN_ID": str(domain.domain_id), **discovery_environment(network=False)}
     process = NodeProcess(reference_node(), ros_arguments(("threshold:=0.4",)), environment)
     try:
-        process.start()
+        process.start(wait=wait)
         yield process
     finally:
         process.stop()
@@ -212,7 +212,7 @@ def test_a_link_started_ahead_without_a_free_domain_starts_at_its_turn(monkeypat
 def test_a_start_not_awaited_reports_its_node_once_awaited() -> None:
     """`start(wait=False)` returns before the supervisor has said the node runs (a suite
     starts the next links meanwhile); `await_started` then waits for that word."""
-    with started_node_unawaited() as process:
+    with started_node(wait=False) as process:
         process.await_started()
         assert process.node_pid is not None and alive(process.node_pid)
         process.await_started()  # again: nothing more to wait for
@@ -253,20 +253,6 @@ def test_a_ctrl_c_as_the_reapers_pipe_closes_leaves_no_stale_descriptor(monkeypa
     monkeypatch.undo()
     assert node._status_fd is None
     node.stop()  # again, as at exit: nothing stale to wait on
-
-
-@contextlib.contextmanager
-def started_node_unawaited() -> Iterator[NodeProcess]:
-    """The reference node, started without waiting, in a domain of its own."""
-    domain = reserve_domain(None)
-    environment = {"ROS_DOMAIN_ID": str(domain.domain_id), **discovery_environment(network=False)}
-    process = NodeProcess(reference_node(), ros_arguments(()), environment)
-    try:
-        process.start(wait=False)
-        yield process
-    finally:
-        process.stop()
-        domain.release()
 
 
 THREADED = textwrap.dedent(
