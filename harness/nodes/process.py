@@ -199,7 +199,7 @@ class NodeProcess:
         self._done = False  # the reaper finished its stop (its last event)
         self._stop_requested = False
         self.started_at = 0.0  # monotonic: when `start` set it on its way
-        self._start_by: float | None = None  # monotonic deadline of the start, until seen
+        self._start_pending = False  # started without waiting: `await_started` waits
         self.how = "started as a command"  # how `start` started it, for the user
 
     def start(self, *, wait: bool = True) -> None:
@@ -251,27 +251,46 @@ class NodeProcess:
         }
         _LIVE.add(self)
         self.started_at = time.monotonic()
-        self._start_by = self.started_at + START_WAIT_S
+        self._start_pending = True
         if wait:
             self.await_started()
 
     def await_started(self) -> None:
-        """Wait (bounded) until the reaper says the node runs; ConfigError if it cannot."""
-        if self.node_pid is not None or self._start_by is None:
+        """Wait (bounded) until the reaper says the node runs; ConfigError if it cannot.
+
+        What the reaper reported already is read first, and the bound
+        (START_WAIT_S) counts from this call, not from `start`: a link started
+        ahead may be awaited long after its node came up (a suite of a slow
+        node), and that is no failure to start.
+        """
+        if self.node_pid is not None or not self._start_pending:
             return
+        self._read_events()
+        deadline = time.monotonic() + START_WAIT_S
         while self.node_pid is None and self.start_error is None and self._status_fd is not None:
-            left = self._start_by - time.monotonic()
+            left = deadline - time.monotonic()
             if left <= 0:
                 break
             self._read_events(min(POLL_S, left))
-        self._start_by = None
+        self._start_pending = False
         if self.node_pid is None:
-            why = self.start_error or (
-                f"its supervisor ({REAPER.name}) did not report within {START_WAIT_S:g} s; "
-                f"stderr: {self.tail('stderr', 3)}"
-            )
+            self.returncode()  # the reaper's last words, if it has exited
+            why = self.start_error or self._no_start_report()
             self.stop()
             raise ConfigError(f"cannot start {self.command.description}: {why}")
+
+    def _no_start_report(self) -> str:
+        """Why the node is not known to run, though nothing said it failed: in the node's
+        own words where it wrote any."""
+        said = (self.tail("stderr", 3) or self.tail("stdout", 3)).replace("\n", " | ")
+        words = f"; it wrote: {said}" if said else "; it wrote nothing"
+        if self._status_fd is None:
+            return f"its supervisor ({REAPER.name}) exited before the node ran{words}"
+        return (
+            f"the node was not running {START_WAIT_S:g} s after the harness began waiting for "
+            f"it (its supervisor, {REAPER.name}, reported nothing: a machine too busy to start "
+            f"a process?){words}"
+        )
 
     def _forked(self, fds: list[int]) -> ForkedSupervisor | None:
         """The node started by a fork server (a module of this interpreter, or a Python

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import contextlib
 import os
+import select
 import signal
 import subprocess
 import sys
@@ -216,6 +217,23 @@ def test_a_start_not_awaited_reports_its_node_once_awaited() -> None:
         process.await_started()
         assert process.node_pid is not None and alive(process.node_pid)
         process.await_started()  # again: nothing more to wait for
+
+
+def test_a_start_awaited_after_its_bound_reads_the_report_that_came(monkeypatch) -> None:
+    """A link started ahead is awaited when its scenario comes, which for a slow node is
+    long after the start's bound (10 s) has passed since `start`: the report that came
+    meanwhile is read first, and the bound counts from the wait (here it is none at all).
+    """
+    from harness.nodes import process as process_module
+
+    monkeypatch.setattr(process_module, "START_WAIT_S", 0.0)
+    with started_node(wait=False) as process:
+        fd = process._status_fd
+        assert fd is not None
+        readable, _, _ = select.select([fd], [], [], 10.0)  # the reaper has reported
+        assert readable
+        process.await_started()
+        assert process.node_pid is not None and alive(process.node_pid)
 
 
 def test_a_node_that_cannot_start_is_reported_when_awaited(tmp_path: Path) -> None:
