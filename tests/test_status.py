@@ -8,7 +8,8 @@ import re
 import pytest
 
 from harness.errors import ConfigError
-from harness.judge.status import find_numbers, half_unit, parse_status
+from harness.judge.status import half_unit, parse_status
+from harness.judge.status_numbers import find_numbers
 
 INF, NAN = math.inf, math.nan
 NONE = (False, None, None)

@@ -40,8 +40,9 @@ import re
 from dataclasses import dataclass
 
 from harness.errors import ConfigError
+from harness.judge.status_numbers import WORD_END, WORD_START, Number, find_numbers
 
-__all__ = ["StatusClaim", "Number", "compile_status_pattern", "find_numbers", "parse_status"]
+__all__ = ["StatusClaim", "compile_status_pattern", "parse_status"]
 
 
 @dataclass(frozen=True)
@@ -57,64 +58,11 @@ class StatusClaim:
     reason: str | None = None  # why no obstacle is claimed, e.g. "says 'no obstacle'"
 
 
-@dataclass(frozen=True)
-class Number:
-    """A number found in a status, with where it stands and what labels it."""
-
-    value: float
-    decimals: int | None  # digits after the point, less the exponent; None for inf/nan
-    start: int
-    end: int
-    label: str | None  # "distance", "angle", "ignore" or None
-
-
-# A candidate number; the glue checks happen in find_numbers.
-_NUMBER = re.compile(
-    r"(?P<sign>[+-]?)"
-    r"(?:(?P<inf>inf(?:inity)?)|(?P<nan>nan)"
-    r"|(?P<mant>\d+(?:\.(?P<frac>\d*))?|\.(?P<frac2>\d+))(?:[eE](?P<exp>[+-]?\d+))?)",
-    re.IGNORECASE,
-)
-
-_UNIT = re.compile(
-    r"\s?(?P<unit>°|deg(?:rees?)?\b|rad(?:ians?)?\b|m\b|cm\b|mm\b|meters?\b|metres?\b"
-    r"|ms\b|s\b|sec(?:onds?)?\b|hz\b)",
-    re.IGNORECASE,
-)
-
-# Keywords may sit inside identifiers ("min_dist=", "angle_rad:"), so they
-# are bounded by letters and digits only, not by "_".
-_W = r"(?<![^\W_])"  # not after a letter or digit
-_E = r"(?![^\W\d_])"  # not before a letter
-_KEYWORDS = {
-    "distance": re.compile(
-        _W
-        + r"(?:distance|dist|range|odleg[łl]o[śs][ćc]|dystans|απόσταση)"
-        + _E
-        + r"|(?<![\w.])[dr]\s*[:=]",
-        re.IGNORECASE,
-    ),
-    "angle": re.compile(
-        _W
-        + r"(?:angle|ang|theta|bearing|heading|direction|k[ąa]t|γωνία)"
-        + _E
-        + r"|θ|(?<![\w.])a\s*[:=]",
-        re.IGNORECASE,
-    ),
-    "ignore": re.compile(
-        _W
-        + r"(?:index|idx|beam|sample|tick|time|stamp|seq|count)"
-        + _E
-        + r"|(?<![\w.])[it]\s*[:=]",
-        re.IGNORECASE,
-    ),
-}
-
 # Phrases that mean "no obstacle" even when numbers follow.
 _NEGATIVE_PHRASES = (
     r"\bno\s+(?:\w+\s+)?(?:obstacles?|objects?|obstructions?|returns?|hits?|detections?"
     r"|readings?|targets?|walls?|echo(?:es)?)\b",  # "no obstacle", "no valid readings"
-    _W + r"no[_\-\s]?obstacles?" + _E,  # "NO_OBSTACLE", "no-obstacle"
+    WORD_START + r"no[_\-\s]?obstacles?" + WORD_END,  # "NO_OBSTACLE", "no-obstacle"
     r"\bnothing\b",
     r"\bnone\s+(?:detected|found|seen|in\s+range)\b",
     r"\bclear\b",  # "clear", "all clear", "path is clear" (not "clearance")
@@ -122,92 +70,13 @@ _NEGATIVE_PHRASES = (
     r"\bobstacle[\s_-]free\b|\bfree\s+(?:path|way|road|route)\b",
     r"\bout\s+of\s+range\b",
     r"\bnot\s+(?:detected|found|present|seen)\b",
-    _W + r"obstacles?(?:[\s_]*(?:detected|present|found|ahead))?\s*[:=?]\s*"
+    WORD_START + r"obstacles?(?:[\s_]*(?:detected|present|found|ahead))?\s*[:=?]\s*"
     r"(?:false|no|none|n)\b",  # "Obstacle: False", "obstacle_detected=no"
     r"\bbrak\b|\bκανένα\b|\bδεν\s+υπάρχει\b",  # Polish "brak", Greek "none"/"there is no"
 )
 _NEGATIVE = re.compile("|".join(_NEGATIVE_PHRASES), re.IGNORECASE)
 # A negative phrase preceded by one of these is itself negated ("not clear").
 _NEGATED = re.compile(r"(?:\bnot|n't|\bnever)\s*$", re.IGNORECASE)
-
-
-def _glued(text: str, start: int) -> bool:
-    """True when the candidate at `start` continues a word, path or number."""
-    if start == 0:
-        return False
-    prev = text[start - 1]
-    if prev.isalnum() or prev in "_/\\":
-        return True
-    # "1.2.3": a number right after "<digit>." is a version or IP part.
-    return prev == "." and start >= 2 and text[start - 2].isdigit()
-
-
-def _label_after(text: str, end: int) -> str | None:
-    m = _UNIT.match(text, end)
-    if not m:
-        return None
-    unit = m.group("unit").lower()
-    if unit.startswith(("°", "deg", "rad")):
-        return "angle"
-    if unit in ("m", "cm", "mm") or unit.startswith("met"):
-        return "distance"
-    return "ignore"  # s, ms, sec, Hz
-
-
-def _label_before(gap: str) -> str | None:
-    found = [label for label, rx in _KEYWORDS.items() if rx.search(gap)]
-    if not found:
-        return None
-    if len(found) == 1:
-        return found[0]
-    # Several kinds named since the last number: the nearest one decides,
-    # unless it is ambiguous between distance and angle.
-    if "distance" in found and "angle" in found:
-        return None
-    last = max(found, key=lambda label: _last_match_end(_KEYWORDS[label], gap))
-    return last
-
-
-def _last_match_end(rx: re.Pattern[str], text: str) -> int:
-    return max((m.end() for m in rx.finditer(text)), default=-1)
-
-
-def find_numbers(text: str) -> list[Number]:
-    """Every number in `text` that stands on its own, with its label."""
-    out: list[Number] = []
-    pos = 0
-    prev_end = 0
-    while True:
-        m = _NUMBER.search(text, pos)
-        if m is None:
-            return out
-        start = m.start()
-        # A sign belongs to the number only if it is not glued ("x-1" is not -1).
-        if m.group("sign") and _glued(text, start):
-            pos = start + 1
-            continue
-        if _glued(text, start):
-            pos = m.end()
-            continue
-        word = m.group("inf") or m.group("nan")
-        end = m.end()
-        if text[end : end + 1] == "." and text[end + 1 : end + 2].isdigit():
-            pos = end  # "1.2.3": a version, not a number
-            continue
-        if word and end < len(text) and (text[end].isalnum() or text[end] == "_"):
-            pos = end  # "info", "nanosec", "infinite"
-            continue
-        if word:
-            value = float(m.group("sign") + word.lower().replace("inity", ""))
-            decimals: int | None = None
-        else:
-            frac = m.group("frac") if m.group("frac") is not None else m.group("frac2")
-            exp = int(m.group("exp")) if m.group("exp") else 0
-            value = float(m.group(0))
-            decimals = len(frac or "") - exp
-        label = _label_after(text, end) or _label_before(text[prev_end:start])
-        out.append(Number(value, decimals, start, end, label))
-        pos = prev_end = end
 
 
 def _pick(numbers: list[Number]) -> tuple[Number | None, Number | None]:
