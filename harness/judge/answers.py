@@ -32,6 +32,9 @@ class Answers:
     problem: str | None = None  # link-level failure, e.g. "node exited with code 1: ..."
     crashed: bool = False  # `problem` is the software under test's own: it exited, crashed,
     # or (a processing function) raised or hung; not the link's
+    # `problem` is the node's silence: it runs, but answered too late or not at all. That
+    # ends the run and is the node's verdict (FAIL), not a break of the run (ERROR).
+    silent: bool = False
     late: list[Received] = field(default_factory=list)  # answers to earlier scans, by tick
     seen: Scan | None = None  # the scan the node received, when a device and driver made it
     lost: str | None = None  # why the node never got this scan (e.g. damaged on the line)

@@ -231,7 +231,7 @@ class Oracle:
         if answers.problem:  # a node that died says how, with its last words: that is all
             failures.append(
                 clip(answers.problem)
-                if answers.crashed
+                if answers.crashed or answers.silent
                 else f"link problem: {clip(answers.problem)}"
             )
 

@@ -74,10 +74,11 @@ class RunResult:
 
         The tick at which a node died, a processing function raised or the
         link broke fails for that reason alone; it is the break, not a wrong
-        answer.
+        answer. A node that runs but answers too late or not at all is judged
+        on that (FAIL): its speed decides its verdict, it does not break the run.
         """
         return self.error is not None and all(
-            r.answers.problem is not None for r in self.failed_ticks
+            r.answers.problem is not None and not r.answers.silent for r in self.failed_ticks
         )
 
     @property

@@ -180,6 +180,9 @@ class Ros2Link(Link):
         self._started = False
         self._start_error: Exception | None = None
         self._no_domain: NoFreeDomain | None = None  # why start() could not start it yet
+        self._first_silence: str | None = None  # why the first scan went unanswered
+        self._first_waited = 0.0  # seconds its copies were given
+        self._ready_took = 0.0  # seconds `open` waited for the graph to show the node ready
 
     # -- life cycle -------------------------------------------------------
     @classmethod
@@ -244,7 +247,8 @@ class Ros2Link(Link):
             self.process.await_started()  # started ahead without waiting for it
         assert self.observer is not None
         opts = self.options
-        deadline = time.monotonic() + opts.ready_timeout
+        waiting = time.monotonic()
+        deadline = waiting + opts.ready_timeout
         clock_due = 0.0  # monotonic time of the next /clock while waiting
         while not self._ready():
             gone = self.node_gone("before it was ready")
@@ -259,6 +263,7 @@ class Ros2Link(Link):
                 clock_due = time.monotonic() + POLL_S
             self.observer.spin(READY_POLL_S)
             self.observer.inbox.clear()  # nothing heard before it is ready is an answer
+        self._ready_took = time.monotonic() - waiting
         if self.publishes_scans:  # its side matched too: the first scan is not repaired late
             self._wait_for(self.observer.scan_readers_named, NAMED_WAIT_S, poll=READY_POLL_S)
             self.observer.inbox.clear()
@@ -372,6 +377,7 @@ class Ros2Link(Link):
         assert self.observer is not None
         obs, opts = self.observer, self.options
         self._await_bool_writer()  # its first Bool must reach us
+        bool_matched = obs.warning_publishers() > 0
         self._counted = (obs.heard["status"], obs.heard["warning"])
         first_at = time.perf_counter()
         deadline = first_at + opts.ready_timeout
@@ -391,10 +397,14 @@ class Ros2Link(Link):
             if outcome != "timeout":
                 break  # answered; or the node is gone, which collect reports at this tick
             self._check_types()
-            if time.perf_counter() >= deadline:
-                raise LinkError(self._never_answered(scan, copies))
+            if time.perf_counter() >= deadline:  # judged at this tick (collect): silent
+                self._first_silence = self._never_answered(scan, copies)
+                self._first_waited = time.perf_counter() - first_at
+                break
         self._copies = copies
-        if copies > 1 and self.copies_queue:
+        if self._first_silence is None and not bool_matched:
+            self._await_first_bool(first_ns)
+        if copies > 1 and self.copies_queue and self._first_silence is None:
             # A node slow on its first scan has the other copies queued: let it answer
             # them (each about as long as the first took) before the next scan goes out,
             # or their answers would be taken for that scan's.
@@ -425,9 +435,27 @@ class Ros2Link(Link):
         if obs.warning_publishers() > 0:
             return
         if obs.node.count_publishers(topic) == 0:
-            self._wait_for(lambda: obs.node.count_publishers(topic) > 0, BOOL_DISCOVERY_S)
+            # As long as the graph took to show the node ready (a busy machine's
+            # discovery is slower), and BOOL_DISCOVERY_S at least.
+            bound = max(BOOL_DISCOVERY_S, self._ready_took)
+            self._wait_for(lambda: obs.node.count_publishers(topic) > 0, bound)
         if obs.node.count_publishers(topic) > 0:
             self._wait_for(lambda: obs.warning_publishers() > 0, WARM_UP_RETRY_S)
+
+    def _await_first_bool(self, first_ns: int) -> None:
+        """The first scan went out while our Bool reader had matched no Bool writer, and
+        it was answered without a Bool: where the node does have a Bool writer (the
+        graph shows it only now, as a loaded machine's discovery may), the Bool it
+        published before the match reaches us once Fast DDS repairs it. Wait for it,
+        bounded by the per-scan deadline, so tick 0 is judged on the Bool the node
+        published, not on discovery's speed."""
+        assert self.observer is not None
+        obs, topic = self.observer, self.options.warning_topic
+        if obs.heard_since("warning", first_ns):
+            return
+        if obs.warning_publishers() == 0 and obs.node.count_publishers(topic) == 0:
+            return  # no Bool writer in sight, even now: the node has none
+        self._wait_for(lambda: obs.heard_since("warning", first_ns), self.options.scan_timeout)
 
     def _copy(self, n: int) -> None:
         """Hook: copy `n` (0 first) of the first scan is about to go out."""
@@ -759,11 +787,15 @@ class Ros2Link(Link):
             return obs.heard_since("warning", self._sent_ns)
 
         timeout = self._deadline(scan)
-        outcome = self._wait_for(status_in, self._sent_at + timeout - time.perf_counter())
+        silence, self._first_silence = self._first_silence, None
+        if silence is not None:  # the first scan's copies went unanswered: nothing to wait for
+            outcome: str | None = "timeout"
+        else:
+            outcome = self._wait_for(status_in, self._sent_at + timeout - time.perf_counter())
         if outcome == "timeout":
             answers.timed_out = True
             outcome = None
-            if not (self.options.realtime or may_be_ignored):
+            if silence is None and not (self.options.realtime or may_be_ignored):
                 # The node is behind. Let it catch up before the next scan, or its
                 # answer to this scan would be taken for an answer to the next one.
                 outcome = self._wait_for(status_in, max(CATCH_UP_S, 3 * timeout))
@@ -788,10 +820,12 @@ class Ros2Link(Link):
                 Received(r.value, r.after, tick) for r in (*answers.statuses, *answers.warnings)
             ]
             answers.statuses, answers.warnings = [], []
-            answers.waited = timeout
+            answers.waited = timeout if silence is None else self._first_waited
         else:
             answers.waited = time.perf_counter() - self._sent_at
-        if not (may_be_ignored and answers.timed_out):  # a node may skip such a scan
+        if silence is not None and answers.problem is None:
+            answers.problem, answers.silent = silence, True
+        elif not (may_be_ignored and answers.timed_out):  # a node may skip such a scan
             self._watch_silence(answers, tick, empty=not scan.valid_mask().any())
         self._watch_flood(answers)
         return answers
@@ -959,3 +993,4 @@ class Ros2Link(Link):
                 f"{self._silent_scans} scans in a row (the node is still running: stuck in a "
                 "callback, or not publishing)"
             )
+        answers.silent = True  # the node runs: its silence is its verdict

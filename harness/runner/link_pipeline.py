@@ -27,12 +27,20 @@ import time
 from collections import deque
 from collections.abc import Callable
 
+from harness.errors import ConfigError
 from harness.links.base import Link
 
 AHEAD = 4  # links started beyond the one running (see the module's docstring)
 BEHIND = 2  # finished links left stopping before the suite waits for the oldest
 
 Closed = Callable[[float], None]  # told the seconds the suite waited for the close
+
+
+class _Unmade:
+    """A link that could not be made (a usage error), kept to be raised at its turn."""
+
+    def __init__(self, error: ConfigError) -> None:
+        self.error = error
 
 
 class LinkPipeline:
@@ -43,7 +51,7 @@ class LinkPipeline:
         self._count = count
         self._ahead = AHEAD if overlap else 0
         self._behind = BEHIND if overlap else 0
-        self._started: deque[Link] = deque()  # made and started, not yet taken, in order
+        self._started: deque[Link | _Unmade] = deque()  # made and started, not yet taken, in order
         self._next = 0  # the index of the next link to make
         self._stopping: deque[tuple[Link, Closed]] = deque()
         self._running: Link | None = None  # taken, not yet retired
@@ -54,16 +62,23 @@ class LinkPipeline:
         if index != self._next - len(self._started):
             raise ValueError(f"links are taken in order: asked for {index}")
         self._start_until(index)
-        link = self._running = self._started.popleft()
+        link = self._started.popleft()
+        if isinstance(link, _Unmade):
+            raise link.error
+        self._running = link
         self._start_until(index + self._ahead)
         return link
 
     def _start_until(self, last: int) -> None:
         while self._next <= min(last, self._count - 1):
-            link = self._make(self._next)
+            try:
+                link: Link | _Unmade = self._make(self._next)
+            except ConfigError as err:  # raised when its scenario is taken, not before
+                link = _Unmade(err)
             self._next += 1
             self._started.append(link)
-            link.start()
+            if not isinstance(link, _Unmade):
+                link.start()
 
     def retire(self, link: Link, closed: Closed) -> None:
         """Its scenario is over: ask it to stop now; `closed` runs once it is closed,
@@ -87,7 +102,8 @@ class LinkPipeline:
         report in order. Safe to call again."""
         self._next = self._count
         running, self._running = self._running, None
-        unused = [*([running] if running is not None else []), *self._started]
+        ahead = [link for link in self._started if not isinstance(link, _Unmade)]
+        unused = [*([running] if running is not None else []), *ahead]
         self._started.clear()
         for link in unused:
             link.stop()

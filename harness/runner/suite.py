@@ -82,16 +82,30 @@ def run_suite(
                     report(_not_run(scenario, link_name, reason))
                     continue
                 started = time.perf_counter()
-                link = pipeline.take(index)  # starts it (unless started ahead), and the next ones
-                taking = time.perf_counter() - started
-                result = run_through(
-                    link,
-                    lambda link, s=scenario: run_scenario(
-                        s, link, settings, on_tick=on_tick, open_link=True
-                    ),
-                    not_started_as(scenario, link_name, settings),
-                    body_opens=True,
-                )
+                try:
+                    link = pipeline.take(index)  # starts it (unless ahead), and the next ones
+                    taking = time.perf_counter() - started
+                    result = run_through(
+                        link,
+                        lambda link, s=scenario: run_scenario(
+                            s, link, settings, on_tick=on_tick, open_link=True
+                        ),
+                        not_started_as(scenario, link_name, settings),
+                        body_opens=True,
+                    )
+                except ConfigError as err:
+                    if not results and index == 0:
+                        raise  # found before anything ran: a usage error (exit 2)
+                    # Scenarios were judged: they keep their rows, this one says why.
+                    result = not_started_as(scenario, link_name, settings)(
+                        f"could not start: {err}", ""
+                    )
+                    result.not_started = True
+                    result.startup_s = time.perf_counter() - started
+                    failed_start = scenario.name
+                    pipeline.drain()  # the scenarios before report first, in order
+                    report(result)
+                    continue
                 result.startup_s += taking  # starting links is start-up too
                 if result.not_started:
                     failed_start = scenario.name
