@@ -15,13 +15,19 @@ The rules, also in docs/grading.md:
   **workspace** when package.xml files sit below it (only under src/ if it
   has one; build/, install/, log/, hidden folders and folders holding a
   COLCON_IGNORE are never searched, at most four levels deep); a **script**
-  when it has no package.xml and one top-level .py file, or several of which
-  exactly one imports rclpy. Anything else is still a student, with the
-  reason there is nothing to run.
+  when it has no package.xml and top-level .py files, one of which is the
+  node (`node_script`: the lab's fossbot_lidar_node.py, else the one whose
+  __main__ guard starts a node, else the one that imports rclpy; the others
+  are its helper modules). Anything else is still a student, with the reason
+  there is nothing to run.
+- Nothing handed in at all (no folder, no archive: an empty DIR, or only
+  loose files) is a usage error: the DIR is likely the wrong one. A class
+  whose hand-ins cannot run is graded: a row each, with its reason.
 """
 
 from __future__ import annotations
 
+import ast
 import os
 import re
 from collections import Counter
@@ -52,6 +58,17 @@ NEVER_SEARCHED = {"build", "install", "log", "__pycache__", "node_modules"}
 IGNORE_MARKERS = ("COLCON_IGNORE", "AMENT_IGNORE")
 MAX_DEPTH = 4  # src/<repo>/<group>/<package>/package.xml
 NOT_A_NODE = {"setup.py", "conftest.py", "__init__.py"}
+LAB_NODE = "fossbot_lidar_node.py"  # what Lab 07 names the node: the node, beside any helper
+# What a __main__ guard calls (itself or through the script's functions) that starts a
+# node: rclpy's init, any spin (an executor's too), or a Node made.
+STARTS_A_NODE = {
+    "rclpy.init",
+    "rclpy.create_node",
+    ".spin",
+    ".spin_once",
+    ".spin_until_future_complete",
+}
+RCLPY_STARTS = {"init", "create_node", "spin", "spin_once", "spin_until_future_complete"}
 SCRIPT_PEEK_BYTES = 1 << 20
 # What LMSs export; the longest suffix first (".tar.gz" before ".tar").
 ARCHIVE_SUFFIXES = (".tar.gz", ".tgz", ".tar.bz2", ".tbz2", ".tar.xz", ".txz", ".tar", ".zip")
@@ -174,12 +191,16 @@ def package_folders(root: Path, depth: int = MAX_DEPTH) -> list[Path]:
     return found
 
 
-def _imports_rclpy(script: Path) -> bool:
+def _read_script(script: Path) -> str:
     try:
         with open(script, "rb") as handle:
-            text = handle.read(SCRIPT_PEEK_BYTES).decode("utf-8", "replace")
+            return handle.read(SCRIPT_PEEK_BYTES).decode("utf-8", "replace")
     except OSError:
-        return False
+        return ""
+
+
+def _imports_rclpy(script: Path) -> bool:
+    text = _read_script(script)
     return re.search(r"^\s*(import|from)\s+rclpy\b", text, re.MULTILINE) is not None
 
 
@@ -198,6 +219,111 @@ def node_scripts(folder: Path) -> list[Path]:
     ]
 
 
+def _called_names(nodes: Iterable[ast.AST]) -> set[str]:
+    """What `nodes` call: ``f()`` gives f; ``rclpy.init()`` gives .init and rclpy.init;
+    ``a.b.Node()`` gives .Node."""
+    names: set[str] = set()
+    for node in nodes:
+        for sub in ast.walk(node):
+            if isinstance(sub, ast.Call):
+                if isinstance(sub.func, ast.Name):
+                    names.add(sub.func.id)
+                elif isinstance(sub.func, ast.Attribute):
+                    names.add("." + sub.func.attr)
+                    if isinstance(sub.func.value, ast.Name):
+                        names.add(f"{sub.func.value.id}.{sub.func.attr}")
+    return names
+
+
+def _base_names(cls: ast.ClassDef) -> set[str]:
+    """The names of the classes `cls` derives from (``rclpy.node.Node`` gives Node)."""
+    return {
+        b.id if isinstance(b, ast.Name) else b.attr
+        for b in cls.bases
+        if isinstance(b, (ast.Name, ast.Attribute))
+    }
+
+
+def _rclpy_starts(tree: ast.Module) -> set[str]:
+    """The names a script calls rclpy's init or spins by (``from rclpy import init, spin``)."""
+    return {
+        alias.asname or alias.name
+        for s in ast.walk(tree)
+        if isinstance(s, ast.ImportFrom) and s.module == "rclpy"
+        for alias in s.names
+        if alias.name in RCLPY_STARTS
+    }
+
+
+def _is_main_guard(statement: ast.stmt) -> bool:
+    """``if __name__ == "__main__":`` (either way round)."""
+    if not isinstance(statement, ast.If) or not isinstance(statement.test, ast.Compare):
+        return False
+    test = statement.test
+    sides = [test.left, *test.comparators]
+    return (
+        len(sides) == 2
+        and isinstance(test.ops[0], ast.Eq)
+        and any(isinstance(s, ast.Name) and s.id == "__name__" for s in sides)
+        and any(isinstance(s, ast.Constant) and s.value == "__main__" for s in sides)
+    )
+
+
+def _starts_a_node(script: Path) -> bool:
+    """Whether `script` has a ``__main__`` guard that starts a ROS node: what it calls
+    (through the script's own functions and classes) includes rclpy's init or a spin, or
+    makes a Node (a class of the script deriving from Node counts as one). A helper
+    module's guard, if it has one, tries out its functions instead."""
+    try:
+        tree = ast.parse(_read_script(script))
+    except (SyntaxError, ValueError, RecursionError):
+        return False
+    guards = [s for s in tree.body if _is_main_guard(s)]
+    if not guards:
+        return False
+    defined: dict[str, ast.stmt] = {}
+    for statement in tree.body:
+        if isinstance(statement, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)):
+            defined[statement.name] = statement
+    nodes = {"Node"}  # and the script's classes deriving from one
+    classes = [s for s in defined.values() if isinstance(s, ast.ClassDef)]
+    while more_nodes := {c.name for c in classes if _base_names(c) & nodes} - nodes:
+        nodes |= more_nodes
+    starts = STARTS_A_NODE | nodes | {"." + n for n in nodes} | _rclpy_starts(tree)
+    seen: set[str] = set()
+    calls = _called_names(guards)
+    while True:
+        if calls & starts:
+            return True
+        more = {n for n in calls & defined.keys() if n not in seen}
+        if not more:
+            return False
+        seen |= more
+        calls = _called_names(defined[n] for n in more)
+
+
+def node_script(scripts: Sequence[Path]) -> list[Path]:
+    """Which of a hand-in's top-level scripts is its node (one), or the candidates left.
+
+    A student may split the node in two (the node and a module of helpers, both
+    importing rclpy). The lab names its node fossbot_lidar_node.py: that file is the
+    node. Otherwise the one whose ``__main__`` guard starts a node, else the one that
+    imports rclpy; a tie leaves the candidates it could not tell apart.
+    """
+    if len(scripts) <= 1:
+        return list(scripts)
+    named = [p for p in scripts if p.name == LAB_NODE]
+    if named:
+        return named
+    for choose in (_starts_a_node, _imports_rclpy):
+        chosen = [p for p in scripts if choose(p)]
+        if len(chosen) == 1:
+            return chosen
+        if chosen:
+            scripts = chosen
+    return list(scripts)
+
+
 def student_in(folder: Path, name: str | None = None) -> Student:
     """What `folder` holds, as a student named `name` (default: the folder's name)."""
     name = name or folder.name
@@ -214,14 +340,15 @@ def student_in(folder: Path, name: str | None = None) -> Student:
         ]
     if packages:
         return Student(name, folder, "workspace", base_paths=tuple(packages))
-    scripts = node_scripts(folder)
-    if len(scripts) > 1:
-        scripts = [p for p in scripts if _imports_rclpy(p)] or scripts
+    scripts = node_script(node_scripts(folder))
     if len(scripts) == 1:
         return Student(name, folder, "script", script=scripts[0])
     if scripts:
         listed = ", ".join(p.name for p in scripts)
-        problem = f"cannot tell which .py file is the node ({listed}): hand in one, or a package"
+        problem = (
+            f"cannot tell which .py file is the node ({listed}): name the node {LAB_NODE}, "
+            "or hand in a package"
+        )
     else:
         problem = "no node found: no package.xml and no .py file"
     return Student(name, folder, "none", problem=problem)
@@ -325,7 +452,8 @@ def _once(entries: list[Entry]) -> list[Entry]:
 
 
 def discover(dirs: Sequence[str | Path], *, exclude: str | Path | None = None) -> Discovery:
-    """The students in `dirs`; ConfigError (exit 2) for a missing folder or no student at all.
+    """The students in `dirs`; ConfigError (exit 2) for a missing folder, or for DIRs that
+    hold nothing handed in (no folder, no archive).
 
     `exclude` is the grader's output folder: never a student, even inside a DIR.
     Archives are only noted here (`archives`, `class_archives`), not opened:
@@ -359,7 +487,9 @@ def discover(dirs: Sequence[str | Path], *, exclude: str | Path | None = None) -
     result.class_archives = _once(result.class_archives)
     result.students = named(result.entries)
     some_archive = result.archives or result.class_archives
-    if not some_archive and not any(s.kind != "none" for s in result.students):
+    if not some_archive and all(e.problem is not None for e in result.entries):
+        # No folder and no archive (an empty DIR, only loose files): likely the wrong DIR.
+        # Folders whose hand-ins cannot run are a class all the same: a row each says why.
         listed = ", ".join(str(d) for d in dirs)
         raise ConfigError(
             f"no students found in {listed}: expected one folder (or archive) per student "

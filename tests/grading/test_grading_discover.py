@@ -110,10 +110,78 @@ def test_output_folder_hidden_folders_and_files_are_skipped(tmp_path: Path) -> N
         (lambda root: root / "missing", "no such folder"),
         (lambda root: touch(root / "file.txt"), "not a folder"),
         (lambda root: root, "no students found"),
-        (lambda root: touch(root / "x" / "notes.txt").parents[1], "no students found"),
+        (lambda root: touch(root / "notes.txt").parent, "no students found"),
     ],
 )
 def test_nothing_to_grade_is_a_usage_error(tmp_path: Path, make, match: str) -> None:
-    """Missing folder, a file, an empty folder, folders without any node: ConfigError."""
+    """Missing folder, a file, an empty folder, a folder of loose files: ConfigError."""
     with pytest.raises(ConfigError, match=match):
         discover([make(tmp_path)])
+
+
+def test_hand_ins_that_cannot_run_are_students_with_reasons(tmp_path: Path) -> None:
+    """Folders with nothing to run are a class all the same: each a row saying why."""
+    touch(tmp_path / "ana" / "notes.txt")
+    touch(tmp_path / "ben" / "one.py", NODE)
+    touch(tmp_path / "ben" / "two.py", NODE)
+    (tmp_path / "cleo").mkdir()
+    found = discover([tmp_path]).students
+    assert [(s.name, s.kind) for s in found] == [("ana", "none"), ("ben", "none"), ("cleo", "none")]
+    assert [s.problem.split(":")[0] for s in found if s.problem] == [
+        "no node found",
+        "cannot tell which .py file is the node (one.py, two.py)",
+        "no node found",
+    ]
+
+
+HELPER = (
+    "import rclpy\nfrom rclpy.node import Node\n\n\ndef nearest(ranges):\n    return min(ranges)\n"
+)
+GUARDED = (
+    "import rclpy\nfrom rclpy.node import Node\n\n\nclass Lidar(Node):\n    pass\n\n\n"
+    "def main():\n    rclpy.init()\n    rclpy.spin(Lidar())\n\n\n"
+    'if __name__ == "__main__":\n    main()\n'
+)
+
+
+def test_the_labs_node_name_wins_over_a_helper_importing_rclpy(tmp_path: Path) -> None:
+    """fossbot_lidar_node.py beside a helper module that imports rclpy too: the node."""
+    touch(tmp_path / "a" / "fossbot_lidar_node.py", NODE)
+    touch(tmp_path / "a" / "lidar_helpers.py", GUARDED)  # even one that could run alone
+    assert student_in(tmp_path / "a").script == tmp_path / "a" / "fossbot_lidar_node.py"
+
+
+@pytest.mark.parametrize(
+    "guard",
+    [
+        GUARDED,
+        # rclpy's names imported, the node made and spun in the guard itself
+        "from rclpy import init as start, spin\nfrom rclpy.node import Node\n"
+        'if "__main__" == __name__:\n    start()\n    spin(Node("n"))\n',
+        # an executor's spin, through two of the script's own functions
+        "import rclpy\nfrom rclpy.executors import SingleThreadedExecutor\n\n\n"
+        "def run(e):\n    e.spin()\n\n\ndef main():\n    run(SingleThreadedExecutor())\n\n\n"
+        'if __name__ == "__main__":\n    main()\n',
+    ],
+)
+def test_otherwise_the_node_is_the_one_whose_main_guard_starts_a_node(
+    tmp_path: Path, guard: str
+) -> None:
+    """No file of the lab's name: the script whose __main__ guard starts a node is it; a
+    helper's guard that only tries out its functions does not count."""
+    touch(tmp_path / "my_node.py", guard)
+    touch(tmp_path / "helpers.py", HELPER + 'if __name__ == "__main__":\n    print(nearest([1]))\n')
+    assert student_in(tmp_path).script == tmp_path / "my_node.py"
+
+
+def test_two_nodes_that_could_each_run_are_ambiguous(tmp_path: Path) -> None:
+    """Two guarded nodes and no file of the lab's name: the reason names the fix."""
+    touch(tmp_path / "old_node.py", GUARDED)
+    touch(tmp_path / "new_node.py", GUARDED)
+    touch(tmp_path / "broken.py", "import rclpy\nif __name__ == '__main__':\n    def (:\n")
+    student = student_in(tmp_path)
+    assert student.kind == "none"
+    assert student.problem == (
+        "cannot tell which .py file is the node (new_node.py, old_node.py): name the node "
+        "fossbot_lidar_node.py, or hand in a package"
+    )
