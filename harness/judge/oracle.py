@@ -316,9 +316,12 @@ class Oracle:
 
     def _judge_claim(self, scan: Scan, exp: Expectation, claim: StatusClaim) -> list[str]:
         quoted = _quoted(claim.text)
+        if claim.unreadable:  # what it claims is unknown: wrong whatever the scan
+            return [f"cannot read status {quoted}: {claim.unreadable}"]
         if not exp.obstacle:
             if claim.obstacle:
-                return [f"status {quoted} claims an obstacle at {_num(claim.distance)} m"]
+                at = f" at {_num(claim.distance)} m" if claim.distance is not None else ""
+                return [f"status {quoted} claims an obstacle{at}"]
             return []
         if not claim.obstacle:
             if exp.may_be_clear:

@@ -7,6 +7,11 @@ from it: is an obstacle claimed, at what distance (metres), at what angle
 
 Default rules, in order:
 
+0. A status printed as a structure -- JSON (``Infinity`` and ``NaN``
+   included), a Python dict or tuple (``inf``, ``nan``, ``np.float32(...)``),
+   ``key: value`` lines or pairs -- is read by its keys
+   (``structured_status``); the rules below read the rest, and a structure
+   none of whose keys say anything.
 1. A negative phrase ("no obstacle", "nothing", "clear", "free", "none
    detected", "out of range", "obstacle: false", ...) means no obstacle is
    claimed, whatever numbers follow. A negated negative ("not clear") is
@@ -41,6 +46,7 @@ from dataclasses import dataclass
 
 from harness.errors import ConfigError
 from harness.judge.status_numbers import WORD_END, WORD_START, Number, find_numbers
+from harness.judge.structured_status import KeyedClaim, read_structured
 
 __all__ = ["StatusClaim", "compile_status_pattern", "parse_status"]
 
@@ -56,6 +62,8 @@ class StatusClaim:
     distance_decimals: int | None  # printed precision, for tolerances
     angle_decimals: int | None
     reason: str | None = None  # why no obstacle is claimed, e.g. "says 'no obstacle'"
+    # A structured status whose keys could not be read: why, and the --status-regex fix.
+    unreadable: str | None = None
 
 
 # Phrases that mean "no obstacle" even when numbers follow.
@@ -158,6 +166,9 @@ def parse_status(text: str, pattern: str | re.Pattern[str] | None = None) -> Sta
     rx = compile_status_pattern(pattern)
     if rx is not None:
         return _parse_with(rx, text)
+    keyed = read_structured(text)
+    if keyed is not None:
+        return _from_keys(text, keyed)
     negative = _negation(text)
     if negative is not None:
         return StatusClaim(text, False, None, None, None, None, reason=f"says {negative!r}")
@@ -171,6 +182,20 @@ def parse_status(text: str, pattern: str | re.Pattern[str] | None = None) -> Sta
         angle=angle.value if angle else None,
         distance_decimals=distance.decimals,
         angle_decimals=angle.decimals if angle else None,
+    )
+
+
+def _from_keys(text: str, keyed: KeyedClaim) -> StatusClaim:
+    distance, angle = keyed.distance, keyed.angle
+    return StatusClaim(
+        text=text,
+        obstacle=keyed.obstacle,
+        distance=distance.value if distance else None,
+        angle=angle.value if angle else None,
+        distance_decimals=distance.decimals if distance else None,
+        angle_decimals=angle.decimals if angle else None,
+        reason=keyed.reason,
+        unreadable=keyed.unreadable,
     )
 
 
