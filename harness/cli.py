@@ -15,6 +15,7 @@ from rich.console import Console
 
 from harness import __version__
 from harness.commands import command_modules
+from harness.commands.arguments import expand_arguments
 from harness.errors import ConfigError, HarnessError, Interrupted
 from harness.nodes.quick_exit import exit_now
 
@@ -85,6 +86,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         if args.command is None:
             parser.print_help()
             return EXIT_USAGE
+        expand_arguments(args)  # ~ and $VAR in paths and commands, as a shell would
         args.given = given_options(parser, argv)  # what the user typed, apart from defaults
         handlers = {m.NAME: m.run for m in command_modules()}
         return handlers[args.command](args, console)

@@ -30,6 +30,7 @@ GROUND = {
     "user_cache",
     "text_file",
     "ctrl_c",
+    "shell_words",
 }
 
 # Bottom to top; a package imports only from layers below its own.
@@ -70,6 +71,7 @@ PURE = [
     "harness.audit.matrix",
     "harness.user_cache",
     "harness.text_file",
+    "harness.shell_words",
     "harness.grading.discover",
     "harness.grading.archives",
     "harness.grading.class_table",

@@ -16,6 +16,7 @@ import os
 import stat
 from collections.abc import Callable, Iterable, Mapping
 from dataclasses import replace
+from functools import partial
 from typing import TYPE_CHECKING
 
 from harness.errors import ConfigError
@@ -124,6 +125,69 @@ def given(option: str) -> Callable[[str], str]:
         return text
 
     return parse
+
+
+#: The options that name files or give command lines, each with how its messages name it:
+#: `~` and `$VAR` are expanded in them as a shell would (harness.shell_words), since a
+#: quoted `--node "python3 ~/lab07/node.py"` reaches us unexpanded.
+COMMAND_OPTIONS: Mapping[str, str] = {"node": "--node", "board_command": "--board-command"}
+PATH_OPTIONS: Mapping[str, str] = {
+    "workspace": "--workspace",
+    "out": "--out",
+    "junit_xml": "--junit-xml",
+    "baseline": "--baseline",
+    "record": "--record",
+    "animation": "--animation",
+    "grading": "--grading",
+    "gradescope": "--gradescope",
+    "roster": "--roster",
+    "port": "--port",
+    "processor": "--processor",
+    "scenarios": "SCENARIO",
+    "dirs": "DIR",
+    "recording": "FILE",
+    "world": "WORLD",
+}
+#: Paths in a comma-separated list: each item expanded (`~` starts each one).
+PATH_LIST_OPTIONS: Mapping[str, str] = {"scenario": "--scenario"}  # names or scenario files
+
+
+def expanded(option: str, value: str, *, command: bool = False) -> str:
+    """`value` of `option` with `~` and `$VAR` expanded (a command line's words, or a
+    path); ConfigError naming the option for an unset variable or what only a shell does,
+    and for a path that expands to nothing."""
+    from harness.shell_words import NotExpanded, expand_command, expand_path
+
+    try:
+        result = (expand_command if command else expand_path)(value)
+    except NotExpanded as err:
+        raise ConfigError(f"{option} {shown(value)}: {err}") from None
+    if not result.strip() and value.strip():
+        raise ConfigError(f"{option} {shown(value)}: expands to nothing")
+    return result
+
+
+def expand_arguments(args: argparse.Namespace) -> None:
+    """Every file and command option of `args` expanded in place (`expanded`), as a shell
+    would have expanded it unquoted: the one place the command line's are."""
+
+    def each(value: object, expand: Callable[[str], str]) -> object:
+        if isinstance(value, list):  # repeated, or a list of names
+            return [each(item, expand) for item in value]
+        return expand(value) if isinstance(value, str) else value
+
+    expanders: list[tuple[Mapping[str, str], Callable[[str, str], str]]] = [
+        (COMMAND_OPTIONS, lambda option, text: expanded(option, text, command=True)),
+        (PATH_OPTIONS, expanded),
+        (
+            PATH_LIST_OPTIONS,
+            lambda option, text: ",".join(expanded(option, i) for i in text.split(",")),
+        ),
+    ]
+    for options, expand in expanders:
+        for dest, option in options.items():
+            if hasattr(args, dest):
+                setattr(args, dest, each(getattr(args, dest), partial(expand, option)))
 
 
 def check_port(option: str, path: str) -> None:

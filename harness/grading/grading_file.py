@@ -19,8 +19,9 @@ gradebook:                          # gradebook.csv, for the LMS's import
 ```
 
 Read with the scenarios' own bounded YAML loader and validated here (pure:
-no rclpy, no pybullet). Paths are made absolute against the file's folder
-now, so nothing is ever resolved inside a student's folder.
+no rclpy, no pybullet). Paths (`~` and `$VAR` expanded as a shell would) are
+made absolute against the file's folder now, so nothing is ever resolved
+inside a student's folder.
 """
 
 from __future__ import annotations
@@ -157,6 +158,17 @@ class GradingFile(_Strict):
         return options
 
 
+def _expanded(ref: str, where: str) -> str:
+    """A scenario file's `~` and `$VAR` expanded as a shell would (no shell reads this
+    file); ConfigError naming `where` for an unset variable."""
+    from harness.shell_words import NotExpanded, expand_path
+
+    try:
+        return expand_path(ref)
+    except NotExpanded as err:
+        raise ConfigError(f"{where} {ref!r}: {err}") from None
+
+
 def _absolute(ref: str, folder: Path) -> str:
     """A scenario file named by the grading file, as an absolute path; a name stays a name."""
     candidate = Path(ref)
@@ -184,9 +196,10 @@ def load_grading_file(path: str | Path) -> GradingFile:
     except ValidationError as err:
         raise ConfigError(f"{name}: {_first_error(err)}") from None
     folder = path.resolve().parent
-    scenarios = [
-        e.model_copy(update={"scenario": _absolute(e.scenario, folder)}) for e in parsed.scenarios
-    ]
+    scenarios = []
+    for i, e in enumerate(parsed.scenarios):
+        ref = _expanded(e.scenario, f"{name}: scenarios.{i}.scenario")
+        scenarios.append(e.model_copy(update={"scenario": _absolute(ref, folder)}))
     return parsed.model_copy(update={"scenarios": scenarios, "source": str(path)})
 
 

@@ -15,7 +15,6 @@ import os
 import re
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from pathlib import Path
 from typing import Any
 
 import pytest
@@ -191,9 +190,29 @@ def _from_ini(config: pytest.Config, opt: _Option, where: str) -> Any:
     text = str(raw).strip() if raw else ""
     if not text:
         return None
+    text = _expanded(opt, text, f"{opt.ini_name} in {where}")
     if opt.name == "workspace" and config.inipath is not None:
-        text = str(config.inipath.parent / Path(text).expanduser())
+        text = str(config.inipath.parent / text)  # relative to the ini file, as its paths are
     return _parse_ini(opt, text, where) if opt.parse is not None else text
+
+
+#: The options that give a command line or a path: ``~`` and ``$VAR`` in them are expanded
+#: as a shell would (harness.shell_words); an ini file, or quotes, leave them to us.
+COMMANDS = ("node",)
+PATHS = ("workspace", "port")
+
+
+def _expanded(opt: _Option, text: str, source: str) -> str:
+    """`text` of `opt` expanded (a command line's words, or a path); a usage error naming
+    `source` ("--hil-node", "hil_node in pytest.ini") for what cannot be."""
+    if opt.name not in COMMANDS + PATHS:
+        return text
+    from harness.shell_words import NotExpanded, expand_command, expand_path
+
+    try:
+        return (expand_command if opt.name in COMMANDS else expand_path)(text)
+    except NotExpanded as err:
+        raise pytest.UsageError(f"{source} {text!r}: {err}") from None
 
 
 def _parse_ini(opt: _Option, text: str, where: str) -> Any:
@@ -213,6 +232,8 @@ def read_config(config: pytest.Config) -> HilConfig:
         value = config.getoption("hil_" + opt.name)
         if opt.repeat:
             value = tuple(value) or None
+        elif isinstance(value, str):
+            value = _expanded(opt, value, opt.flag)
         if value is None and opt.ini:
             value = _from_ini(config, opt, where)
             if value is not None:
