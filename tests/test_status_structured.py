@@ -42,6 +42,7 @@ STRUCTURED: list[tuple[str, tuple[bool, float | None, float | None]]] = [
     ('{"range_max": 12.0, "distance": null, "angle": null}', NONE),
     ('{"index": 90, "distance": 0.84, "time": 3.2, "angle": 1.57}', (True, 0.84, 1.57)),
     ('{"obstacle": true, "threshold": 0.5, "distance": 0.84}', (True, 0.84, None)),
+    ('{"valid_count": 300, "min_valid": 0.84, "angle": 1.57}', (True, 0.84, 1.57)),
     ('{"min_distance": Infinity, "angle": null}', (True, INF, None)),  # inf is a claim
     ('{"distance": null, "angle": null}', NONE),
     # one level of nesting
@@ -176,7 +177,15 @@ def test_free_text_that_looks_structured(
 
 @pytest.mark.parametrize(
     "text",
-    ["[" * 5000, '{"a": ' * 3000, "{" + "1: 2, " * 2000 + "}", "- " * 4000 + "1", "x: " * 5000],
+    [
+        "[" * 5000,
+        '{"a": ' * 3000,
+        "{" + "1: 2, " * 2000 + "}",
+        "- " * 4000 + "1",
+        "x: " * 5000,
+        "{'distance': 1" + "0" * 400 + "}",  # too large for a float
+        "{'d': 1j, 'e': b'x', **rest}",
+    ],
 )
 def test_hostile_structures_do_not_break_the_reader(text: str) -> None:
     """Deep nesting, long runs: read or left to free text, never an exception."""

@@ -46,7 +46,7 @@ _IGNORE = {
     "index", "idx", "beam", "beams", "sample", "samples", "tick", "time", "stamp",
     "timestamp", "seq", "count", "i", "t", "n", "num", "max", "maximum", "threshold",
     "thresh", "limit", "warning", "warn", "alarm", "increment", "hz", "rate", "frequency",
-    "id", "frame", "step", "total", "valid", "invalid", "points", "readings", "sec", "secs",
+    "id", "frame", "step", "total", "points", "readings", "sec", "secs",
     "seconds", "ms",
 }  # fmt: skip
 _ANGLE = {

@@ -135,7 +135,7 @@ def _python(body: str) -> object:
             warnings.simplefilter("ignore")  # "invalid escape sequence" and the like
             tree = ast.parse(body, mode="eval").body
         return _literal(tree, body, 0)
-    except (SyntaxError, ValueError, RecursionError, MemoryError, _NotLiteral):
+    except (SyntaxError, ValueError, OverflowError, RecursionError, MemoryError, _NotLiteral):
         return None
 
 
