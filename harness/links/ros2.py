@@ -69,6 +69,10 @@ FIRST_RETRY_MAX_S = 2.0  # the first scan's resends back off up to this interval
 # Once ready, for discovery to name the node reading the scans (Observer.scan_readers_named);
 # a participant that never names itself (no ROS node) is sent its first scan after this.
 NAMED_WAIT_S = 0.5
+# While not ready: once the graph shows the node reading LaserScans (or writing Strings) on
+# another topic instead of the harness's, it is given this long to use ours too, then the
+# run says so (waiting out the whole readiness bound would tell nothing more).
+ELSEWHERE_GRACE_S = 1.0
 CATCH_UP_S = 2.0  # after a missed deadline, wait this long (at least) for the late answer
 FLOOD_SCANS = 5  # a flood is judged over this many recent scans, in which a topic carried
 FLOOD_PER_SCAN = 5  # more than this many messages a scan,
@@ -183,6 +187,7 @@ class Ros2Link(Link):
         self._first_silence: str | None = None  # why the first scan went unanswered
         self._first_waited = 0.0  # seconds its copies were given
         self._ready_took = 0.0  # seconds `open` waited for the graph to show the node ready
+        self._gave_up_early_s: float | None = None  # readiness abandoned early, after this
 
     # -- life cycle -------------------------------------------------------
     @classmethod
@@ -250,11 +255,12 @@ class Ros2Link(Link):
         waiting = time.monotonic()
         deadline = waiting + opts.ready_timeout
         clock_due = 0.0  # monotonic time of the next /clock while waiting
+        elsewhere = _Elsewhere(self)
         while not self._ready():
             gone = self.node_gone("before it was ready")
             if gone:
                 raise LinkError(gone)
-            expired = time.monotonic() >= deadline
+            expired = time.monotonic() >= deadline or elsewhere.settled()
             self._check_types(named_only=not expired)
             if expired:
                 raise LinkError(self._never_ready())
@@ -312,10 +318,21 @@ class Ros2Link(Link):
                 )
         return (
             f"node {self.command.description} never became ready within "
-            f"{opts.ready_timeout:g} s: the harness waited for it to subscribe to "
+            f"{self._ready_bound_said()}: the harness waited for it to subscribe to "
             f"{opts.scan_topic} and publish {opts.status_topic}, but {reason} "
             f"({self.observer.graph_summary()})"
             + self._topic_hints(reads=reads, publishes=publishes)
+        )
+
+    def _ready_bound_said(self) -> str:
+        """How long the harness waited for readiness, in words (it stops early once the
+        node is seen using other topics)."""
+        bound = f"{self.options.ready_timeout:g} s"
+        if self._gave_up_early_s is None:
+            return bound
+        return (
+            f"{self._gave_up_early_s:.1f} s (of the {bound} allowed: it uses other topics, "
+            f"seen for {ELSEWHERE_GRACE_S:g} s)"
         )
 
     def _check_types(self, *, named_only: bool = False) -> None:
@@ -622,7 +639,10 @@ class Ros2Link(Link):
         if obs.heard["warning"] or obs.warning_publishers():
             return []
         elsewhere = self._topics_elsewhere(BOOL_TYPE, opts.warning_topic, publishers=True)
-        if len(elsewhere) == 1:
+        untaken = self._untaken_topic_parameter(opts.topic_params[2], opts.warning_topic)
+        if len(elsewhere) == 1 and untaken is not None:
+            self._notes.append(f"the node publishes a Bool on {elsewhere[0]}, not {untaken}")
+        elif len(elsewhere) == 1:
             self._notes.append(
                 f"the node publishes a Bool on {elsewhere[0]}, not {opts.warning_topic}: pass "
                 f"--warning-topic {elsewhere[0]} if that is the lab's name"
@@ -637,6 +657,32 @@ class Ros2Link(Link):
                 f"no Bool came on {opts.warning_topic} all run; the graph: {obs.node_topics()}"
             )
         return list(self._notes)
+
+    def _untaken_topic_parameter(self, parameter: str, topic: str) -> str | None:
+        """When the harness told the node its topic through `parameter` (a scenario's
+        node_topics) and the node does not declare that parameter: the rest of a note
+        saying so, and naming the node's own parameter for it where one looks like it.
+        None when the harness set no such parameter, or the node declares it."""
+        if f"{parameter}:={topic}" not in self.options.params:
+            return None
+        asked = self._ask_parameters()
+        if isinstance(asked, str):
+            return None  # its parameters are not known: the plain advice stands
+        _, declared = asked
+        if parameter in declared:
+            return None
+        word = parameter.split("_")[0]  # "warning", "lidar"
+        own = [name for name in declared if word in name.lower() and "topic" in name.lower()]
+        said = (
+            f"{topic}: the node did not take the parameter {parameter}:={topic} the harness "
+            f"set, as it declares no {parameter}"
+        )
+        if len(own) == 1:
+            return (
+                f"{said} (it declares {own[0]}): pass --param {own[0]}:={topic}, or name the "
+                f"parameter {parameter} as the lab does"
+            )
+        return f"{said}: declare {parameter} and publish on the topic it names"
 
     def _topics_elsewhere(self, type_name: str, topic: str, *, publishers: bool) -> list[str]:
         """Topics other than `topic` that another node publishes (or subscribes to) as
@@ -994,3 +1040,45 @@ class Ros2Link(Link):
                 "callback, or not publishing)"
             )
         answers.silent = True  # the node runs: its silence is its verdict
+
+
+class _Elsewhere:
+    """While a ros2 link waits for its node to be ready: does the graph show the node on
+    another scan or status topic (the one it reads or writes instead of the harness's),
+    for ELSEWHERE_GRACE_S? Then waiting longer tells nothing more. Looked at once per
+    POLL_S (a graph query costs more than a spin)."""
+
+    def __init__(self, link: Ros2Link) -> None:
+        self._link = link
+        self._began = time.monotonic()
+        self._seen_at: float | None = None
+        self._next_look = 0.0
+
+    def settled(self) -> bool:
+        link = self._link
+        if not link.publishes_scans or link.observer is None:
+            return False  # a board's graph is the board's: its own topics are no sign
+        now = time.monotonic()
+        if now >= self._next_look:
+            self._next_look = now + POLL_S
+            self._look(now)
+        if self._seen_at is None or now - self._seen_at < ELSEWHERE_GRACE_S:
+            return False
+        link._gave_up_early_s = now - self._began
+        return True
+
+    def _look(self, now: float) -> None:
+        link = self._link
+        assert link.observer is not None
+        opts = link.options
+        elsewhere = (
+            not link._reads_scans()
+            and bool(link._topics_elsewhere(SCAN_TYPE, opts.scan_topic, publishers=False))
+        ) or (
+            link.observer.status_sub.get_publisher_count() == 0
+            and bool(link._topics_elsewhere(STRING_TYPE, opts.status_topic, publishers=True))
+        )
+        if not elsewhere:
+            self._seen_at = None
+        elif self._seen_at is None:
+            self._seen_at = now

@@ -2,7 +2,8 @@
 """A Lab 07 node as students write it from the lab text, with their typical bugs.
 
 Run as ``python3 student_node.py VARIANT --ros-args ...``. ``correct`` and
-``correct_bool_when_close`` are right; every other variant has one bug the
+``correct_bool_when_close`` are right (``own_warning_parameter`` is right but names its
+warning topic parameter ``obstacle_warning_topic``); every other variant has one bug the
 harness's default suite must catch.
 """
 
@@ -35,6 +36,7 @@ VARIANTS = {
     "first_answer_wrong",
     "status_on_change",
     "silent_when_clear",
+    "own_warning_parameter",
 }
 
 
@@ -44,7 +46,11 @@ class LidarNode(Node):
         self.variant = variant
         self.declare_parameter("lidar_topic", "/scan")
         self.declare_parameter("lidar_status_topic", "/lidar_status")
-        self.declare_parameter("warning_topic", "/obstacle_warning")
+        # The lab names no warning parameter: a student may choose another name.
+        warning_param = "warning_topic"
+        if variant == "own_warning_parameter":
+            warning_param = "obstacle_warning_topic"
+        self.declare_parameter(warning_param, "/obstacle_warning")
         self.declare_parameter("threshold", 0.5)
         # Seconds a scan's callback takes before it answers (a slow but right node): every
         # scan's, or with slow_scan N only the N-th scan's (1 = the first it receives).
@@ -59,9 +65,7 @@ class LidarNode(Node):
             self.threshold = 0.5
         self.sub = self.create_subscription(LaserScan, scan_topic, self.on_scan, 10)
         self.status_pub = self.create_publisher(String, status_topic, 10)
-        self.warning_pub = self.create_publisher(
-            Bool, self.get_parameter("warning_topic").value, 10
-        )
+        self.warning_pub = self.create_publisher(Bool, self.get_parameter(warning_param).value, 10)
 
     def nearest(self, msg):
         best, best_i = math.inf, None

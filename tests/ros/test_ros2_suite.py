@@ -113,8 +113,37 @@ def test_ignored_topic_parameter_never_becomes_ready() -> None:
         "3",
     )
     assert done.returncode == 1
-    assert "never became ready within 3 s" in done.stdout
+    assert "never became ready within " in done.stdout
     assert "subscribers on /robot/scan: 0" in done.stdout
+
+
+def test_a_node_reading_another_scan_topic_is_told_so_without_waiting_out_readiness() -> None:
+    """The graph shows the node reading LaserScans on /scan, not the harness's topic: the
+    run says so about a second later, not after the whole readiness bound (20 s)."""
+    done = fossbot_hil(
+        "run",
+        "approach_wall",
+        *("--node", student("topic_parameter_ignored")),
+        *("--param", "lidar_topic:=/robot/scan", "--scan-topic", "/robot/scan"),
+    )
+    assert done.returncode == 1, done.stdout + done.stderr
+    waited = re.search(r"never became ready within (\d+\.\d) s \(of the 20 s allowed", done.stdout)
+    assert waited is not None, done.stdout
+    assert float(waited.group(1)) < 20
+    assert "it subscribes to a LaserScan on /scan, not /robot/scan" in done.stdout
+
+
+def test_a_node_that_names_its_warning_parameter_otherwise_is_told_which_parameter() -> None:
+    """obstacle_at_side sets the node's topics through the lab's parameters; a node that
+    declares obstacle_warning_topic, not warning_topic, is told the parameter it did not
+    take and the option that names its own, not only the topic it used instead."""
+    done = fossbot_hil("run", "obstacle_at_side", "--node", student("own_warning_parameter"))
+    assert done.returncode == 0, done.stdout + done.stderr
+    note = next(line for line in done.stdout.splitlines() if line.startswith("note: "))
+    assert "did not take the parameter warning_topic:=/fossbot2/obstacle_warning" in note
+    assert "(it declares obstacle_warning_topic)" in note
+    assert "pass --param obstacle_warning_topic:=/fossbot2/obstacle_warning" in note
+    assert "--warning-topic" not in note
 
 
 def test_non_default_topics_and_threshold_as_parameters() -> None:
