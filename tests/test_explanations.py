@@ -274,6 +274,19 @@ def test_a_status_published_only_on_change_is_named() -> None:
     )
 
 
+def test_answers_that_came_late_are_not_called_a_status_only_on_change() -> None:
+    """A node slower than the deadline answers every scan, late: its answers came, so no
+    hint about silence (only when it changes, nothing when clear) fits it."""
+    scans = approach([1.0, 1.0, 1.0, 1.0])  # the first status still holds for the others
+    replies = [answers(*status_for(scans[0]))]
+    for tick, scan in enumerate(scans[1:], start=1):
+        text, _ = status_for(scan)
+        replies.append(answers(None, late=[Received(text, 2.0, tick)]))
+    first = result_of(scans, replies).first_failure or ""
+    assert "it came after 2.00 s" in first
+    assert "hint" not in first, first
+
+
 def test_only_the_first_answer_wrong_is_named() -> None:
     scans = approach([1.0, 0.9, 0.8, 0.7])
     replies = [answers("Min distance: 0.000 m, angle: 0.000 rad", False)]

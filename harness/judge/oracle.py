@@ -36,6 +36,7 @@ _EPS32 = float(np.finfo(np.float32).eps)
 ABS_DISTANCE_TOL = 1e-6  # metres, on top of printed precision and float32 rounding
 ABS_ANGLE_TOL = 1e-5  # radians: float32 angle_min/increment times a few hundred beams
 MIN_BAND = 0.005  # metres either side of the threshold
+CAME_LATE = "; it came after"  # a missed deadline whose answer did come: late, not silent
 
 
 @dataclass(frozen=True)
@@ -246,7 +247,7 @@ class Oracle:
             if answers.timed_out:
                 came = [r for r in answers.late if r.tick == tick and isinstance(r.value, str)]
                 late = (
-                    f"; it came after {came[0].after:.2f} s: {_quoted(str(came[0].value))}"
+                    f"{CAME_LATE} {came[0].after:.2f} s: {_quoted(str(came[0].value))}"
                     if came
                     else ""
                 )

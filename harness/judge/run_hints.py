@@ -25,7 +25,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 
-from harness.judge.oracle import Oracle, Verdict
+from harness.judge.oracle import CAME_LATE, Oracle, Verdict
 from harness.lidar.scan import Scan
 
 WARNING_FAILURE = "expected warning"
@@ -116,7 +116,11 @@ def one_scan_late_hint(
 
 
 def _silent(v: Verdict) -> bool:
-    return v.claim is None and any(f.startswith(NO_STATUS) for f in v.failures)
+    """No status within the deadline, and none came later either (a late one is slow, not
+    silent: no hint about silence fits it)."""
+    return v.claim is None and any(
+        f.startswith(NO_STATUS) and CAME_LATE not in f for f in v.failures
+    )
 
 
 def silent_when_clear_hint(verdicts: Sequence[Verdict]) -> str | None:
