@@ -24,7 +24,7 @@ from harness.user_cache import cache_root
 
 __all__ = ["audit_key", "cached_audit", "keep_audit"]
 
-FORMAT = 1
+FORMAT = 2  # 2: each mutant's status and error, the score of the mutants judged
 
 
 def _folder() -> Path:

@@ -5,6 +5,13 @@ seed's suite; a pair that failed in some seeds and passed in others is a
 flip: a verdict that depends on luck, reported, never counted as a kill. A
 scenario the correct node does not pass every time kills nothing: its
 failures say nothing about the mistakes.
+
+What could not run is neither a kill nor a pass: a unit (a mutant, or the
+correct control) that did not finish, a scenario a mutant's suite did not
+run, or a mutant's failure in a scenario the correct node could not run
+(so nothing says the scenario is sound). Such a mutant is an error, with
+why; it is no survivor (nothing says the suite lets it pass), and the score
+counts only the mutants that were judged.
 """
 
 from __future__ import annotations
@@ -13,9 +20,12 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any, Protocol
 
-__all__ = ["Flip", "KillMatrix", "kill_matrix"]
+__all__ = ["CONTROL_NOT_RUN", "Flip", "KillMatrix", "kill_matrix"]
 
 FAILED = ("FAIL", "ERROR")
+NOT_RUN = "NOT RUN"
+# why a mutant that failed only where the correct node could not run is not judged
+CONTROL_NOT_RUN = "the correct node could not run it"
 
 
 class UnitVerdicts(Protocol):
@@ -47,28 +57,76 @@ class KillMatrix:
 
     scenarios: tuple[str, ...]
     mutants: tuple[str, ...]
-    cells: dict[tuple[str, str], str]  # (mutant, scenario) -> "killed" | "survived" | "flip"
-    killed_by: dict[str, tuple[str, ...]]
+    # (mutant, scenario) -> "killed" | "survived" | "flip" | "not run"
+    cells: dict[tuple[str, str], str]
+    killed_by: dict[str, tuple[str, ...]]  # () for a survivor and for an error
     why: dict[str, str]  # mutant -> the first failure of the first scenario that killed it
     flips: tuple[Flip, ...]
-    unsound: dict[str, str]  # scenario -> how the correct node failed it
-    unit_errors: dict[str, str]  # unit -> why it did not finish
+    unsound: dict[str, str]  # scenario -> how the correct node failed it (or did not run it)
+    unjudged: frozenset[str]  # of those, the scenarios the correct node could not run
+    unit_errors: dict[str, str]  # unit (mutant or "correct") -> why its verdict is unknown
+
+    def status(self, mutant: str) -> str:
+        """killed, survived or error (it could not be judged: `unit_errors` says why)."""
+        if mutant in self.unit_errors:
+            return "error"
+        return "killed" if self.killed_by[mutant] else "survived"
 
     @property
     def survivors(self) -> tuple[str, ...]:
-        return tuple(m for m in self.mutants if not self.killed_by[m])
+        return tuple(m for m in self.mutants if self.status(m) == "survived")
+
+    @property
+    def errors(self) -> tuple[str, ...]:
+        """The mutants that could not be judged, in order."""
+        return tuple(m for m in self.mutants if self.status(m) == "error")
 
     @property
     def score(self) -> tuple[int, int]:
-        """(mutants killed, mutants)."""
-        return len(self.mutants) - len(self.survivors), len(self.mutants)
+        """(mutants killed, mutants judged): what could not run is not counted."""
+        killed = sum(1 for m in self.mutants if self.status(m) == "killed")
+        return killed, len(self.mutants) - len(self.errors)
 
 
 def _cell(verdicts: list[str]) -> str:
+    if not verdicts or NOT_RUN in verdicts:
+        return "not run"
     failed = [v in FAILED for v in verdicts]
-    if failed and all(failed):
+    if all(failed):
         return "killed"
     return "flip" if any(failed) else "survived"
+
+
+def _control_failures(
+    scenarios: Sequence[str], control: UnitVerdicts
+) -> tuple[dict[str, str], set[str]]:
+    """The scenarios the correct node did not pass every time (-> how), and of those the
+    ones it could not run (an ERROR, a NOT RUN, or no verdict: nothing was judged)."""
+    unsound: dict[str, str] = {}
+    unjudged: set[str] = set()
+    for scenario in scenarios:
+        verdicts = control.verdicts(scenario)
+        if verdicts and all(v == "PASS" for v in verdicts):
+            continue
+        why = control.first_failure(scenario) or control.error or "not run"
+        unsound[scenario] = f"{'/'.join(verdicts) or NOT_RUN}: {why}"
+        if not verdicts or any(v in ("ERROR", NOT_RUN) for v in verdicts):
+            unjudged.add(scenario)
+    return unsound, unjudged
+
+
+def _unknown(unit: UnitVerdicts, cells: dict[str, str], unjudged: set[str]) -> str | None:
+    """Why `unit` (killed by no sound scenario) cannot be called a survivor, or None."""
+    if unit.error:
+        return unit.error
+    for scenario, cell in cells.items():
+        if cell == "not run":
+            why = unit.first_failure(scenario) or "not run"
+            return why if why.startswith(f"{scenario}:") else f"{scenario}: {why}"
+    for scenario, cell in cells.items():
+        if cell == "killed" and scenario in unjudged:
+            return f"{scenario}: {CONTROL_NOT_RUN}"
+    return None
 
 
 def kill_matrix(
@@ -76,30 +134,29 @@ def kill_matrix(
 ) -> KillMatrix:
     """The matrix of `units` (the mutants, in order) over `scenarios`, `control` being the
     correct node's unit."""
-    unsound = {}
-    for scenario in scenarios:
-        verdicts = control.verdicts(scenario)
-        if not verdicts or any(v != "PASS" for v in verdicts):
-            why = control.first_failure(scenario) or control.error or "not run"
-            unsound[scenario] = f"{'/'.join(verdicts) or 'NOT RUN'}: {why}"
+    unsound, unjudged = _control_failures(scenarios, control)
     cells: dict[tuple[str, str], str] = {}
     killed_by: dict[str, tuple[str, ...]] = {}
     why: dict[str, str] = {}
     flips: list[Flip] = []
+    errors: dict[str, str] = {}
     for unit in units:
-        kills = []
+        row = {}
         for scenario in scenarios:
             verdicts = unit.verdicts(scenario)
-            cell = _cell(verdicts)
-            cells[unit.name, scenario] = cell
-            if cell == "flip":
+            row[scenario] = cells[unit.name, scenario] = _cell(verdicts)
+            if row[scenario] == "flip":
                 flips.append(Flip(unit.name, scenario, tuple(verdicts)))
-            if cell == "killed" and scenario not in unsound:
-                kills.append(scenario)
-        killed_by[unit.name] = tuple(kills)
+        kills = tuple(s for s in scenarios if row[s] == "killed" and s not in unsound)
+        unknown = _unknown(unit, row, unjudged) if unit.error or not kills else None
+        if unknown is not None:
+            errors[unit.name] = unknown
+            kills = ()
+        killed_by[unit.name] = kills
         if kills:
             why[unit.name] = unit.first_failure(kills[0])
-    errors = {u.name: u.error for u in (*units, control) if u.error}
+    if control.error:
+        errors[control.name] = control.error
     return KillMatrix(
         tuple(scenarios),
         tuple(u.name for u in units),
@@ -108,5 +165,6 @@ def kill_matrix(
         why,
         tuple(flips),
         unsound,
+        frozenset(unjudged),
         errors,
     )

@@ -12,15 +12,17 @@ from harness.audit.mutants import mutant_named
 from harness.audit.suite_audit import AuditOutcome
 from harness.judge.reading_coverage import CASE_NAMES, CASES, other_counts
 
-__all__ = ["audit_json", "print_audit"]
+__all__ = ["LEGEND", "audit_json", "exit_code", "print_audit", "score_line"]
 
-MARKS = {"killed": "x", "survived": ".", "flip": "~"}
+MARKS = {"killed": "x", "survived": ".", "flip": "~", "not run": "!"}
+LEGEND = "x killed in every seed, . passed, ~ the verdict changed with the seed, ! could not run"
 
 
 def audit_json(outcome: AuditOutcome, *, repeat: int, seeds: list[int | None]) -> dict[str, Any]:
-    """`mutants` (name, mistake, killed_by), `survivors`, `coverage`, `flips`, and the rest."""
+    """`mutants` (name, mistake, status, killed_by, error), `survivors`, `errors`, `score`
+    (of the mutants judged), `coverage`, `flips`, and the rest."""
     matrix = outcome.matrix
-    killed, total = matrix.score
+    killed, judged = matrix.score
     return {
         "scenarios": list(matrix.scenarios),
         "repeat": repeat,
@@ -29,17 +31,26 @@ def audit_json(outcome: AuditOutcome, *, repeat: int, seeds: list[int | None]) -
             {
                 "name": name,
                 "mistake": mutant_named(name).mistake,
+                "status": matrix.status(name),
                 "killed_by": list(matrix.killed_by[name]),
                 "first_failure": matrix.why.get(name, ""),
+                "error": matrix.unit_errors.get(name),
             }
             for name in matrix.mutants
         ],
         "survivors": list(matrix.survivors),
-        "score": {"killed": killed, "mutants": total},
+        "errors": list(matrix.errors),
+        "score": {
+            "killed": killed,
+            "judged": judged,
+            "errors": len(matrix.errors),
+            "mutants": len(matrix.mutants),
+        },
         "coverage": outcome.coverage,
         "coverage_gaps": outcome.coverage_gaps,
         "flips": [flip.as_dict() for flip in matrix.flips],
         "correct_node_failed": matrix.unsound,
+        "correct_node_not_run": sorted(matrix.unjudged),
         "unit_errors": matrix.unit_errors,
     }
 
@@ -57,7 +68,8 @@ def _matrix_table(matrix: KillMatrix) -> Table:
     for name in matrix.mutants:
         marks = [MARKS[matrix.cells[name, s]] for s in matrix.scenarios]
         count = len(matrix.killed_by[name])
-        table.add_row(name, *marks, str(count) if count else "SURVIVED")
+        status = matrix.status(name)
+        table.add_row(name, *marks, str(count) if count else status.upper())
     return table
 
 
@@ -82,11 +94,17 @@ def print_audit(console: Console, outcome: AuditOutcome) -> None:
     _say(console)
     _say(console, "scenarios: " + ", ".join(f"{i} {s}" for i, s in enumerate(matrix.scenarios, 1)))
     console.print(_matrix_table(matrix))
-    _say(console, "x killed in every seed, . passed, ~ the verdict changed with the seed")
+    _say(console, LEGEND)
     for scenario, why in matrix.unsound.items():
-        _say(console, f"the correct node fails {scenario}, so it kills nothing: {why}")
-    for name, why in matrix.unit_errors.items():
-        _say(console, f"{name}: did not finish: {why}")
+        if scenario in matrix.unjudged:
+            _say(console, f"the correct node could not run {scenario}, so it judges nothing: {why}")
+        else:
+            _say(console, f"the correct node fails {scenario}, so it kills nothing: {why}")
+    if matrix.unit_errors:
+        _say(console)
+        _say(console, "could not run (neither killed nor passed):")
+        for name, why in matrix.unit_errors.items():
+            _say(console, f"  {name}: {why}")
     if matrix.survivors:
         _say(console)
         _say(console, "mistakes no scenario catches, and what would catch them:")
@@ -104,6 +122,25 @@ def print_audit(console: Console, outcome: AuditOutcome) -> None:
         _say(console, line)
     for gap in outcome.coverage_gaps:
         _say(console, f"  gap: {gap}")
-    killed, total = matrix.score
     _say(console)
-    _say(console, f"score: the suite catches {killed} of {total} mistakes")
+    _say(console, score_line(matrix))
+
+
+def score_line(matrix: KillMatrix) -> str:
+    """The score, of the mutants judged: what could not run is said, not counted."""
+    killed, judged = matrix.score
+    errors = len(matrix.errors)
+    if not errors:
+        return f"score: the suite catches {killed} of {judged} mistakes"
+    if not judged:
+        return f"score: none: the audit could not run any of the {errors} mistakes"
+    return (
+        f"score: the suite catches {killed} of the {judged} mistakes that ran "
+        f"({errors} could not run)"
+    )
+
+
+def exit_code(matrix: KillMatrix) -> int:
+    """0 when every mistake ran and was caught; 1 when one survives, the correct node
+    fails or could not run a scenario, or a unit could not run."""
+    return 1 if matrix.survivors or matrix.unsound or matrix.unit_errors else 0

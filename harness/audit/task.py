@@ -3,8 +3,12 @@
 The task runs ``harness.audit.worker`` as a bounded child process (as
 ``grade`` runs a student's suite), so the nodes start by fork from the
 child's main thread (its warm Python started once for the batch, not once
-per mutant), and a mutant that crashes or hangs ends only its own runs.
-Everything it needs travels with it, so any worker can take it.
+per mutant). Each unit's failure is its own: the worker bounds each unit in
+time and records a unit that cannot run (a usage error of its node, an
+error of the harness) as that unit's error, then runs the next; should the
+worker process itself die, the unit it was running gets the reason and the
+units it had not started run in a fresh worker. Everything the task needs
+travels with it, so any worker can take it.
 """
 
 from __future__ import annotations
@@ -24,6 +28,7 @@ __all__ = ["AuditConfig", "AuditUnit", "UnitResult", "run_batch"]
 
 MAX_LOG_BYTES = 8 * 1024 * 1024
 SECONDS_PER_SCENARIO = 90.0  # a unit's bound: each suite's runs end at their own deadlines
+STOP_MARGIN_S = 60.0  # past its units' bounds, for the worker to start and to stop a unit
 
 
 @dataclass(frozen=True)
@@ -37,10 +42,17 @@ class AuditConfig:
     settings: RunSettings
     seeds: tuple[int | None, ...]  # one suite per seed; None: each scenario's own
     units_dir: Path  # one folder per batch: job.json, results.json, run.log
+    seconds_per_scenario: float = SECONDS_PER_SCENARIO  # of a unit's bound, per run
+
+    @property
+    def unit_timeout(self) -> float:
+        """One unit's bound, counted from its start: generous per scenario run, as each
+        run ends at its own deadlines."""
+        return self.seconds_per_scenario * len(self.scenarios) * len(self.seeds)
 
     def batch_timeout(self, units: int) -> float:
-        """A batch's bound: generous per scenario run, as each run ends at its deadlines."""
-        return SECONDS_PER_SCENARIO * len(self.scenarios) * len(self.seeds) * units + 30.0
+        """A worker process's bound, should it not stop a unit past the unit's own."""
+        return self.unit_timeout * units + STOP_MARGIN_S
 
 
 @dataclass(frozen=True)
@@ -60,11 +72,15 @@ class UnitResult:
     error: str | None = None  # the unit did not finish: why
 
     def verdicts(self, scenario: str) -> list[str]:
-        """The scenario's verdict in each seed's suite, in seed order ("NOT RUN" if absent)."""
+        """The scenario's verdict in each seed's suite, in seed order: "NOT RUN" if absent
+        or if the node never came up (nothing was judged)."""
         found = []
         for run in self.runs:
             entry = next((e for e in run["results"] if e["scenario"] == scenario), None)
-            found.append(entry["verdict"] if entry else "NOT RUN")
+            if entry is None or entry.get("not_started"):
+                found.append("NOT RUN")
+            else:
+                found.append(entry["verdict"])
         return found
 
     def first_failure(self, scenario: str) -> str:
@@ -78,19 +94,47 @@ class UnitResult:
 def run_batch(
     batch: tuple[AuditUnit, ...], config: AuditConfig, number: int, cancel: Any = None
 ) -> list[UnitResult]:
-    """Run each unit of `batch` through every seed's suite in one bounded worker process;
-    never raises for what a node does (that is its unit's result)."""
+    """Run each unit of `batch` through every seed's suite in a bounded worker process
+    (another for the units a dead one had not started); never raises for what a node does
+    (that is its unit's result)."""
+    folder = config.units_dir / f"batch-{number}"
+    folder.mkdir(parents=True, exist_ok=True)
+    stop = cancel or threading.Event()
+    done: dict[str, UnitResult] = {}
+    waiting = list(batch)
+    while waiting:
+        if done and stop.is_set():  # interrupted between two workers
+            done.update((unit.name, UnitResult(unit.name, error="interrupted")) for unit in waiting)
+            break
+        units, why, final = _run_worker(waiting, config, folder, stop)
+        for unit in waiting:
+            entry = units.get(unit.name)
+            if entry is not None:  # started: its runs, and why it did not finish
+                error = entry.get("error") or (None if entry.get("done") else why)
+                done[unit.name] = UnitResult(unit.name, list(entry.get("runs", [])), error)
+        left = [unit for unit in waiting if unit.name not in done]
+        if final or len(left) == len(waiting):  # nothing more would run in another worker
+            done.update((unit.name, UnitResult(unit.name, error=why)) for unit in left)
+            break
+        waiting = left
+    return [done[unit.name] for unit in batch]
+
+
+def _run_worker(
+    units: list[AuditUnit], config: AuditConfig, folder: Path, stop: Any
+) -> tuple[dict[str, Any], str, bool]:
+    """One worker process through `units`: each started unit's entry by name, why the
+    worker stopped where it did, and whether that holds for every unit not started (an
+    interruption, a scenario the worker cannot resolve)."""
     from harness.audit.worker import write_job
     from harness.grading.process import run_bounded
 
-    folder = config.units_dir / f"batch-{number}"
-    folder.mkdir(parents=True, exist_ok=True)
     results = folder / "results.json"
     results.unlink(missing_ok=True)
-    names = [unit.name for unit in batch]
+    names = [unit.name for unit in units]
     job = write_job(
         folder / "job.json",
-        commands={unit.name: unit.command for unit in batch},
+        commands={unit.name: unit.command for unit in units},
         scenarios=list(config.scenario_refs),
         link=config.link,
         options=config.options,
@@ -98,15 +142,16 @@ def run_batch(
         seeds=list(config.seeds),
         coverage=CONTROL if CONTROL in names else None,
         results=results,
+        unit_timeout=config.unit_timeout,
     )
-    timeout = config.batch_timeout(len(batch))
+    timeout = config.batch_timeout(len(units))
     finished = run_bounded(
         [sys.executable, "-m", "harness.audit.worker", str(job)],
         log=folder / "run.log",
         timeout=timeout,
         max_log_bytes=MAX_LOG_BYTES,
         cwd=folder,
-        cancel=cancel or threading.Event(),
+        cancel=stop,
     )
     try:
         data = json.loads(results.read_text(encoding="utf-8"))
@@ -114,20 +159,17 @@ def run_batch(
         data = {}
     if not isinstance(data, dict):
         data = {}
-    units = data.get("units", {})
+    units_seen = data.get("units", {})
+    if not isinstance(units_seen, dict):
+        units_seen = {}
     if data.get("error"):  # the worker said why it stopped (a scenario it cannot resolve)
-        why = str(data["error"])
-    elif finished.timed_out:
-        why = f"stopped after {timeout:g} s"
-    elif finished.cancelled:
-        why = "interrupted"
+        return units_seen, str(data["error"]), True
+    if finished.cancelled:
+        return units_seen, "interrupted", True
+    if finished.timed_out:
+        why = f"its worker was stopped after {timeout:g} s"
+    elif finished.flooded:
+        why = f"its worker wrote more than {MAX_LOG_BYTES // (1024 * 1024)} MB of output"
     else:
-        why = finished.start_error or f"the audit worker ended (exit code {finished.returncode})"
-    outcomes = []
-    for name in names:
-        unit = units.get(name, {})
-        outcome = UnitResult(name, list(unit.get("runs", [])))
-        if not unit.get("finished"):
-            outcome.error = why
-        outcomes.append(outcome)
-    return outcomes
+        why = finished.start_error or f"its worker ended (exit code {finished.returncode})"
+    return units_seen, f"{why} (see {folder / 'run.log'})", False

@@ -3,27 +3,40 @@
 
 Its own process, as a student's suite in ``grade`` is: its main thread may
 start the nodes by fork from a warm Python (a Dask worker's thread may not;
-the warm Python is started once for the batch), and a node that takes its
-process down takes only this batch with it. JOB is a JSON file
+the warm Python is started once for the batch). JOB is a JSON file
 (``write_job``) naming each mutant's node command, the scenarios, the link,
-the LinkOptions and RunSettings fields, the seeds, and where
-``results.json`` goes; it is rewritten (atomically) after every suite, so a
-batch stopped at its time limit still tells what it judged.
+the LinkOptions and RunSettings fields, the seeds, each unit's time bound,
+and where ``results.json`` goes; it is rewritten (atomically) when a unit
+starts and after every suite, so a batch stopped at its time limit still
+tells what it judged and which unit it was running.
+
+Each unit's failure is its own: a unit past its bound is stopped as SIGTERM
+stops a suite (its nodes stopped, its links closed), a unit whose node is a
+usage error (a ConfigError) or that meets an error of the harness gets that
+as its error, and the next unit runs. Only a scenario the worker cannot
+resolve, or a SIGTERM from the command, ends the batch.
 """
 
 from __future__ import annotations
 
 import json
+import os
+import signal
 import sys
+import threading
+import time
+import traceback
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import asdict, replace
 from pathlib import Path
 from typing import Any
 
 from harness.atomic_write import write_atomically
-from harness.errors import ConfigError
+from harness.errors import ConfigError, one_line
 from harness.safe_text import clip
 
-__all__ = ["FAILURE_CHARS", "write_job"]
+__all__ = ["FAILURE_CHARS", "UnitClock", "write_job"]
 
 FAILURE_CHARS = 600  # of each scenario's first failure kept in results.json
 
@@ -39,9 +52,11 @@ def write_job(
     seeds: list[int | None],
     coverage: str | None,
     results: Path,
+    unit_timeout: float,
 ) -> Path:
     """Write a job file for this worker: each mutant's node command by name, LinkOptions and
-    RunSettings as their fields, and which unit's runs give the reading coverage."""
+    RunSettings as their fields, which unit's runs give the reading coverage, and each
+    unit's bound in seconds."""
     job = {
         "commands": commands,
         "scenarios": scenarios,
@@ -51,6 +66,7 @@ def write_job(
         "seeds": seeds,
         "coverage": coverage,
         "results": str(results),
+        "unit_timeout": unit_timeout,
     }
     return write_atomically(path, json.dumps(job, indent=2).encode())
 
@@ -63,60 +79,138 @@ def _entry(result: Any) -> dict[str, Any]:
         "scenario": result.scenario,
         "verdict": verdict_of(result),
         "first_failure": clip(failure, FAILURE_CHARS),
+        "not_started": result.not_started,
         "ticks": len(result.records),
     }
 
 
-def run_job(job: dict[str, Any]) -> int:
-    """Run each unit's suite once per seed; results.json tells the outcome, the exit code
-    only if the worker itself broke."""
+class UnitClock:
+    """One unit's time bound, counted from its start: past it, the main thread gets the
+    KeyboardInterrupt a SIGTERM gives it, so the suite stops the unit's nodes and closes its
+    links, and the worker goes on with the next unit. A SIGTERM from outside (the command
+    stopping the batch) is told apart: no unit was overdue."""
+
+    def __init__(self, seconds: float) -> None:
+        self.seconds = seconds
+        self.overdue = False  # the running unit had its time
+        self._lock = threading.Lock()
+        self._running = False
+        self._sent = False  # its SIGTERM is on its way to the handler
+
+    def install(self) -> None:
+        """SIGTERM raises KeyboardInterrupt in the main thread, except the clock's own
+        signal landing after its unit ended anyway."""
+
+        def handler(signum: int, frame: object) -> None:
+            with self._lock:
+                late = self._sent and not self._running
+                self._sent = False
+            if not late:
+                raise KeyboardInterrupt
+
+        signal.signal(signal.SIGTERM, handler)
+
+    @contextmanager
+    def bound(self) -> Iterator[None]:
+        """Time the unit run inside the block."""
+        with self._lock:
+            self.overdue, self._running = False, True
+        timer = threading.Timer(self.seconds, self._expire)
+        timer.daemon = True
+        timer.start()
+        try:
+            yield
+        finally:
+            with self._lock:
+                self._running = False
+            timer.cancel()
+
+    def _expire(self) -> None:
+        with self._lock:
+            if not self._running:
+                return
+            self.overdue = self._sent = True
+        os.kill(os.getpid(), signal.SIGTERM)
+
+
+def run_job(job: dict[str, Any], clock: UnitClock | None = None) -> int:
+    """Run each unit's suite once per seed; results.json tells the outcome (each unit's
+    runs, whether it is done, and its error), the exit code only if the worker broke."""
     from harness.grading.worker import link_options_from, run_settings_from
-    from harness.judge.reading_coverage import coverage_of, gaps
-    from harness.runner.suite import run_suite
     from harness.scenario.files import resolve_scenario
 
     results_path = Path(job["results"])
-    units: dict[str, dict[str, Any]] = {}
+    state: dict[str, Any] = {"units": {}, "running": None, "error": None}
 
-    def write(error: str | None = None) -> None:
-        data = {"units": units, "error": error}  # a unit not finished: `error` says why
-        write_atomically(results_path, json.dumps(data, indent=2).encode())
+    def write() -> None:
+        write_atomically(results_path, json.dumps(state, indent=2).encode())
 
+    clock = clock or UnitClock(float(job["unit_timeout"]))
     options = link_options_from(job["options"])
     base = run_settings_from(job["settings"])
     try:
         chosen = [resolve_scenario(ref) for ref in job["scenarios"]]
-        for name, command in job["commands"].items():
-            unit: dict[str, Any] = {"runs": [], "finished": False}
-            units[name] = unit
-            node = replace(options, node=command)
-            for seed in job["seeds"]:
-                results = run_suite(chosen, job["link"], node, replace(base, seed=seed))
-                run: dict[str, Any] = {"seed": seed, "results": [_entry(r) for r in results]}
-                if job.get("coverage") == name:
-                    coverage = coverage_of(results)
-                    run["coverage"], run["coverage_gaps"] = coverage.as_dict(), gaps(coverage)
-                unit["runs"].append(run)
-                write()
-            unit["finished"] = True
-            write()
-    except ConfigError as err:
-        write(str(err))
+    except ConfigError as err:  # the same for every unit: the batch says it once
+        state["error"] = str(err)
+        write()
         return 0
-    except KeyboardInterrupt:  # SIGTERM from the command: links closed, nodes stopped
-        write("stopped")
-        return 1
+    for name, command in job["commands"].items():
+        unit: dict[str, Any] = {"runs": [], "done": False, "error": None}
+        state["units"][name], state["running"] = unit, name
+        write()
+        started = time.monotonic()
+        try:
+            with clock.bound():
+                _run_unit(unit, name, chosen, job, replace(options, node=command), base, write)
+        except KeyboardInterrupt:
+            if not clock.overdue:  # SIGTERM from the command: links closed, nodes stopped
+                unit["error"] = "stopped"
+                write()
+                return 1
+            unit["error"] = f"stopped after {clock.seconds:g} s (its bound)"
+        except ConfigError as err:  # e.g. its node cannot start for want of rclpy
+            unit["error"] = str(err)
+        except Exception as err:  # noqa: BLE001 - the harness's error, but this unit's only
+            traceback.print_exc()  # into run.log
+            unit["error"] = f"the audit failed on it: {type(err).__name__}: {one_line(err)}"
+        took = time.monotonic() - started
+        print(f"{name}: {unit['error'] or 'done'} ({took:.1f} s)", flush=True)
+        unit["done"], state["running"] = True, None
+        write()
     return 0
 
 
-def main(argv: list[str]) -> int:
-    from harness.grading.worker import interrupt_on_sigterm
+def _run_unit(
+    unit: dict[str, Any],
+    name: str,
+    chosen: list[Any],
+    job: dict[str, Any],
+    node: Any,
+    base: Any,
+    write: Any,
+) -> None:
+    """One unit's suite once per seed into `unit`, written after each."""
+    from harness.judge.reading_coverage import coverage_of, gaps
+    from harness.runner.suite import run_suite
 
+    for seed in job["seeds"]:
+        results = run_suite(chosen, job["link"], node, replace(base, seed=seed))
+        run: dict[str, Any] = {"seed": seed, "results": [_entry(r) for r in results]}
+        if job.get("coverage") == name:
+            coverage = coverage_of(results)
+            run["coverage"], run["coverage_gaps"] = coverage.as_dict(), gaps(coverage)
+        unit["runs"].append(run)
+        write()
+
+
+def main(argv: list[str]) -> int:
     if len(argv) != 1:
         print("usage: python -m harness.audit.worker JOB.json", file=sys.stderr)
         return 2
-    interrupt_on_sigterm()
-    return run_job(json.loads(Path(argv[0]).read_text(encoding="utf-8")))
+    job = json.loads(Path(argv[0]).read_text(encoding="utf-8"))
+    clock = UnitClock(float(job["unit_timeout"]))
+    clock.install()
+    return run_job(job, clock)
 
 
 if __name__ == "__main__":

@@ -103,7 +103,7 @@ def _list(console: Console) -> int:
 def run(args: argparse.Namespace, console: Console) -> int:
     from harness.atomic_write import write_atomically
     from harness.audit.cache import audit_key, keep_audit
-    from harness.audit.report import audit_json, print_audit
+    from harness.audit.report import audit_json, exit_code, print_audit
     from harness.audit.suite_audit import audit_suite
     from harness.audit.task import AuditConfig, UnitResult
     from harness.cluster.client import check_cluster_options, open_client
@@ -180,5 +180,4 @@ def run(args: argparse.Namespace, console: Console) -> int:
     else:
         print_audit(console, outcome)
         say(console, f"audited in {wall_s:.1f} s; wrote {path}")
-    matrix = outcome.matrix
-    return 1 if matrix.survivors or matrix.unsound or matrix.unit_errors else 0
+    return exit_code(outcome.matrix)
