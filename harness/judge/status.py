@@ -205,7 +205,3 @@ def half_unit(decimals: int | None) -> float:
     if decimals is None:
         return 0.0
     return 0.5 * 10.0 ** (-decimals) if -decimals < 308 else math.inf
-
-
-def is_finite(value: float | None) -> bool:
-    return value is not None and math.isfinite(value)

@@ -8,6 +8,7 @@ scan the node under test received.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -58,3 +59,22 @@ class Scan:
             dtype=np.float64,
         )
         return head.tobytes() + self.ranges.tobytes() + self.intensities.tobytes()
+
+
+def scan_from_message(message: Any) -> Scan:
+    """A sensor_msgs/LaserScan of any make (rclpy's as received, a recording's as rosbags
+    reads it) as a Scan; its arrays are copied, so the message may be reused."""
+    stamp = message.header.stamp
+    return Scan(
+        angle_min=float(message.angle_min),
+        angle_max=float(message.angle_max),
+        angle_increment=float(message.angle_increment),
+        time_increment=float(message.time_increment),
+        scan_time=float(message.scan_time),
+        range_min=float(message.range_min),
+        range_max=float(message.range_max),
+        ranges=np.array(message.ranges, dtype=np.float32),
+        intensities=np.array(message.intensities, dtype=np.float32),
+        stamp=stamp.sec + stamp.nanosec * 1e-9,
+        frame_id=message.header.frame_id,
+    )

@@ -83,24 +83,6 @@ def laser_scan(scan: Scan) -> Any:
     )
 
 
-def scan_from_message(message: Any) -> Scan:
-    """A recorded LaserScan (ours or a robot's) as the harness's Scan."""
-    stamp = message.header.stamp
-    return Scan(
-        angle_min=float(message.angle_min),
-        angle_max=float(message.angle_max),
-        angle_increment=float(message.angle_increment),
-        time_increment=float(message.time_increment),
-        scan_time=float(message.scan_time),
-        range_min=float(message.range_min),
-        range_max=float(message.range_max),
-        ranges=message.ranges,
-        intensities=message.intensities,
-        stamp=stamp.sec + stamp.nanosec * 1e-9,
-        frame_id=message.header.frame_id,
-    )
-
-
 def clock(seconds: float) -> Any:
     return typestore().types[CLOCK](clock=_time(seconds))
 

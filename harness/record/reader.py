@@ -10,7 +10,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from harness.errors import ConfigError
-from harness.lidar.scan import Scan
+from harness.lidar.scan import Scan, scan_from_message
 from harness.record import messages as msg
 from harness.record.writer import METADATA_NAME, RecordTopics
 
@@ -79,7 +79,7 @@ def read_scans(path: str | Path, topic: str | None = None) -> RecordedScans:
             for connection, when, raw in reader.messages(connections=wanted):
                 message = reader.deserialize(raw, connection.msgtype)
                 if connection.topic == chosen:
-                    scans.append(msg.scan_from_message(message))
+                    scans.append(scan_from_message(message))
                     times.append(when)
                 elif connection.msgtype == msg.POSE:
                     poses.append(msg.planar_pose(message))

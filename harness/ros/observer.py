@@ -30,11 +30,10 @@ from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import LaserScan
 from std_msgs.msg import Bool, String
 
-from harness.lidar.scan import Scan
+from harness.lidar.scan import Scan, scan_from_message
 from harness.ros.announcements import harness_announcements
 from harness.ros.cdr import clock_cdr, scan_cdr
 from harness.ros.domain import discovery_environment
-from harness.ros.messages import scan_from_message
 
 QOS = QoSProfile(depth=50, reliability=ReliabilityPolicy.RELIABLE)
 INBOX_LIMIT = 10_000  # messages kept between two collects: more is a flood, not answers

@@ -14,10 +14,9 @@ from harness.serial_line.modem_lines import ModemLines
 from harness.serial_line.pacing import LinePacer, PacingReport
 from harness.serial_line.port_lock import PortLock, hold_port
 from harness.serial_line.ports import DevicePort, PortInfo, PtyPort, SerialPort, list_serial_ports
-from harness.serial_line.server import Delivery, DeviceServer, ServerStats
+from harness.serial_line.server import DeviceServer, RevolutionSent, ServerStats
 
 __all__ = [
-    "Delivery",
     "DevicePort",
     "DeviceServer",
     "LinePacer",
@@ -26,6 +25,7 @@ __all__ = [
     "PortInfo",
     "PortLock",
     "PtyPort",
+    "RevolutionSent",
     "SerialPort",
     "ServerStats",
     "hold_port",

@@ -91,7 +91,7 @@ _STOP_JOIN_S = 2.0
 
 
 @dataclass(frozen=True)
-class Delivery:
+class RevolutionSent:
     """When a revolution went out: the first and the last of its own bytes."""
 
     tick: int
@@ -292,7 +292,7 @@ class DeviceServer:
         self._reboot_at: float | None = None
         self._last_rx: float | None = None  # host bytes since the line was last quiet
         self._t0 = 0.0
-        self._deliveries: list[Delivery] = []
+        self._deliveries: list[RevolutionSent] = []
         self._n = dict.fromkeys(
             (
                 "bytes_written",
@@ -389,7 +389,7 @@ class DeviceServer:
             self._idling = self.mode == "lockstep"
         self._wake()
 
-    def end_idle(self, timeout: float) -> Delivery | None:
+    def end_idle(self, timeout: float) -> RevolutionSent | None:
         """Continuous lockstep: stop the idle stream before the next push; wait (at most
         `timeout` s) until the revolution it was writing is out. Returns the last
         repeat written since the last push (its driver scan comes before the
@@ -424,7 +424,7 @@ class DeviceServer:
             self._whole_marker_pending = self.mode == "lockstep"
         self._wake()
 
-    def delivery_of(self, push_id: int) -> Delivery | None:
+    def delivery_of(self, push_id: int) -> RevolutionSent | None:
         """When the pushed revolution `push_id` went out whole, or None (not yet, or never)."""
         with self._lock:
             for delivery in reversed(self._deliveries):
@@ -461,7 +461,7 @@ class DeviceServer:
             self._check()
         return True
 
-    def deliveries(self) -> list[Delivery]:
+    def deliveries(self) -> list[RevolutionSent]:
         """When each revolution went out, in order."""
         with self._lock:
             return list(self._deliveries)
@@ -934,7 +934,7 @@ class DeviceServer:
                 self._n["revolutions_whole"] += 1
             with self._lock:
                 self._deliveries.append(
-                    Delivery(tick, started, now, push_id, self._write_ns, repeat)
+                    RevolutionSent(tick, started, now, push_id, self._write_ns, repeat)
                 )
             self._current = None
             self._rev_left = 0
