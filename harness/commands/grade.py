@@ -32,7 +32,7 @@ from harness.commands.arguments import (
 )
 from harness.commands.cluster_options import add_cluster_options, describe_cluster, workers
 from harness.commands.sandbox_options import add_sandbox_options, check_workers, sandbox_limits
-from harness.errors import ConfigError
+from harness.errors import ConfigError, one_line
 from harness.grading import LAB_EXECUTABLE, LAB_PACKAGE
 from harness.grading.discover import GRADES_MARKER, Student, absolute
 from harness.holder_lock import HolderLock
@@ -406,7 +406,8 @@ def run(args: argparse.Namespace, console: Console) -> int:
             out / "grades.csv", class_csv(grades, names, roster=roster is not None)
         )
         html_path = write_atomically(
-            out / "grades.html", class_html(grades, names, meta=meta, max_score=plan.max_score)
+            out / "grades.html",
+            class_html(grades, names, meta=meta, max_score=plan.max_score, audit=audit_line),
         )
         book = grading.gradebook if grading is not None else GradebookSettings()
         book_path = write_atomically(
@@ -562,7 +563,7 @@ def _audit(
     from dataclasses import replace
 
     from harness.atomic_write import write_atomically
-    from harness.audit.known import known_audit, survivors_warning
+    from harness.audit.known import audit_warning, known_audit
     from harness.audit.task import AuditConfig
 
     audit = AuditConfig(
@@ -582,10 +583,10 @@ def _audit(
     try:
         data, cached = known_audit(client, audit, scenarios)
     except Exception as err:  # noqa: BLE001 - the grades are written; the audit is advice
-        return f"the audit of the scenarios could not be made: {type(err).__name__}: {err}"
+        return f"warning: the audit could not run: {type(err).__name__}: {one_line(err)}"
     write_atomically(out / "audit.json", json.dumps(data, indent=2).encode())
     words = " ".join(_scenario_words(scenarios))
-    warning = survivors_warning(data, words)
+    warning = audit_warning(data, words)
     if warning is None:
         killed = len(data.get("mutants", []))
         return f"these scenarios catch all {killed} typical mistakes{' (cached)' if cached else ''}"

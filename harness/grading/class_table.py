@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import csv
 import io
+import re
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from urllib.parse import quote
@@ -112,7 +113,9 @@ td.PASS { background: #e3f5e1; color: #17621a; }
 td.FAIL, td.ERROR { background: #fbe3e1; color: #9b1c12; }
 td.NOT-RUN { background: #fdf5d8; color: #7a5c00; }
 td.why { font-size: .92em; word-break: break-word; }
-th.scenario, td.student { overflow-wrap: anywhere; }
+th.scenario span { display: inline-block; }
+td.student { overflow-wrap: anywhere; }
+p.audit { margin: 0 0 1em; padding: .4em .6em; background: #fdf5d8; color: #5c4500; }
 td.student { min-width: 9em; }
 td.why { min-width: 12em; }
 td.student small { color: #555; }
@@ -128,6 +131,14 @@ def _h(text: object) -> str:
 
 def _t(text: str, style: str = "") -> Text:
     return Text(for_terminal(clip(text, TEXT_LIMIT)), style=style)
+
+
+def _breakable(name: str) -> str:
+    """A scenario's name, escaped, that a narrow column breaks only after an underscore,
+    a hyphen or a dot ("approach_" / "wall"), never inside a word: each piece is an
+    inline block (a line may break between two, not inside one)."""
+    pieces = re.findall(r"[^_.-]*[_.-]|[^_.-]+$", clip(name, TEXT_LIMIT)) or [""]
+    return "".join(f"<span>{for_html(piece)}</span>" for piece in pieces)
 
 
 def _verdict_cell(grade: StudentGrade, scenario: str) -> str:
@@ -150,11 +161,14 @@ def class_html(
     title: str = "FOSSBot LIDAR lab: class results",
     meta: Sequence[tuple[str, str]] = (),
     max_score: float | None = None,
+    audit: str | None = None,
 ) -> bytes:
-    """One self-contained page (inline CSS, no script); every text escaped."""
+    """One self-contained page (inline CSS, no script); every text escaped. `audit` is
+    grade's line about the scenarios' audit (which typical mistakes they let pass, or what
+    the audit could not run), shown above the table."""
     passed_all = sum(1 for g in grades if g.passed == len(scenarios) and scenarios)
     about = [f"{len(grades)} students, {passed_all} passed every scenario", *map(": ".join, meta)]
-    head = "".join(f'<th class="scenario">{_h(s)}</th>' for s in scenarios)
+    head = "".join(f'<th class="scenario">{_breakable(s)}</th>' for s in scenarios)
     rows = []
     for g in grades:
         links = " · ".join(
@@ -176,7 +190,8 @@ def class_html(
         f'<html lang="en">\n<head>\n<meta charset="utf-8">\n<title>{_h(title)}</title>\n'
         f"<style>{_CSS}</style>\n</head>\n<body>\n<h1>{_h(title)}</h1>\n"
         f'<p class="meta">{" · ".join(_h(a) for a in about)}</p>\n'
-        f"<table>\n<thead><tr><th>student</th>{head}<th>passed<br><small>ticks held</small></th>"
+        + (f'<p class="audit">{_h(audit)}</p>\n' if audit else "")
+        + f"<table>\n<thead><tr><th>student</th>{head}<th>passed<br><small>ticks held</small></th>"
         f"<th>score{'<br><small>of ' + _h(f'{max_score:g}') + '</small>' if max_score else ''}"
         "</th><th>first failure</th></tr>"
         "</thead>\n<tbody>\n" + "\n".join(rows) + "\n</tbody>\n</table>\n</body>\n</html>\n"
