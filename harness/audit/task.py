@@ -72,15 +72,13 @@ class UnitResult:
     error: str | None = None  # the unit did not finish: why
 
     def verdicts(self, scenario: str) -> list[str]:
-        """The scenario's verdict in each seed's suite, in seed order: "NOT RUN" if absent
-        or if the node never came up (nothing was judged)."""
+        """The scenario's verdict in each seed's suite, in seed order ("NOT RUN" if absent).
+        A node that never came up is an ERROR, as in any run: a mistake can be why (a node
+        that ignores the scan topic parameter never subscribes to the harness's scans)."""
         found = []
         for run in self.runs:
             entry = next((e for e in run["results"] if e["scenario"] == scenario), None)
-            if entry is None or entry.get("not_started"):
-                found.append("NOT RUN")
-            else:
-                found.append(entry["verdict"])
+            found.append(entry["verdict"] if entry else "NOT RUN")
         return found
 
     def first_failure(self, scenario: str) -> str:
