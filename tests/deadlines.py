@@ -4,9 +4,10 @@ A deadline costs time only where it is waited out: where no answer comes. A
 test whose node must answer every scan in time gets a generous deadline
 (GENEROUS_S), which a right answer never waits out. A test whose node answers
 some scans and then none (it hangs, falls silent, stops publishing) waits out
-each unanswered scan's deadline and the harness's catch-up wait after it; its
-deadline is short, but never shorter than this machine needs now to carry the
-answers that must come in time (silence_deadline): a floor that covers
+each unanswered scan's deadline and the harness's catch-up wait after it, and a
+run in real time waits out every scan's period, which is its deadline too:
+those deadlines are short, but never shorter than this machine needs now to
+carry the answers that must come in time (short_deadline): a floor that covers
 Fast DDS's own repair delays, or a multiple of the slowest round trip between
 two processes measured here and now, whichever is longer.
 """
@@ -70,9 +71,10 @@ def slowest_round_trip(seconds: float = PROBE_S) -> float:
     return slowest
 
 
-def silence_deadline() -> float:
-    """A per-scan deadline (seconds, to 0.01) for a run whose node answers some scans in
-    time and then none: FLOOR_S, or ROUND_TRIPS times the slowest round trip measured
-    now, whichever is longer, at most CEILING_S."""
+def short_deadline() -> float:
+    """A per-scan deadline (seconds, to 0.01) for a run that waits it out (a node that
+    answers some scans in time and then none; a scan period in real time): FLOOR_S, or
+    ROUND_TRIPS times the slowest round trip measured now, whichever is longer, at most
+    CEILING_S."""
     measured = ROUND_TRIPS * slowest_round_trip()
     return round(min(CEILING_S, max(FLOOR_S, measured)), 2)

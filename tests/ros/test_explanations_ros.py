@@ -14,7 +14,7 @@ from pathlib import Path
 
 import pytest
 from command_line import fossbot_hil
-from deadlines import silence_deadline
+from deadlines import short_deadline
 
 pytestmark = [pytest.mark.ros, pytest.mark.timeout(120)]
 
@@ -52,7 +52,7 @@ def test_a_status_only_on_change_is_judged_from_tick_0_and_named(link: str) -> N
 
     The scans before must be answered in time, those after are waited out: a deadline
     short, but measured against this machine's load."""
-    deadline = silence_deadline()
+    deadline = short_deadline()
     done = fossbot_hil(
         "run", "approach_wall", "--link", link, "--timeout", f"{deadline:g}", "--node",
         student("status_on_change"),

@@ -19,7 +19,7 @@ from pathlib import Path
 
 import pytest
 from command_line import COMMAND, fossbot_hil
-from deadlines import GENEROUS_S, silence_deadline
+from deadlines import GENEROUS_S, short_deadline
 
 from harness.errors import LinkError
 from harness.judge.records import RunResult
@@ -157,7 +157,7 @@ def test_hang_in_callback(pids: Path) -> None:
 
     Ticks 0 and 1 must be answered in time, tick 2 on waited out: a deadline short, but
     measured against this machine's load."""
-    deadline = silence_deadline()
+    deadline = short_deadline()
     done = hostile_cli("hang", pids, timeout=deadline)
     assert done.returncode == 1, explanation(done)
     says(
@@ -226,7 +226,7 @@ def test_wrong_message_type_is_named(variant: str, wrong: str, pids: Path) -> No
 
     No answer of the right type comes (the Int32 node's first Bool is waited for, one
     deadline): a short deadline, measured against this machine's load."""
-    done = hostile_cli(variant, pids, timeout=silence_deadline())
+    done = hostile_cli(variant, pids, timeout=short_deadline())
     assert done.returncode == 1, explanation(done)
     says(done, "uses the wrong message type: ", wrong, "but the harness expects std_msgs/msg/")
     assert survivors(pids) == []
