@@ -47,9 +47,16 @@ KILLS_ITS_WORKER = shlex.join(
 )
 
 
+def clear() -> str:
+    """Nothing in range for 4 ticks (a silent node waits out each one's deadline)."""
+    text = nothing_in_range()
+    assert "turn: 1.0" in text
+    return text.replace("turn: 1.0", "turn: 0.4")
+
+
 def config(tmp_path: Path, *, seconds_per_scenario: float = 90.0) -> AuditConfig:
-    """Two short scenarios: a wall driven at, and nothing in range."""
-    files = {"near_wall": NEAR_WALL, "clear": nothing_in_range()}
+    """Two short scenarios: a wall driven at (16 ticks), and nothing in range."""
+    files = {"near_wall": NEAR_WALL, "clear": clear()}
     for name, text in files.items():
         (tmp_path / f"{name}.yaml").write_text(text)
     return AuditConfig(
