@@ -150,7 +150,8 @@ def test_script_student_runs_as_a_node_command(graded: Graded) -> None:
 
 
 class _Table(HTMLParser):
-    """The rows of the page's table, as text per cell."""
+    """The rows of the page's table, as text per cell, a line break read as a space (a
+    header's pieces, inline blocks, read as one word)."""
 
     def __init__(self) -> None:
         super().__init__()
@@ -162,10 +163,13 @@ class _Table(HTMLParser):
             self.rows.append([])
         elif tag in ("td", "th"):
             self._cell = []
+        elif tag == "br" and self._cell is not None:
+            self._cell.append("\n")
 
     def handle_endtag(self, tag: str) -> None:
         if tag in ("td", "th") and self._cell is not None:
-            self.rows[-1].append(" ".join(t.strip() for t in self._cell if t.strip()))
+            lines = "".join(self._cell).split("\n")
+            self.rows[-1].append(" ".join(line.strip() for line in lines if line.strip()))
             self._cell = None
 
     def handle_data(self, data: str) -> None:
