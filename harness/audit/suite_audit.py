@@ -112,7 +112,8 @@ def _cost(name: str) -> float:
 
 
 def _outcomes(future: Any, batch: tuple[AuditUnit, ...]) -> list[UnitResult]:
-    """The batch's results; a batch lost to the cluster is results too (it killed nothing)."""
+    """The batch's results; a batch lost to the cluster (its Dask worker died) makes each of
+    its units an error saying so: neither a kill nor a survivor."""
     try:
         outcomes = future.result()
     except Exception as err:  # noqa: BLE001 - lost to the cluster, not to the node
