@@ -31,8 +31,8 @@ def grade(tmp_path: Path, scenario: Path, out: str) -> subprocess.CompletedProce
 
 def test_grade_warns_naming_the_mistakes_its_scenarios_let_pass(tmp_path: Path) -> None:
     """An approach to a wall alone never shows an empty scan nor a warning that must
-    clear: the warning names those mistakes, and the scenario file to audit; the second
-    grade takes it from the cache."""
+    clear: the warning names those mistakes, and the scenario file to audit, on the
+    terminal and on grades.html; the second grade takes it from the cache."""
     script_student(tmp_path / "class" / "dave")
     scenario = tmp_path / "wall_ahead.yaml"
     scenario.write_text(WALL_AHEAD)
@@ -44,6 +44,8 @@ def test_grade_warns_naming_the_mistakes_its_scenarios_let_pass(tmp_path: Path) 
         assert name in warning, warning
     words = shlex.quote(str(scenario.resolve()))  # a file, not a shipped name
     assert f"fossbot-hil audit {words} shows what would catch them" in warning
+    page = (tmp_path / "grades" / "grades.html").read_text(encoding="utf-8")
+    assert '<p class="audit">warning: these scenarios let ' in page  # the class page says it too
     audit = json.loads((tmp_path / "grades" / "audit.json").read_text())
     assert "warning_latched" in audit["survivors"]
     assert "angle_in_degrees" not in audit["survivors"]  # an approach catches that one
