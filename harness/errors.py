@@ -28,6 +28,11 @@ class LinkError(HarnessError):
     """The link to the software under test broke in a way that ends the run."""
 
 
+class NeverReady(LinkError):
+    """The node runs, but never used the topics the harness waited on: this scenario's
+    failure to come up, not the node's (a later scenario with other topics may run)."""
+
+
 class Interrupted(KeyboardInterrupt):
     """Ctrl-C or SIGTERM: the run stops, and says what it had judged.
 

@@ -48,6 +48,7 @@ class RunResult:
     startup_s: float = 0.0  # waiting for the software under test to come up (in series)
     stop_s: float = 0.0  # waiting for it to stop, after the run (in series)
     not_started: bool = False  # the software under test never came up
+    never_ready: bool = False  # of that: it ran, but never used the topics it was given
     not_run: bool = False  # skipped because it did not come up in an earlier scenario
     lidar_mount: LidarMount | None = None  # the mount the device was emulated with (serial links)
     # On a run-long device session: seconds between the previous scenario's last

@@ -36,7 +36,7 @@ from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from harness.errors import ConfigError, LinkError
+from harness.errors import ConfigError, LinkError, NeverReady
 from harness.judge.answers import Answers, Received
 from harness.links.base import Link, LinkOptions, register
 from harness.nodes.command import (
@@ -263,7 +263,7 @@ class Ros2Link(Link):
             expired = time.monotonic() >= deadline or elsewhere.settled()
             self._check_types(named_only=not expired)
             if expired:
-                raise LinkError(self._never_ready())
+                raise NeverReady(self._never_ready())
             if self._clock_before_ready() and time.monotonic() >= clock_due:
                 self.observer.publish_clock(0.0)  # a node may wait for /clock before it subscribes
                 clock_due = time.monotonic() + POLL_S

@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from harness.errors import ConfigError, LinkError
+from harness.errors import ConfigError, LinkError, NeverReady
 from harness.faults.link import (
     scan_periods,
 )
@@ -138,6 +138,7 @@ def run_through(
     except LinkError as err:
         result = not_started(str(err), link.diagnostics())
         result.not_started = True
+        result.never_ready = isinstance(err, NeverReady)
         result.startup_s = time.perf_counter() - started
         return result
     if not body_opens:

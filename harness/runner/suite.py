@@ -107,7 +107,11 @@ def run_suite(
                     report(result)
                     continue
                 result.startup_s += taking  # starting links is start-up too
-                if result.not_started:
+                # A node up but deaf to the topics this scenario gave it (its node_topics)
+                # may well hear the next scenario's: only a node that did not come up at
+                # all leaves the rest not run.
+                own_topics = result.never_ready and scenario.node_topics is not None
+                if result.not_started and not own_topics:
                     failed_start = scenario.name
                     _check_setup(result, options)
                 if on_judged is not None:

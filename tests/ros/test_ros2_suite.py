@@ -254,3 +254,16 @@ def test_the_strict_warning_rule_fails_a_bool_only_when_close() -> None:
     assert "expected warning False; got no Bool" in strict.stdout
     assert "judged with --warning-when-clear required" in strict.stdout
     assert "judged with --warning-when-clear" not in lenient.stdout
+
+
+def test_a_node_deaf_to_one_scenarios_topics_still_runs_the_next_scenarios() -> None:
+    """obstacle_at_side gives the node its topics through its parameters; a node that
+    ignores lidar_topic never reads that scenario's scans (ERROR there), but it is up, and
+    the next scenario, on the lab's topics, runs and passes."""
+    done = fossbot_hil(
+        "run", "obstacle_at_side", "approach_wall", "--node", student("topic_parameter_ignored")
+    )
+    assert done.returncode == 1, done.stdout + done.stderr
+    assert re.search(r"^obstacle_at_side\s+ros2\s+0\s+0\s+ERROR", done.stdout, re.M), done.stdout
+    assert re.search(r"^approach_wall\s+ros2\s+\d+\s+0\s+PASS", done.stdout, re.M), done.stdout
+    assert "it subscribes to a LaserScan on /scan, not /fossbot2/scan" in done.stdout
