@@ -14,6 +14,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 from harness.devices.events import DeviceEvent, Listener
+from harness.devices.protocol import DeviceDefaults
 from harness.devices.revolution import Sample
 
 HEADER = 0x54
@@ -153,8 +154,15 @@ def _is_command_frame(frame: bytes) -> bool:
     )
 
 
-class LdlidarDevice:
-    """An LD06/LD19 streaming at a fixed rotation speed and sample rate."""
+class LdlidarDevice(DeviceDefaults):
+    """An LD06/LD19 streaming at a fixed rotation speed and sample rate.
+
+    No motor line, no reboot, no request it answers (``DeviceDefaults``);
+    its encoder holds a partial packet between revolutions (``packetized``).
+    """
+
+    mode = "streaming"  # from power-up, unasked
+    packetized = True
 
     def __init__(self, *, speed_deg_s: float = SPEED_DEG_S, samples_per_s: int = SAMPLES_PER_S):
         if speed_deg_s <= 0 or samples_per_s <= 0:
@@ -177,11 +185,15 @@ class LdlidarDevice:
     def samples_per_packet(self) -> int:
         return POINTS_PER_PACKET
 
+    def set_rate(self, rate_hz: float) -> None:
+        """Turn at `rate_hz`: every packet reports the speed."""
+        self.speed_deg_s = 360.0 * rate_hz
+
     @property
     def rate_hz(self) -> float:
         return self.speed_deg_s / 360.0
 
-    def encode_revolution(self, samples: Sequence[Sample], *, start_ms: float) -> bytes:
+    def encode_revolution(self, samples: Sequence[Sample], *, start_ms: float = 0.0) -> bytes:
         """Whole packets for one revolution whose first sample was taken at ``start_ms``.
 
         Sample k is taken at start_ms + k / samples_per_s; a packet carries

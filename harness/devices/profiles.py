@@ -9,6 +9,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
+from harness.devices.protocol import LineDevice
 from harness.devices.revolution import Sample, samples_at_beams, samples_from_scan
 from harness.errors import ConfigError
 from harness.lidar.mount import FORWARD, LidarMount
@@ -28,7 +29,7 @@ class DeviceProfile:
     description: str
     baudrate: int
     driver_module: str  # the bundled board driver, run as `python -m`
-    make_device: Callable[[float], Any]  # (revolutions per second) -> device
+    make_device: Callable[[float], LineDevice]  # (revolutions per second) -> device
     samples_per_rev: Callable[[Any, float], int]  # (device, rate_hz) -> native samples
     streams_unasked: bool  # LD19: always streaming; RPLIDAR: only after a SCAN request
     at_beam_angles: Callable[[Any], bool] = lambda device: False  # (device) -> no resampling?
@@ -60,13 +61,13 @@ class DeviceProfile:
         return samples_from_scan(scan, samples_per_rev=native, max_range_m=max_range_m, mount=mount)
 
 
-def _rplidar(rate_hz: float) -> Any:
+def _rplidar(rate_hz: float) -> LineDevice:
     from harness.devices.rplidar import RplidarDevice
 
     return RplidarDevice()
 
 
-def _ldlidar(rate_hz: float) -> Any:
+def _ldlidar(rate_hz: float) -> LineDevice:
     from harness.devices.ldlidar import LdlidarDevice
 
     return LdlidarDevice(speed_deg_s=360.0 * rate_hz)

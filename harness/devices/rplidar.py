@@ -21,6 +21,7 @@ from operator import xor
 
 from harness.devices.events import DeviceEvent, Listener
 from harness.devices.ldlidar import starts_like_command
+from harness.devices.protocol import DeviceDefaults
 from harness.devices.revolution import DEFAULT_QUALITY, Sample
 
 # -- wire constants (Slamtec protocol v2.x, sl_lidar_cmd.h) --------------------
@@ -334,7 +335,7 @@ def decode_express(capsule_a: bytes, capsule_b: bytes) -> list[Sample]:
 # -- the device -----------------------------------------------------------------
 
 
-class RplidarDevice:
+class RplidarDevice(DeviceDefaults):
     """An A1M8 as seen from its serial line: requests in, replies and scans out.
 
     Motor: on the A1 the USB adapter drives the motor from DTR (DTR asserted,
@@ -344,6 +345,8 @@ class RplidarDevice:
     no PWM input). SCAN and EXPRESS_SCAN stream nothing while the motor is
     off (the device waits for a stable rotation); FORCE_SCAN streams anyway.
     """
+
+    follows_motor_line = True  # the adapter's DTR drives the motor
 
     def __init__(
         self,
@@ -673,8 +676,9 @@ class RplidarDevice:
 
     # -- revolutions out -------------------------------------------------------
 
-    def encode_revolution(self, samples: Sequence[Sample]) -> bytes:
-        """The bytes the device streams for one revolution in the current mode.
+    def encode_revolution(self, samples: Sequence[Sample], *, start_ms: float = 0.0) -> bytes:
+        """The bytes the device streams for one revolution in the current mode
+        (nodes and capsules carry no time: `start_ms` is not sent).
 
         Empty when idle, rebooting, or when the motor is off (except after
         FORCE_SCAN). Express capsules need the next capsule's start angle,
