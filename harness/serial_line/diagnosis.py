@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from harness.serial_line.server import ServerStats
+from harness.serial_line.stats import ServerStats
 
 SCAN_REQUESTS = ("SCAN", "FORCE_SCAN", "EXPRESS_SCAN")
 # Requests that ask for something the emulated device may not have.

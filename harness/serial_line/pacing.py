@@ -149,3 +149,22 @@ class LinePacer:
             period_jitter_p99_ms=jitter,
             period_mean_ms=mean,
         )
+
+
+LOCKSTEP_CHUNK = 4096  # bytes offered per write in lockstep (a pty takes them at once)
+HARDWARE_CHUNK_S = 0.02  # a real UART: offer 20 ms of line time per write
+
+
+def unpaced_chunks(
+    baudrate: int, bits_per_byte: int = 10, *, paced_by_hardware: bool = False
+) -> tuple[int, int]:
+    """Lockstep (no pacer): bytes per write, and bytes written before the host is read again.
+
+    A pty takes what it is offered at once, so large chunks; a real UART
+    drains at its baud rate, so about 20 ms of line time a write, one write
+    between looks at the host (a request is answered within that).
+    """
+    if paced_by_hardware:
+        chunk = max(16, int(baudrate / bits_per_byte * HARDWARE_CHUNK_S))
+        return chunk, chunk
+    return LOCKSTEP_CHUNK, 16 * LOCKSTEP_CHUNK

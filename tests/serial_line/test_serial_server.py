@@ -12,6 +12,7 @@ from itertools import pairwise
 
 import pytest
 
+from harness.devices.protocol import DeviceDefaults
 from harness.errors import LinkError
 from harness.serial_line.ports import PtyPort, SerialPort
 from harness.serial_line.server import DeviceServer
@@ -29,8 +30,10 @@ class Sample:
     quality: int
 
 
-class StandIn:
+class StandIn(DeviceDefaults):
     """b"?" -> b"!", b"S" starts a scan (b"ok"), b"X" stops it; `session` bumps on both."""
+
+    follows_motor_line = True
 
     def __init__(self) -> None:
         self.mode = "idle"
@@ -57,7 +60,7 @@ class StandIn:
         self.motor_on = on
         self.motor_calls.append(on)
 
-    def encode_revolution(self, samples: list[Sample]) -> bytes:
+    def encode_revolution(self, samples: list[Sample], *, start_ms: float = 0.0) -> bytes:
         if self.mode == "idle":
             return b""
         return b"".join(
