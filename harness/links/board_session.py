@@ -97,26 +97,21 @@ class BoardSession:
     # -- life cycle -------------------------------------------------------
     def open(self) -> BoardSession:
         """Reserve the run's domain, open the line, start the device and the board's software."""
-        from harness.serial_line.ports import PtyPort, SerialPort
-        from harness.serial_line.server import DeviceServer
+        from harness.serial_line.device_line import open_device_line
 
         opts = self.options
         try:
             self.domain = reserve_domain(opts.domain_id)
-            if self.physical:
-                assert opts.port is not None
-                self.port = SerialPort(opts.port, self.profile.baudrate)
-            else:
-                self.port = PtyPort()
-            self.server = DeviceServer(
+            line = open_device_line(
                 self.device,
-                self.port,
-                mode=self.mode,
+                port=opts.port,
                 baudrate=self.profile.baudrate,
+                mode=self.mode,
                 revolution_period_s=1.0 / opts.scan_rate_hz,
                 next_start="replace",  # no driver ever sees an extra, marker-only revolution
                 continuous=True,
-            ).start()
+            )
+            self.port, self.server = line.port, line.server.start()
             # Until the first scenario's first frame: an empty room.
             self.server.stream_idle(self._empty_revolution(opts.scan_rate_hz))
             if not self.physical:
@@ -208,8 +203,7 @@ class BoardSession:
         """A scenario's LIDAR rate: the device spins at it (as a real one's drifts)."""
         assert self.server is not None
         self.server.period_s = 1.0 / rate_hz
-        if hasattr(self.device, "speed_deg_s"):  # an LD06/LD19 reports its speed in each packet
-            self.device.speed_deg_s = 360.0 * rate_hz
+        self.device.set_rate(rate_hz)  # an LD06/LD19 reports its speed in each packet
 
     def between(self) -> None:
         """A scenario is over: the device keeps scanning the same world until the next one."""

@@ -149,7 +149,7 @@ class _Log:
 
 def _rts_reporter(log: _Log) -> Callable[[str, bool], None]:
     """The client's RTS changes as line events (its DTR is the server's: the motor)."""
-    from harness.serial_line.server import LineEvent
+    from harness.serial_line.line_watch import LineEvent
 
     def told(line: str, asserted: bool) -> None:
         if line == "rts":
@@ -207,9 +207,9 @@ def emulate(
     end: the summary says which.
     """
     settings = settings or RunSettings()
+    from harness.serial_line.device_line import open_device_line
     from harness.serial_line.diagnosis import diagnose, line_errors
-    from harness.serial_line.ports import PtyPort, SerialPort
-    from harness.serial_line.server import DeviceServer
+    from harness.serial_line.ports import PtyPort
     from harness.sim.simulation import Simulation
 
     spec = scenario.lidar_spec
@@ -217,26 +217,27 @@ def emulate(
     seed = effective_seed(scenario, settings)
     check_device_faults(faults.link)
     drift = faults.link.get("rate_drift")
-    device = profile.make_device(spec.rate_hz)
-    line: PtyPort | SerialPort = SerialPort(port, profile.baudrate) if port else PtyPort()
-    name = line.slave_path if isinstance(line, PtyPort) else line.name
     started = time.monotonic()
     log = _Log(announce, started, verbose)
-    rng = np.random.default_rng(seed)
-    revolutions = 0
-    stopped_by: str | None = None
-    server = DeviceServer(
-        device,
-        line,
-        mode="realtime",
-        baudrate=profile.baudrate,
-        revolution_period_s=spec.scan_time,
-        listener=log.event,
-    )
+    damage = None
     if faults.link.on_line:
         from harness.faults.link import LineDamage
 
-        server.damage = LineDamage(faults.link, seed)
+        damage = LineDamage(faults.link, seed)
+    device = profile.make_device(spec.rate_hz)
+    device_line = open_device_line(
+        device,
+        port=port or None,
+        baudrate=profile.baudrate,
+        mode="realtime",
+        revolution_period_s=spec.scan_time,
+        listener=log.event,
+        damage=damage,
+    )
+    line, server, name = device_line.port, device_line.server, device_line.name
+    rng = np.random.default_rng(seed)
+    revolutions = 0
+    stopped_by: str | None = None
     periods = scan_periods(drift, spec.rate_hz, seed) if drift is not None else None
     try:
         announce(f"port: {name}")  # from here on, a stop is a normal end
