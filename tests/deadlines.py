@@ -24,6 +24,10 @@ from harness.links.ros2 import CATCH_UP_S
 # A right answer must come within this: a loaded CI machine has held a node's answer back
 # 3 s (seen on a board in real time); a right node never waits it out.
 GENEROUS_S = 5.0
+# A node's start and its first answer (--ready-timeout), where neither is waited out (the
+# node comes up, or is told at once what it does wrong): a loaded machine has taken more
+# than 5 s for a flooding node's first answer.
+GENEROUS_READY_S = 30.0
 
 # The shortest deadline for a node that must answer some scans in time and then falls
 # silent: twice what a quiet machine's 0.3 s was, above the 0.1-0.45 s Fast DDS has taken to

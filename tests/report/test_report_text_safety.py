@@ -25,7 +25,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from command_line import COMMAND, fossbot_hil
-from deadlines import GENEROUS_S
+from deadlines import GENEROUS_READY_S, GENEROUS_S
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from property_depth import examples
@@ -98,7 +98,7 @@ def test_a_node_writing_control_characters_gets_safe_reports(tmp_path: Path) -> 
         "--timeout",
         f"{GENEROUS_S:g}",  # it answers until it exits: no deadline is waited out
         "--ready-timeout",
-        "5",
+        f"{GENEROUS_READY_S:g}",  # it comes up: not waited out
         "--node",
         node,
         "--out",
