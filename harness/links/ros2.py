@@ -39,6 +39,14 @@ from typing import TYPE_CHECKING
 from harness.errors import ConfigError, LinkError, NeverReady
 from harness.judge.answers import Answers, Received
 from harness.links.base import Link, LinkOptions, register
+from harness.links.topic_advice import (
+    BOOL_TYPE,
+    ELSEWHERE_GRACE_S,
+    ElsewhereWatch,
+    topic_hints,
+    topics_elsewhere,
+    untaken_topic_parameter,
+)
 from harness.nodes.command import (
     NodeCommand,
     node_arguments,
@@ -69,19 +77,12 @@ FIRST_RETRY_MAX_S = 2.0  # the first scan's resends back off up to this interval
 # Once ready, for discovery to name the node reading the scans (Observer.scan_readers_named);
 # a participant that never names itself (no ROS node) is sent its first scan after this.
 NAMED_WAIT_S = 0.5
-# While not ready: once the graph shows the node reading LaserScans (or writing Strings) on
-# another topic instead of the harness's, it is given this long to use ours too, then the
-# run says so (waiting out the whole readiness bound would tell nothing more).
-ELSEWHERE_GRACE_S = 1.0
 CATCH_UP_S = 2.0  # after a missed deadline, wait this long (at least) for the late answer
 FLOOD_SCANS = 5  # a flood is judged over this many recent scans, in which a topic carried
 FLOOD_PER_SCAN = 5  # more than this many messages a scan,
 FLOOD_MIN = 30  # this many at least,
 FLOOD_RATE_HZ = 200.0  # and this many a second (a 10 Hz timer during long waits is no flood)
 LOUD_BYTES = 1 << 20  # a node that wrote more than this is told how much, in the diagnostics
-SCAN_TYPE = "sensor_msgs/msg/LaserScan"
-STRING_TYPE = "std_msgs/msg/String"
-BOOL_TYPE = "std_msgs/msg/Bool"
 
 
 def node_command(options: LinkOptions) -> NodeCommand:
@@ -255,12 +256,20 @@ class Ros2Link(Link):
         waiting = time.monotonic()
         deadline = waiting + opts.ready_timeout
         clock_due = 0.0  # monotonic time of the next /clock while waiting
-        elsewhere = _Elsewhere(self)
+        observer = self.observer
+        elsewhere = ElsewhereWatch(
+            observer.node,
+            opts,
+            reads_scans=self._reads_scans,
+            status_heard=lambda: observer.status_sub.get_publisher_count() > 0,
+            watch=self.publishes_scans,  # a board's graph is the board's: no sign there
+        )
         while not self._ready():
             gone = self.node_gone("before it was ready")
             if gone:
                 raise LinkError(gone)
             expired = time.monotonic() >= deadline or elsewhere.settled()
+            self._gave_up_early_s = elsewhere.gave_up_after
             self._check_types(named_only=not expired)
             if expired:
                 raise NeverReady(self._never_ready())
@@ -321,7 +330,7 @@ class Ros2Link(Link):
             f"{self._ready_bound_said()}: the harness waited for it to subscribe to "
             f"{opts.scan_topic} and publish {opts.status_topic}, but {reason} "
             f"({self.observer.graph_summary()})"
-            + self._topic_hints(reads=reads, publishes=publishes)
+            + topic_hints(self.observer.node, opts, reads=reads, publishes=publishes)
         )
 
     def _ready_bound_said(self) -> str:
@@ -638,8 +647,10 @@ class Ros2Link(Link):
             return []
         if obs.heard["warning"] or obs.warning_publishers():
             return []
-        elsewhere = self._topics_elsewhere(BOOL_TYPE, opts.warning_topic, publishers=True)
-        untaken = self._untaken_topic_parameter(opts.topic_params[2], opts.warning_topic)
+        elsewhere = topics_elsewhere(obs.node, BOOL_TYPE, opts.warning_topic, publishers=True)
+        untaken = untaken_topic_parameter(
+            opts, opts.topic_params[2], opts.warning_topic, self._ask_parameters
+        )
         if len(elsewhere) == 1 and untaken is not None:
             self._notes.append(f"the node publishes a Bool on {elsewhere[0]}, not {untaken}")
         elif len(elsewhere) == 1:
@@ -657,84 +668,6 @@ class Ros2Link(Link):
                 f"no Bool came on {opts.warning_topic} all run; the graph: {obs.node_topics()}"
             )
         return list(self._notes)
-
-    def _untaken_topic_parameter(self, parameter: str, topic: str) -> str | None:
-        """When the harness told the node its topic through `parameter` (a scenario's
-        node_topics) and the node does not declare that parameter: the rest of a note
-        saying so, and naming the node's own parameter for it where one looks like it.
-        None when the harness set no such parameter, or the node declares it."""
-        if f"{parameter}:={topic}" not in self.options.params:
-            return None
-        asked = self._ask_parameters()
-        if isinstance(asked, str):
-            return None  # its parameters are not known: the plain advice stands
-        _, declared = asked
-        if parameter in declared:
-            return None
-        word = parameter.split("_")[0]  # "warning", "lidar"
-        own = [name for name in declared if word in name.lower() and "topic" in name.lower()]
-        said = (
-            f"{topic}: the node did not take the parameter {parameter}:={topic} the harness "
-            f"set, as it declares no {parameter}"
-        )
-        if len(own) == 1:
-            return (
-                f"{said} (it declares {own[0]}): pass --param {own[0]}:={topic}, or name the "
-                f"parameter {parameter} as the lab does"
-            )
-        return f"{said}: declare {parameter} and publish on the topic it names"
-
-    def _topics_elsewhere(self, type_name: str, topic: str, *, publishers: bool) -> list[str]:
-        """Topics other than `topic` that another node publishes (or subscribes to) as
-        `type_name`: where a node with another topic name sends (or reads) it."""
-        assert self.observer is not None
-        node = self.observer.node
-        me = (node.get_name(), node.get_namespace())
-        found = []
-        for name, types in node.get_topic_names_and_types():
-            if name == topic or type_name not in types:
-                continue
-            infos = (
-                node.get_publishers_info_by_topic(name)
-                if publishers
-                else node.get_subscriptions_info_by_topic(name)
-            )
-            if any((i.node_name, i.node_namespace) != me for i in infos):
-                found.append(name)
-        return sorted(found)
-
-    def _topic_hints(self, *, reads: bool, publishes: bool) -> str:
-        """For a node never ready: the scan or status topic it uses instead, and the option
-        that names it ('' when there is none to name)."""
-        opts = self.options
-        hints = []
-        for missing, type_name, topic, option, what, publishers in (
-            (
-                not reads,
-                SCAN_TYPE,
-                opts.scan_topic,
-                "--scan-topic",
-                "subscribes to a LaserScan",
-                False,
-            ),
-            (
-                not publishes,
-                STRING_TYPE,
-                opts.status_topic,
-                "--status-topic",
-                "publishes a String",
-                True,
-            ),
-        ):
-            if not missing:
-                continue
-            others = self._topics_elsewhere(type_name, topic, publishers=publishers)
-            if len(others) == 1:
-                hints.append(
-                    f"it {what} on {others[0]}, not {topic}: pass {option} {others[0]} "
-                    "if that is the lab's name"
-                )
-        return "".join(f"; {h}" for h in hints)
 
     # -- lockstep ---------------------------------------------------------
     def send(self, scan: Scan, tick: int, *, clock: float | None = None) -> None:
@@ -1040,45 +973,3 @@ class Ros2Link(Link):
                 "callback, or not publishing)"
             )
         answers.silent = True  # the node runs: its silence is its verdict
-
-
-class _Elsewhere:
-    """While a ros2 link waits for its node to be ready: does the graph show the node on
-    another scan or status topic (the one it reads or writes instead of the harness's),
-    for ELSEWHERE_GRACE_S? Then waiting longer tells nothing more. Looked at once per
-    POLL_S (a graph query costs more than a spin)."""
-
-    def __init__(self, link: Ros2Link) -> None:
-        self._link = link
-        self._began = time.monotonic()
-        self._seen_at: float | None = None
-        self._next_look = 0.0
-
-    def settled(self) -> bool:
-        link = self._link
-        if not link.publishes_scans or link.observer is None:
-            return False  # a board's graph is the board's: its own topics are no sign
-        now = time.monotonic()
-        if now >= self._next_look:
-            self._next_look = now + POLL_S
-            self._look(now)
-        if self._seen_at is None or now - self._seen_at < ELSEWHERE_GRACE_S:
-            return False
-        link._gave_up_early_s = now - self._began
-        return True
-
-    def _look(self, now: float) -> None:
-        link = self._link
-        assert link.observer is not None
-        opts = link.options
-        elsewhere = (
-            not link._reads_scans()
-            and bool(link._topics_elsewhere(SCAN_TYPE, opts.scan_topic, publishers=False))
-        ) or (
-            link.observer.status_sub.get_publisher_count() == 0
-            and bool(link._topics_elsewhere(STRING_TYPE, opts.status_topic, publishers=True))
-        )
-        if not elsewhere:
-            self._seen_at = None
-        elif self._seen_at is None:
-            self._seen_at = now
