@@ -1,7 +1,11 @@
 """How an answer is judged: the node's words read, held against the truth, recorded.
 
 - ``answers``: what came back for one scan (status Strings, warning Bools);
-- ``status``: reading the free-text status a student node publishes;
+- ``status``: reading the free-text status a student node publishes (its
+  numbers and their labels in ``status_numbers``); a structured one (JSON,
+  a printed dict, ``key: value`` lines) taken apart by ``structured_text``
+  and read by its keys in ``structured_status``;
+- ``run_hints``: what a whole run suggests about a failure's cause;
 - ``oracle``: per-tick expectations from the scan the node was sent, and
   the verdict with its explanation;
 - ``records``: what one run produced, tick by tick (``RunResult``);
