@@ -55,6 +55,8 @@ class RunResult:
     # revolution and this scenario's first judged one (the device kept streaming).
     gap_s: float | None = None
     node_start: str = ""  # how the node under test was started (by fork, as a command)
+    # Ended at its first failed tick, the last record (RunSettings.stop_at_first_failure).
+    stopped_early: bool = False
 
     @property
     def total_s(self) -> float:

@@ -60,6 +60,7 @@ def judge_frames(
     on_tick: Callable[[TickRecord], None] | None = None,
     link_faults: LinkFaults = NO_LINK_FAULTS,
     diagnose: bool = True,
+    stop_at_first_failure: bool = False,
 ) -> RunResult:
     """Deliver each frame's scan through an opened `link`; judge and record every tick.
 
@@ -68,7 +69,10 @@ def judge_frames(
     dropped, twice, out of order, stale); the oracle is told, so a dropped
     scan expects no answer and a late one is timed from when it went out.
     With `diagnose`, the link's diagnostics end the run (which stops a node
-    process); without, the link stays usable for another run.
+    process); without, the link stays usable for another run. With
+    `stop_at_first_failure`, the run ends at its first failed tick (the last
+    record; `result.stopped_early` says so): a tick that got no status by its
+    deadline at once, a wrong answer as soon as it is judged.
     """
     # A tick waits in `pending` until the next scan's exchange is over:
     # answers to scan k that arrive after scan k+1 was sent (a Bool published
@@ -80,6 +84,8 @@ def judge_frames(
     ready: list[tuple[Frame, Answers, Delivery]] = []
 
     def judge(frame: Frame, answers: Answers, delivery: Delivery) -> None:
+        if result.stopped_early:  # the failed tick is the run's last
+            return
         # Judge against what the node saw: over a serial link that is the
         # board driver's scan, quantised and re-binned, not ours.
         seen = answers.seen if answers.seen is not None else frame.scan
@@ -99,6 +105,8 @@ def judge_frames(
         result.records.append(record)
         if on_tick is not None:
             on_tick(record)
+        if stop_at_first_failure and not verdict.ok:
+            result.stopped_early = True
 
     def judge_ready() -> None:
         for held in ready:
@@ -142,6 +150,8 @@ def judge_frames(
                 # While the node works on this scan, judge the ticks that are
                 # complete and simulate the next one.
                 judge_ready()
+                if result.stopped_early:  # the scan just sent is never collected
+                    break
                 upcoming = next(planned, None)
                 answers = link.collect(scan, frame.tick, may_be_ignored=delivery.may_be_ignored)
             except LinkError as err:  # the line or graph broke: end here, keep what we have
@@ -152,8 +162,14 @@ def judge_frames(
             if answers.problem is not None:  # the node died or went silent: nothing more to judge
                 result.error = f"t={frame.t:.2f} s tick {frame.tick}: {answers.problem}"
                 break
-        complete_pending(link.settle())  # ready ticks stay ahead of the pending ones
-        judge_ready()
+            if stop_at_first_failure and _fails_alone(answers, delivery):
+                complete_pending([])  # judged now: later answers cannot make it pass
+                judge_ready()
+                if result.stopped_early:
+                    break
+        if not result.stopped_early:
+            complete_pending(link.settle())  # ready ticks stay ahead of the pending ones
+            judge_ready()
     except KeyboardInterrupt as err:  # Ctrl-C or SIGTERM: keep what was judged, say where
         judge_ready()  # complete ticks only; those still waiting for answers are not judged
         raise _interrupted(err, result, current) from None
@@ -161,6 +177,18 @@ def judge_frames(
         result.notes = link.notices()  # before the diagnostics, which stop the node
         result.diagnostics = link.diagnostics()
     return result
+
+
+def _fails_alone(answers: Answers, delivery: Delivery) -> bool:
+    """The tick fails whatever comes after: its scan went out, no status came by its
+    deadline, and an answer to a scan whose deadline passed stays late (take_late)."""
+    return (
+        answers.timed_out
+        and not answers.statuses
+        and delivery.delivered
+        and not delivery.may_be_ignored
+        and answers.lost is None
+    )
 
 
 def _send_first(link: Link, frame: Frame, scan: Scan, delivery: Delivery) -> None:

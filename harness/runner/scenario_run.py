@@ -75,7 +75,15 @@ def run_scenario(
                 Frame(s.tick, s.t, s.x, s.y, s.yaw, _emit(profile, s, sim.spec, rng, bool(drift)))
                 for s in sim.ticks(periods)
             )
-            judge_frames(frames, link, oracle, result, on_tick=on_tick, link_faults=profile.link)
+            judge_frames(
+                frames,
+                link,
+                oracle,
+                result,
+                on_tick=on_tick,
+                link_faults=profile.link,
+                stop_at_first_failure=settings.stop_at_first_failure,
+            )
     finally:  # an interrupted run reports its time too; waiting for the link is start-up
         result.wall_s = time.perf_counter() - started - result.startup_s
     return result

@@ -24,6 +24,9 @@ class RunSettings:
     status_pattern: str | None = None
     warning_when_clear: str | None = None  # "required" or "optional"; None: the scenario's
     gui: bool = False
+    # End each scenario at its first failed tick (its verdict is then that tick's FAIL):
+    # the audit's mutants need no more to be killed. Off for every graded run.
+    stop_at_first_failure: bool = False
 
 
 def effective_seed(scenario: Scenario, settings: RunSettings) -> int:
