@@ -29,16 +29,17 @@ GENEROUS_S = 5.0
 # than 5 s for a flooding node's first answer.
 GENEROUS_READY_S = 30.0
 
-# The shortest deadline for a node that must answer some scans in time and then falls
-# silent: twice what a quiet machine's 0.3 s was, above the 0.1-0.45 s Fast DDS has taken to
+# The shortest deadline a run waits out (its node must still answer the scans before in
+# time): twice what a quiet machine's 0.3 s was, above the 0.1-0.45 s Fast DDS has taken to
 # repair a young node's sample (timer-bound, whatever the load), and no dearer to wait out
 # than 0.3 s was but for itself: the catch-up wait after a missed deadline is
 # max(CATCH_UP_S, 3 deadlines), CATCH_UP_S up to CATCH_UP_S / 3.
 FLOOR_S = 0.6
 assert FLOOR_S <= CATCH_UP_S / 3
 # An answer is a scan's way to the node and back, a round trip between two processes,
-# with DDS's threads woken on each side: a deadline this many of the slowest round trips
-# measured leaves a margin of about ten answers' worth.
+# with DDS's threads woken on each side: on this 2-core machine, loaded (two busy loops,
+# three test workers), a run's slowest answer took up to ten times the slowest round trip
+# measured beside it; twenty leave twice that.
 ROUND_TRIPS = 20
 # Beyond this the tests' own bounds (a run's time limit, pytest's timeout) would need to
 # grow too: three missed deadlines and their catch-up waits take 3 * (2 + 6) = 24 s.
