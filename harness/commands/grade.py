@@ -283,8 +283,9 @@ def _show_dashboard(console: Console, link: str | None) -> None:
 
 def run(args: argparse.Namespace, console: Console) -> int:
     from harness.atomic_write import write_atomically
-    from harness.cluster.client import check_cluster_options, dashboard, open_client
+    from harness.cluster.client import check_cluster_options, dashboard
     from harness.cluster.progress import add_task, task_progress
+    from harness.cluster.soon import client_soon
     from harness.grading.build import colcon_executable
     from harness.grading.class_table import (
         class_csv,
@@ -312,25 +313,28 @@ def run(args: argparse.Namespace, console: Console) -> int:
     out = Path(args.out)
     found = discover(args.dirs, exclude=out)  # before prepare_out: no folder for a typo
     check_out(out)
-    if any(s.kind in ("package", "workspace") for s in found.students):
-        colcon_executable()
-    if importlib.util.find_spec("rclpy") is None:  # checked last: the input was fine
-        raise ConfigError(
-            "grading needs rclpy: pip install 'fossbot-hil[ros]' (or source ROS 2 Jazzy)"
-        )
-    sandbox = sandbox_limits(args, console)  # this machine cannot sandbox: exit 2 now
-    planned = planned_ticks(scenarios, settings)  # what a partial score counts against
-    replaced = previous_grading(out)
     with contextlib.ExitStack() as stack:
-        client = stack.enter_context(
-            open_client(
-                args.scheduler,
-                args.workers,
+        # The cluster starts now, in the background, while the checks below and the
+        # scenarios' tick counts run here (harness.cluster.soon).
+        soon = stack.enter_context(
+            client_soon(
+                scheduler=args.scheduler,
+                workers=args.workers,
                 retries=WORKER_RETRIES,
                 worker_wait=args.worker_wait,
                 preload=("harness.grading.grade",),  # each student runs in a process of its own
             )
         )
+        if any(s.kind in ("package", "workspace") for s in found.students):
+            colcon_executable()
+        if importlib.util.find_spec("rclpy") is None:  # checked last: the input was fine
+            raise ConfigError(
+                "grading needs rclpy: pip install 'fossbot-hil[ros]' (or source ROS 2 Jazzy)"
+            )
+        sandbox = sandbox_limits(args, console)  # this machine cannot sandbox: exit 2 now
+        planned = planned_ticks(scenarios, settings)  # what a partial score counts against
+        replaced = previous_grading(out)
+        client = soon.client()  # a --scheduler that does not answer: exit 2 now
         if sandbox is not None and args.scheduler:
             check_workers(client, console)  # the embedded cluster's are this machine's
         stack.enter_context(prepare_out(out))  # the folder is this grade's until it is done
@@ -355,6 +359,7 @@ def run(args: argparse.Namespace, console: Console) -> int:
                 s.name: HiddenScenario(s.label, s.show_failure) for s in plan.scenarios if s.hidden
             },
             sandbox=sandbox,
+            sandbox_checked=args.scheduler is None,  # the embedded cluster's host is this one
         )
         if replaced:
             console.print(replaced, markup=False, highlight=False)

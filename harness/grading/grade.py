@@ -68,6 +68,9 @@ class GradeConfig:
     planned: dict[str, int] = field(default_factory=dict)  # scenario -> ticks when unbroken
     hidden: dict[str, HiddenScenario] = field(default_factory=dict)  # scenario -> how shown
     sandbox: SandboxLimits | None = None  # each student's build and run in bubblewrap
+    # True: the grader has found that its host can sandbox, and every worker runs there
+    # (the embedded cluster), so a worker need not try again before its first student.
+    sandbox_checked: bool = False
 
     @property
     def unheld(self) -> dict[str, tuple[int, int]]:
@@ -286,7 +289,7 @@ def _grade(student: Student, config: GradeConfig, cancel: StopFlag) -> StudentGr
 
     if student.problem is not None:
         return without_run(student.problem)
-    if config.sandbox is not None and (problem := sandbox_problem()) is not None:
+    if config.sandbox is not None and not config.sandbox_checked and (problem := sandbox_problem()):
         return without_run(f"could not grade: {problem}")  # this worker cannot sandbox
     build_s = None
     if student.kind in ("package", "workspace"):
