@@ -20,25 +20,29 @@ import sys
 import time
 from dataclasses import asdict, fields
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from harness.atomic_write import write_atomically
 from harness.errors import ConfigError
-from harness.judge.records import RunResult
 from harness.nodes.sandbox_prefix import NODE_SANDBOX_ENV
-from harness.report.summary import verdict_of
+
+if TYPE_CHECKING:  # imported by the suite: after the node's fork server has started
+    from harness.judge.records import RunResult
 
 __all__ = [
     "interrupt_on_sigterm",
     "link_options_from",
     "result_entry",
     "run_settings_from",
+    "warm_node_server",
     "write_job",
 ]
 
 
 def result_entry(result: RunResult) -> dict[str, Any]:
     """What the grader needs of one scenario's run, as JSON-ready data."""
+    from harness.report.summary import verdict_of
+
     return {
         "scenario": result.scenario,
         "verdict": verdict_of(result),
@@ -206,14 +210,30 @@ def interrupt_on_sigterm() -> None:
     signal.signal(signal.SIGTERM, handler)
 
 
+def warm_node_server(job: dict[str, Any]) -> bool:
+    """Start the fork server students' nodes start from (``warm_python``) now, before
+    this process imports the runner: its imports (rclpy, the messages) then run beside
+    ours instead of after them. Only for a node the ros2 link starts; True if started.
+    The suite uses this server (one per process and module) and closes it at its end."""
+    from harness.nodes.forkserver import shared
+    from harness.nodes.process import fork_server_enabled
+    from harness.nodes.python_script import SERVER_MODULE
+
+    if job.get("link") != "ros2" or not fork_server_enabled():
+        return False
+    shared(SERVER_MODULE)  # in the sandbox: started in the node's nested one, as later
+    return True
+
+
 def main(argv: list[str]) -> int:
     if len(argv) != 1:
         print("usage: python -m harness.grading.worker JOB.json", file=sys.stderr)
         return 2
     interrupt_on_sigterm()
     if os.environ.get(NODE_SANDBOX_ENV):
-        _not_dumpable()
+        _not_dumpable()  # before anything is started: the fork server is its child
     job = json.loads(Path(argv[0]).read_text(encoding="utf-8"))
+    warm_node_server(job)
     return run_job(job)
 
 
