@@ -14,6 +14,7 @@ from typing import Any
 from harness.bench.stage import StageResult
 
 __all__ = [
+    "GRADE_KEYS",
     "REQUIRED_KEYS",
     "STUDENT_SPLIT_KEYS",
     "SUITE_KEYS",
@@ -38,6 +39,17 @@ REQUIRED_KEYS = (
     "serial_rate_error_pct",
     "serial_jitter_p99_ms",
     "peak_rss_mb",
+)
+
+#: Grading a class (issue 41): a class of correct script students through the default
+#: suite, and the same students' runs back to back.
+GRADE_KEYS = (
+    "grade_s",
+    "grade_per_student_s",
+    "grade_students",
+    "grade_workers",
+    "grade_runs_s",
+    "grade_ratio",
 )
 
 #: The edit-run loop (issue 13): the shipped suite as a user runs it, and its split.
@@ -115,6 +127,12 @@ TARGETS = (
         "<= 1.5",
         lambda v: v <= 1.5,
     ),
+    Target(
+        "grade_ratio",
+        "grading a class / its runs on the same workers",
+        "<= 1.3",
+        lambda v: v <= 1.3,
+    ),
     Target("serial_rate_error_pct", "serial byte rate error", "within 1 %", lambda v: abs(v) <= 1),
     Target("serial_jitter_p99_ms", "revolution jitter p99", "< 2 ms", lambda v: v < 2.0),
 )
@@ -166,6 +184,8 @@ def figures(stages: Mapping[str, StageResult], harness_peak_rss_mb: float) -> di
     out["lab_suite_cli_wall_s"] = _extra(suite, "cli_wall_s")
     for key in (*SUITE_KEYS, *STUDENT_SPLIT_KEYS):
         out[key] = _extra(suite, key)
+    for key in GRADE_KEYS:
+        out[key] = _extra(stages.get("grade"), key)
     out["serial_rate_error_pct"] = _extra(pacing, "reader_rate_error_pct")
     out["serial_jitter_p99_ms"] = _extra(pacing, "reader_jitter_p99_ms")
     out["serial_pacer_rate_error_pct"] = _extra(pacing, "pacer_rate_error_pct")

@@ -68,6 +68,11 @@ class BenchPlan:
         workspace node, inprocess link): the median of three (quick: one)."""
         return 1 if self.quick else 3
 
+    @property
+    def grade_students(self) -> int:
+        """The grade stage's class: four students (two per worker on 2 cores; quick: two)."""
+        return 2 if self.quick else 4
+
 
 def parse_stages(text: str | None) -> tuple[str, ...]:
     """``--only a,b``: known stage names, in the bench's own order."""
@@ -119,6 +124,10 @@ def _measure(name: str, plan: BenchPlan) -> StageResult:
             student_split=plan.suite_student_split,
             suite=plan.suite_scenarios,
         )
+    if name == "grade":
+        from harness.bench.grade_class import measure_grade
+
+        return measure_grade(plan.grade_students, plan.suite_scenarios, runs=not plan.quick)
     raise ValueError(name)
 
 
