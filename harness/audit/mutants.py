@@ -23,6 +23,7 @@ __all__ = ["CONTROL", "MUTANTS", "NODE_SCRIPT", "Mutant", "mutant_command", "mut
 
 NODE_SCRIPT = Path(__file__).resolve().with_name("mutant_node.py")
 CONTROL = "correct"  # the node without a mistake, written the same way: the audit's sanity check
+QUICK_S = 0.35  # a scenario of a mistake that shows in its answers: a node start, a few ticks
 
 
 @dataclass(frozen=True)
@@ -32,9 +33,10 @@ class Mutant:
     name: str  # snake_case; the name in the CLI, the kill matrix and --json
     mistake: str  # one line: what the node does wrong, in a student's terms
     caught_by: str  # one line: the kind of scenario that kills it
-    # Its runs wait out per-scan deadlines (silence costs seconds a scenario): the audit
-    # starts these first, so the slowest are not left for last.
-    slow: bool = False
+    # Seconds a scenario of its suite takes, measured with the shipped suite on 2 busy
+    # cores, each scenario ended at its first failed tick (what batches balance): a
+    # mistake whose runs wait out deadlines costs many quick ones, and goes first.
+    cost_s: float = QUICK_S
 
 
 MUTANTS: tuple[Mutant, ...] = (
@@ -127,18 +129,19 @@ MUTANTS: tuple[Mutant, ...] = (
         "one_scan_late",
         "publishes the previous scan's answer (status and Bool), nothing for the first",
         "a robot that moves: consecutive scans differ",
+        cost_s=1.8,  # its first scan goes twice: unanswered, then answered late
     ),
     Mutant(
         "silent_when_clear",
         "publishes no status and no Bool when nothing valid is in range",
         "a scan with nothing in range",
-        slow=True,
+        cost_s=4.0,  # the readiness bound (20 s) where its first scan is clear
     ),
     Mutant(
         "status_only_on_change",
         "publishes the status only when its text changed (the Bool every scan)",
         "two consecutive scans with the same answer (standing still, nothing in range)",
-        slow=True,
+        cost_s=2.2,  # a deadline and its catch-up (1 s + 3 s) where a status repeats
     ),
     Mutant(
         "status_twice",
@@ -154,13 +157,13 @@ MUTANTS: tuple[Mutant, ...] = (
         "slow_callback",
         "takes 1.5 s per scan before answering",
         "any run: the answers miss the per-scan deadline",
-        slow=True,
+        cost_s=6.0,  # its first scan answered two or three times over, 1.5 s each
     ),
     Mutant(
         "goes_silent",
         "stops answering after its 10th scan",
         "a run of more than 10 scans",
-        slow=True,
+        cost_s=4.3,  # a deadline and its catch-up (1 s + 3 s) in every scenario
     ),
     # -- units and configuration
     Mutant(

@@ -16,11 +16,13 @@ from harness.audit.matrix import KillMatrix, kill_matrix
 from harness.audit.mutants import CONTROL, mutant_command, mutant_named
 from harness.audit.task import AuditConfig, AuditUnit, UnitResult, run_batch
 
-__all__ = ["AuditOutcome", "audit_suite", "audit_units", "batches"]
+__all__ = ["AuditOutcome", "audit_suite", "audit_units", "batches", "unit_cost"]
 
 STOP_WAIT_S = 30.0  # on Ctrl-C: for running units to stop their nodes
-BATCHES_PER_THREAD = 2  # batches per worker thread: start-up shared, the load still even
-SLOW_COST = 6.0  # a mistake that waits out deadlines costs about six quick ones
+# One batch per worker thread: one worker process's start-up each, and batches of equal
+# measured cost (Mutant.cost_s) finish together.
+BATCHES_PER_THREAD = 1
+CONTROL_COST_S = 0.25  # a scenario of the correct node's suite, run whole
 
 
 class AuditOutcome:
@@ -41,9 +43,13 @@ class AuditOutcome:
         return list(runs[0].get("coverage_gaps", [])) if runs else []
 
 
-def audit_units(names: Sequence[str]) -> list[AuditUnit]:
-    """The correct control, then the mutants, each a node command."""
-    return [AuditUnit(name, mutant_command(name)) for name in (CONTROL, *names)]
+def audit_units(names: Sequence[str], *, whole_runs: bool = False) -> list[AuditUnit]:
+    """The correct control, then the mutants, each a node command. A mutant's scenario
+    ends at its first failed tick (all a kill needs), unless `whole_runs` (--repeat: the
+    verdicts that flip are compared on whole runs); the control always runs whole."""
+    control = AuditUnit(CONTROL, mutant_command(CONTROL))
+    stop = not whole_runs
+    return [control, *(AuditUnit(n, mutant_command(n), stop_at_first_failure=stop) for n in names)]
 
 
 def audit_suite(
@@ -59,7 +65,7 @@ def audit_suite(
     from harness.cluster.flag import ClusterFlag
     from harness.cluster.window import Window, cluster_threads
 
-    units = audit_units(mutants)
+    units = audit_units(mutants, whole_runs=len(config.seeds) > 1)
     queued = batches(units, BATCHES_PER_THREAD * cluster_threads(client))
     done: dict[str, UnitResult] = {}
     stop = ClusterFlag()
@@ -89,26 +95,29 @@ def audit_suite(
 
 
 def batches(units: Sequence[AuditUnit], count: int) -> list[tuple[AuditUnit, ...]]:
-    """`units` in at most `count` batches of about equal cost, the costliest first: a
-    mistake whose runs wait out deadlines costs several quick ones. One batch shares one
-    worker process and its warm Python, so the fewer batches, the less start-up; enough
-    of them keep every worker busy to the end."""
+    """`units` in at most `count` batches of about equal expected cost (`unit_cost`), the
+    costliest batch first and in each batch the costliest unit first: each unit in turn,
+    costliest first, joins the batch with the least cost so far (ties: the first), so the
+    mistakes that wait out deadlines spread over the batches and quick ones even them
+    out. Deterministic: the same units give the same batches. One batch shares one worker
+    process and its warm Python, so the fewer batches, the less start-up."""
     count = max(1, min(count, len(units)))
     loads = [0.0] * count
     chosen: list[list[AuditUnit]] = [[] for _ in range(count)]
-    for unit in sorted(units, key=lambda u: -_cost(u.name)):  # stable: control, then order
+    for unit in sorted(units, key=lambda u: -unit_cost(u)):  # stable: control, then order
         lightest = loads.index(min(loads))
         chosen[lightest].append(unit)
-        loads[lightest] += _cost(unit.name)
+        loads[lightest] += unit_cost(unit)
     ranked = sorted(range(count), key=lambda i: -loads[i])
     return [tuple(chosen[i]) for i in ranked if chosen[i]]
 
 
-def _cost(name: str) -> float:
-    """How long a unit's runs take, relative to a quick one's."""
-    if name == CONTROL:
-        return 1.0
-    return SLOW_COST if mutant_named(name).slow else 1.0
+def unit_cost(unit: AuditUnit) -> float:
+    """Seconds a scenario of the unit's suite is expected to take (the mutant's measured
+    cost_s; the control runs whole, and quickly)."""
+    if unit.name == CONTROL:
+        return CONTROL_COST_S
+    return mutant_named(unit.name).cost_s
 
 
 def _outcomes(future: Any, batch: tuple[AuditUnit, ...]) -> list[UnitResult]:

@@ -61,6 +61,13 @@ class AuditUnit:
 
     name: str
     command: str
+    # A kill needs only a scenario's first failed tick: a mutant's runs may end there
+    # (RunSettings.stop_at_first_failure); the control's never do (it must pass whole).
+    stop_at_first_failure: bool = False
+
+    def overrides(self) -> dict[str, dict[str, Any]]:
+        """What this unit runs with beyond the audit's RunSettings (job.json)."""
+        return {"settings": {"stop_at_first_failure": self.stop_at_first_failure}}
 
 
 @dataclass
@@ -133,6 +140,7 @@ def _run_worker(
     job = write_job(
         folder / "job.json",
         commands={unit.name: unit.command for unit in units},
+        overrides={unit.name: unit.overrides() for unit in units},
         scenarios=list(config.scenario_refs),
         link=config.link,
         options=config.options,

@@ -53,12 +53,15 @@ def write_job(
     coverage: str | None,
     results: Path,
     unit_timeout: float,
+    overrides: dict[str, dict[str, dict[str, Any]]] | None = None,
 ) -> Path:
     """Write a job file for this worker: each mutant's node command by name, LinkOptions and
-    RunSettings as their fields, which unit's runs give the reading coverage, and each
-    unit's bound in seconds."""
+    RunSettings as their fields, which unit's runs give the reading coverage, each unit's
+    bound in seconds, and what a unit runs with of its own (`overrides`: by name, its
+    "settings": RunSettings fields, e.g. a mutant's stop at its first failed tick)."""
     job = {
         "commands": commands,
+        "overrides": overrides or {},
         "scenarios": scenarios,
         "link": link,
         "options": asdict(options),
@@ -72,7 +75,7 @@ def write_job(
 
 
 def _entry(result: Any) -> dict[str, Any]:
-    from harness.report.summary import verdict_of
+    from harness.judge.verdicts import verdict_of
 
     failure = result.first_failure or result.error or ""
     return {
@@ -81,6 +84,7 @@ def _entry(result: Any) -> dict[str, Any]:
         "first_failure": clip(failure, FAILURE_CHARS),
         "not_started": result.not_started,
         "ticks": len(result.records),
+        "stopped_early": result.stopped_early,  # ended at its first failed tick
     }
 
 
@@ -159,9 +163,12 @@ def run_job(job: dict[str, Any], clock: UnitClock | None = None) -> int:
         state["units"][name], state["running"] = unit, name
         write()
         started = time.monotonic()
+        own = job.get("overrides", {}).get(name, {})
+        node = replace(options, node=command)
+        settings = replace(base, **own.get("settings", {}))
         try:
             with clock.bound():
-                _run_unit(unit, name, chosen, job, replace(options, node=command), base, write)
+                _run_unit(unit, name, chosen, job, node, settings, write)
         except KeyboardInterrupt:
             if not clock.overdue:  # SIGTERM from the command: links closed, nodes stopped
                 unit["error"] = "stopped"
