@@ -23,7 +23,7 @@ __all__ = ["CONTROL", "MUTANTS", "NODE_SCRIPT", "Mutant", "mutant_command", "mut
 
 NODE_SCRIPT = Path(__file__).resolve().with_name("mutant_node.py")
 CONTROL = "correct"  # the node without a mistake, written the same way: the audit's sanity check
-QUICK_S = 0.35  # a scenario of a mistake that shows in its answers: a node start, a few ticks
+QUICK_S = 0.27  # a scenario of a mistake that shows in its answers: a node start, a few ticks
 
 
 @dataclass(frozen=True)
@@ -135,13 +135,13 @@ MUTANTS: tuple[Mutant, ...] = (
         "silent_when_clear",
         "publishes no status and no Bool when nothing valid is in range",
         "a scan with nothing in range",
-        cost_s=4.0,  # the readiness bound (20 s) where its first scan is clear
+        cost_s=3.7,  # the readiness bound (20 s) where its first scan is clear
     ),
     Mutant(
         "status_only_on_change",
         "publishes the status only when its text changed (the Bool every scan)",
         "two consecutive scans with the same answer (standing still, nothing in range)",
-        cost_s=2.2,  # a deadline and its catch-up (1 s + 3 s) where a status repeats
+        cost_s=2.1,  # a deadline and its catch-up (1 s + 3 s) where a status repeats
     ),
     Mutant(
         "status_twice",
@@ -163,7 +163,7 @@ MUTANTS: tuple[Mutant, ...] = (
         "goes_silent",
         "stops answering after its 10th scan",
         "a run of more than 10 scans",
-        cost_s=4.3,  # a deadline and its catch-up (1 s + 3 s) in every scenario
+        cost_s=4.2,  # a deadline and its catch-up (1 s + 3 s) in every scenario
     ),
     # -- units and configuration
     Mutant(
