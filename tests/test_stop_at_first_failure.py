@@ -7,8 +7,8 @@ from pathlib import Path
 
 import pytest
 
+from harness.judge.verdicts import verdict_of
 from harness.links.base import LinkOptions
-from harness.report.summary import verdict_of
 from harness.runner.scenario_run import run
 from harness.runner.settings import RunSettings
 from harness.scenario.files import resolve_scenario

@@ -27,6 +27,8 @@ from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from itertools import combinations
 
+from harness.judge.verdicts import RunVerdict
+
 FACTORS = ("scenario", "faults", "threshold", "seed")
 UNORDERED = ("scenario", "faults", "seed")  # the others are quantities: "threshold <= 0.2"
 Factors = tuple[str, ...]
@@ -68,8 +70,8 @@ class _Tally:
 
     def add(self, run: _Run) -> None:
         self.runs += 1
-        self.fail += run.verdict == "FAIL"
-        self.error += run.verdict == "ERROR"
+        self.fail += run.verdict == RunVerdict.FAIL
+        self.error += run.verdict == RunVerdict.ERROR
 
     def minus(self, other: _Tally) -> _Tally:
         return _Tally(self.runs - other.runs, self.fail - other.fail, self.error - other.error)
@@ -124,12 +126,8 @@ def _level(factor: str, value: object) -> Level:
 
 def _verdict(value: object) -> str:
     """PASS, FAIL or ERROR; anything that does not say it passed or failed is an ERROR."""
-    text = _text(value).upper()
-    if text in ("PASS", "PASSED"):
-        return "PASS"
-    if text in ("FAIL", "FAILED"):
-        return "FAIL"
-    return "ERROR"
+    verdict = RunVerdict.read(_text(value))
+    return RunVerdict.ERROR if verdict is RunVerdict.NOT_RUN else verdict
 
 
 def _runs(rows: Iterable[Row], factors: Factors) -> list[_Run]:

@@ -16,6 +16,7 @@ from dataclasses import replace
 from typing import Any
 
 from harness.campaign.plan import SCENARIO_FAULTS, RunSpec
+from harness.judge.verdicts import RunVerdict, verdict_of
 from harness.links.base import LinkOptions
 from harness.runner.settings import RunSettings
 from harness.safe_text import clip, for_csv
@@ -42,14 +43,15 @@ def run_one(
         )
         result = run(scenario, link_name, options, settings)
     except Exception as err:  # a run that could not be made is a result, not a lost task
-        verdict, ticks, failed, failure = "ERROR", 0, 0, f"{type(err).__name__}: {err}"
+        verdict, ticks, failed = RunVerdict.ERROR, 0, 0
+        failure = f"{type(err).__name__}: {err}"
     else:
-        verdict = "PASS" if result.ok else ("ERROR" if result.error else "FAIL")
+        verdict = verdict_of(result)  # as `run` and every report say it
         ticks, failed = len(result.records), len(result.failed_ticks)
         failure = result.first_failure or result.error or ""
     return {
         **spec.as_row(),
-        "verdict": verdict,
+        "verdict": verdict.value,
         "ticks": ticks,
         "failed_ticks": failed,
         "first_failure": for_csv(clip(failure, FAILURE_CHARS)).replace("\n", "\\n"),

@@ -23,6 +23,7 @@ from rich.console import Console
 
 from harness.commands.arguments import check_output_file, given
 from harness.errors import ConfigError
+from harness.judge.verdicts import RunVerdict
 
 if TYPE_CHECKING:  # imported when a run starts (the parser is built for any command)
     from harness.grading.grading_file import GradingFile
@@ -200,7 +201,7 @@ class RunGrading:
         from harness.grading.gradescope import gradescope_results
         from harness.report.terminal import run_notes
 
-        passed = sum(1 for v in verdicts.values() if v == "PASS")
+        passed = sum(1 for v in verdicts.values() if v == RunVerdict.PASS)
         data = gradescope_results(
             plan,
             verdicts,
@@ -222,7 +223,7 @@ def _verdicts(
 ) -> tuple[dict[str, str], dict[str, str]]:
     """Each scenario's verdict (NOT RUN when it has no result) and first failure in words."""
     from harness.grading.class_table import NOT_RUN, PASS
-    from harness.report.summary import verdict_of
+    from harness.judge.verdicts import verdict_of
 
     by_name = {r.scenario: r for r in results}
     verdicts: dict[str, str] = {}
@@ -247,7 +248,7 @@ def _ticks(
     from harness.runner.planned_ticks import planned_ticks
 
     by_name = {r.scenario: r for r in results}
-    unfinished = [s for s in scenarios if verdicts.get(s.name) != "PASS"]
+    unfinished = [s for s in scenarios if verdicts.get(s.name) != RunVerdict.PASS]
     planned = planned_ticks(unfinished, settings) if unfinished else {}
     ticks: dict[str, tuple[int, int]] = {}
     for scenario in scenarios:

@@ -26,6 +26,7 @@ from harness.commands.cluster_options import (
     describe_cluster,
 )
 from harness.errors import ConfigError
+from harness.judge.verdicts import RunVerdict
 from harness.report.console_text import print_safe as say
 
 if TYPE_CHECKING:
@@ -172,7 +173,7 @@ def run(args: argparse.Namespace, console: Console) -> int:
         say(console, f"wrote {write_parquet(out / 'results.parquet', rows, columns)}")
     for line in lines:
         say(console, line)
-    failed = sum(row["verdict"] != "PASS" for row in rows)
+    failed = sum(row["verdict"] != RunVerdict.PASS for row in rows)
     return 0 if not failed else 1
 
 
@@ -259,7 +260,7 @@ def _run_all(
             for index, future in window:
                 row = _row_of(future, todo[index])
                 table.add(row)
-                failed += row["verdict"] != "PASS"
+                failed += row["verdict"] != RunVerdict.PASS
                 progress.update(bar, advance=1, failed=failed, running=len(window.running))
     return table
 
@@ -286,7 +287,7 @@ def _row_of(future: Any, spec: RunSpec) -> dict[str, Any]:
         ) from None
     return {
         **spec.as_row(),
-        "verdict": "ERROR",
+        "verdict": RunVerdict.ERROR.value,
         "ticks": 0,
         "failed_ticks": 0,
         "first_failure": failure,

@@ -41,7 +41,7 @@ __all__ = [
 
 def result_entry(result: RunResult) -> dict[str, Any]:
     """What the grader needs of one scenario's run, as JSON-ready data."""
-    from harness.report.summary import verdict_of
+    from harness.judge.verdicts import verdict_of
 
     return {
         "scenario": result.scenario,

@@ -9,6 +9,8 @@
 - ``oracle``: per-tick expectations from the scan the node was sent, and
   the verdict with its explanation;
 - ``records``: what one run produced, tick by tick (``RunResult``);
+- ``verdicts``: its one verdict (``RunVerdict``: PASS, FAIL, ERROR, NOT RUN;
+  ``verdict_of``), as every command and report says it;
 - ``alignment``: whether the board's /scan is the truth turned or mirrored,
   fitted over a run (``run_alignment``), and the likely fix;
 - ``reading_coverage``: which kinds of readings a suite's delivered scans
@@ -29,6 +31,8 @@ _EXPORTS = {
     "Verdict": "oracle",
     "RunResult": "records",
     "TickRecord": "records",
+    "RunVerdict": "verdicts",
+    "verdict_of": "verdicts",
     "Alignment": "alignment",
     "fit_alignment": "alignment",
     "run_alignment": "alignment",

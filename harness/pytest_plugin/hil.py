@@ -240,7 +240,7 @@ class Hil:
         result = self._run(chosen, link, options, settings)
         self.results.append(result)
         if self._record is not None:
-            from harness.report.summary import verdict_of
+            from harness.judge.verdicts import verdict_of
 
             verdict = verdict_of(result.raw)
             if result.failed_ticks:

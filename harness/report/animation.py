@@ -32,8 +32,8 @@ import numpy as np
 from harness.atomic_write import fill_atomically
 from harness.errors import ConfigError
 from harness.judge.records import RunResult, TickRecord
+from harness.judge.verdicts import verdict_of
 from harness.report.plot import draw_text
-from harness.report.summary import verdict_of
 from harness.safe_text import clip, shown, visible
 from harness.scenario.footprint import Outline, disc, robot_outlines
 from harness.scenario.model_files import find_model_file, parse_xml, robot_models_dir

@@ -30,6 +30,7 @@ from typing import Any
 
 from harness import __version__
 from harness.errors import ConfigError
+from harness.judge.verdicts import RunVerdict
 
 __all__ = [
     "KINDS",
@@ -42,7 +43,7 @@ __all__ = [
 ]
 
 SUMMARY = "summary.json"
-VERDICTS = ("PASS", "FAIL", "ERROR", "NOT RUN")
+VERDICTS = tuple(v.value for v in RunVerdict)
 KINDS = (
     "regressed",
     "fixed",
@@ -138,7 +139,7 @@ class Change:
 
     @property
     def fails_now(self) -> bool:
-        return self.now is not None and self.now != "PASS"
+        return self.now is not None and self.now != RunVerdict.PASS
 
     def as_json(self) -> dict[str, Any]:
         return {

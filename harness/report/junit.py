@@ -20,7 +20,7 @@ from pathlib import Path
 
 from harness.atomic_write import relative_path, write_atomically
 from harness.judge.records import RunResult
-from harness.report.summary import verdict_of
+from harness.judge.verdicts import RunVerdict, verdict_of
 from harness.safe_text import DIAGNOSTICS_LIMIT, TEXT_LIMIT, clip, for_xml
 
 MAX_LISTED_FAILURES = 50
@@ -50,8 +50,8 @@ def junit_xml(
     if artifacts is not None and len(artifacts) != len(results):
         raise ValueError("junit_xml: one artifacts mapping per result")
     verdicts = [verdict_of(r) for r in results]  # the table's words: FAIL and ERROR as there
-    failures = verdicts.count("FAIL")
-    errors = verdicts.count("ERROR")
+    failures = verdicts.count(RunVerdict.FAIL)
+    errors = verdicts.count(RunVerdict.ERROR)
     root = ET.Element("testsuites")
     node = ET.SubElement(
         root,
@@ -90,7 +90,7 @@ def junit_xml(
         if r.not_run:
             ET.SubElement(case, "skipped", message=_x(r.error or "not run"))
             continue
-        kind = "failure" if verdicts[i] == "FAIL" else "error"
+        kind = "failure" if verdicts[i] is RunVerdict.FAIL else "error"
         lines = [_x(t.verdict.explanation) for t in r.failed_ticks[:MAX_LISTED_FAILURES]]
         if len(r.failed_ticks) > MAX_LISTED_FAILURES:
             lines.append(f"... and {len(r.failed_ticks) - MAX_LISTED_FAILURES} more failed ticks")

@@ -18,7 +18,7 @@ import numpy as np
 
 from harness.atomic_write import write_atomically
 from harness.judge.records import RunResult
-from harness.report.summary import verdict_of
+from harness.judge.verdicts import verdict_of
 from harness.safe_text import visible
 
 __all__ = ["AS_WRITTEN", "PlotSeries", "draw_text", "plot_series", "render_plot", "write_plot"]

@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING, Any
 
 from harness import __version__
 from harness.judge.records import RunResult, TickRecord
+from harness.judge.verdicts import verdict_of
 from harness.safe_text import for_storage
 
 if TYPE_CHECKING:
@@ -30,19 +31,9 @@ __all__ = [
     "scenario_details",
     "scenario_entry",
     "tick_entry",
-    "verdict_of",
 ]
 
 FORMAT = 1  # bump when a key changes meaning or disappears (docs/reports.md)
-
-
-def verdict_of(result: RunResult) -> str:
-    """PASS, FAIL (an answer was wrong), ERROR (the run broke, no answer was wrong) or NOT RUN."""
-    if result.ok:
-        return "PASS"
-    if result.not_run:
-        return "NOT RUN"
-    return "ERROR" if result.broken else "FAIL"
 
 
 def _number(x: float | None) -> float | str | None:

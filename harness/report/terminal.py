@@ -16,9 +16,10 @@ from rich.table import Table
 from rich.text import Text
 
 from harness.judge.records import RunResult
+from harness.judge.verdicts import RunVerdict, verdict_of
 from harness.report.baseline import KINDS
 from harness.report.console_text import print_safe
-from harness.report.summary import alignment_fails, passed_line, verdict_of
+from harness.report.summary import alignment_fails, passed_line
 from harness.safe_text import DIAGNOSTICS_LIMIT, clip, for_terminal
 from harness.scenario.schema import Scenario
 
@@ -27,7 +28,12 @@ if TYPE_CHECKING:
     from harness.report.baseline import Comparison
 
 DIAGNOSTIC_LINES = 15
-VERDICT_STYLES = {"PASS": "green", "FAIL": "red", "ERROR": "red", "NOT RUN": "yellow"}
+VERDICT_STYLES = {
+    RunVerdict.PASS: "green",
+    RunVerdict.FAIL: "red",
+    RunVerdict.ERROR: "red",
+    RunVerdict.NOT_RUN: "yellow",
+}
 CHANGE_STYLES = {"regressed": "bold red", "fixed": "green", "still failing": "yellow"}
 
 

@@ -27,8 +27,9 @@ from rich.table import Table
 from rich.text import Text
 
 from harness.judge.records import RunResult, TickRecord
+from harness.judge.verdicts import verdict_of
 from harness.report.console_text import print_safe
-from harness.report.summary import passed_line, verdict_of
+from harness.report.summary import passed_line
 from harness.report.terminal import VERDICT_STYLES
 from harness.safe_text import DIAGNOSTICS_LIMIT, clip, for_terminal
 

@@ -13,8 +13,8 @@ from harness.grading.hidden import HiddenScenario, hidden_run, scrub_text
 from harness.grading.roster import parse_roster
 from harness.grading.scoring import ScenarioScore, ScorePlan
 from harness.judge.records import RunResult
+from harness.judge.verdicts import verdict_of
 from harness.links.base import LinkOptions
-from harness.report.summary import verdict_of
 from harness.runner.settings import RunSettings
 
 PLAN = ScorePlan(

@@ -50,7 +50,7 @@ def run_with(name: str, scenario: str = "approach_wall", timeout: float = 1.0):
 )
 def test_a_function_that_ends_or_raises_is_an_error_at_its_tick(name: str, phrase: str) -> None:
     """The run ends at tick 0 as an ERROR naming what the function did; no pass."""
-    from harness.report.summary import verdict_of
+    from harness.judge.verdicts import verdict_of
 
     result = run_with(name)
     assert not result.ok
