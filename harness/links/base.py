@@ -52,6 +52,9 @@ class LinkOptions:
     # Serial links: how the device sits on the robot (None: what the robot model says;
     # the runner fills it in).
     lidar_mount: LidarMount | None = None
+    # A missed deadline ends the run (RunSettings.stop_at_first_failure): no wait for the
+    # late answer to keep it from the next scan, as no next scan goes (the runner sets it).
+    late_ends_run: bool = False
 
 
 class Link(ABC):

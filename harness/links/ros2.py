@@ -479,8 +479,13 @@ class Ros2Link(Link):
         obs, topic = self.observer, self.options.warning_topic
         if obs.heard_since("warning", first_ns):
             return
-        if obs.warning_publishers() == 0 and obs.node.count_publishers(topic) == 0:
-            return  # no Bool writer in sight, even now: the node has none
+        bool_writers = [
+            info
+            for info in obs.node.get_publishers_info_by_topic(topic)
+            if info.topic_type == BOOL_TYPE
+        ]
+        if obs.warning_publishers() == 0 and not bool_writers:
+            return  # no Bool writer in sight, even now (another type is named elsewhere)
         self._wait_for(lambda: obs.heard_since("warning", first_ns), self.options.scan_timeout)
 
     def _copy(self, n: int) -> None:
@@ -774,7 +779,8 @@ class Ros2Link(Link):
         if outcome == "timeout":
             answers.timed_out = True
             outcome = None
-            if silence is None and not (self.options.realtime or may_be_ignored):
+            opts = self.options
+            if silence is None and not (opts.realtime or may_be_ignored or opts.late_ends_run):
                 # The node is behind. Let it catch up before the next scan, or its
                 # answer to this scan would be taken for an answer to the next one.
                 outcome = self._wait_for(status_in, max(CATCH_UP_S, 3 * timeout))

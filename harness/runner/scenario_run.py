@@ -170,10 +170,16 @@ def closed(result: RunResult, link: Link, waited: float) -> None:
 def scenario_options(
     scenario: Scenario, options: LinkOptions, settings: RunSettings, link_name: str = ""
 ) -> LinkOptions:
-    """The link options for one scenario: its threshold, its LIDAR's rate and, on a link
-    that publishes the scans itself, the node's topics it names (`node_topic_options`)."""
+    """The link options for one scenario: its threshold, its LIDAR's rate, whether a missed
+    deadline ends it and, on a link that publishes the scans itself, the node's topics it
+    names (`node_topic_options`)."""
     threshold = effective_threshold(scenario, settings)
-    options = replace(options, threshold=threshold, scan_rate_hz=scenario.lidar_spec.rate_hz)
+    options = replace(
+        options,
+        threshold=threshold,
+        scan_rate_hz=scenario.lidar_spec.rate_hz,
+        late_ends_run=settings.stop_at_first_failure,
+    )
     if link_name and link_class(link_name).sets_node_topics:
         options = node_topic_options(scenario, options)
     return options

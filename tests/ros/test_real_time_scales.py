@@ -131,3 +131,22 @@ def test_a_suite_whose_third_node_cannot_start_keeps_what_was_judged(tmp_path: P
     summary = json.loads((out / "summary.json").read_text())
     verdicts = [entry["verdict"] for entry in summary["scenarios"]]
     assert verdicts == ["PASS", "PASS", "ERROR", "NOT RUN"]
+
+
+def test_a_run_that_ends_at_its_first_failure_does_not_wait_for_the_late_answer() -> None:
+    """With stop_at_first_failure (the audit's mistakes), a missed deadline ends the run:
+    the link does not wait on (catch up) for the late answer, which only kept it from
+    being taken for the next scan's, and no next scan goes."""
+    from harness.links.base import LinkOptions
+    from harness.runner.scenario_run import run
+    from harness.runner.settings import RunSettings
+    from harness.scenario.files import resolve_scenario
+
+    slow_second = (f"{student('correct')} --ros-args -p delay_s:=1.5 -p slow_scan:=2",)
+    options = LinkOptions(node=slow_second[0], scan_timeout=0.5)
+    settings = RunSettings(stop_at_first_failure=True)
+    result = run(resolve_scenario("approach_wall"), "ros2", options, settings)
+    assert result.stopped_early and len(result.records) == 2, result.first_failure
+    explanation = result.records[-1].verdict.explanation
+    assert "no status within the deadline (0.50 s)" in explanation
+    assert "it came after" not in explanation  # the catch-up would have heard it at 1.5 s
