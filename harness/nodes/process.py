@@ -41,6 +41,7 @@ STOP_WAIT_S = INT_GRACE_S + TERM_GRACE_S + 5.0 + 0.5 + 5.0 + 2.0
 POLL_S = 0.05
 TAIL_BYTES = 16384
 FORK_SERVER_SETTING = "FOSSBOT_HIL_FORK_SERVER"
+LAST_WORDS_S = 0.5  # after the node exited: for its output's readers to reach end of file
 LINE_CHARS = 300  # a longer line in a tail is cut (a flood may have no newlines)
 
 
@@ -391,11 +392,20 @@ class NodeProcess:
         output = self._outputs.get(which)
         return output.last_lines(lines) if output is not None else ""
 
+    def _last_words(self) -> None:
+        """Once the node has exited: let its output's readers take what is still in the
+        pipes (bounded: a process it left behind may hold them open), so its last stderr
+        lines are in the tail before a crash is explained. A loaded machine may not have
+        run the reader thread yet when the exit is seen."""
+        for output in self._outputs.values():
+            output.join(LAST_WORDS_S)
+
     def exit_summary(self, when: str = "") -> str:
         """`exited with code 1 <when>; last stderr: ...` for failure explanations."""
         code = self.returncode()
         if code is None:
             return "still running"
+        self._last_words()
         if code < 0:
             how = f"was killed by {signal_name(-code)}"
         else:
@@ -412,6 +422,7 @@ class NodeProcess:
         code = self.returncode()
         if code is None:
             return "is still running"
+        self._last_words()
         at = f" {when}" if when else ""
         if code < 0:
             how = f"crashed{at}: it was killed by {signal_name(-code)}"
