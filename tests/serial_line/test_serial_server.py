@@ -11,6 +11,7 @@ from dataclasses import dataclass
 from itertools import pairwise
 
 import pytest
+from deadlines import slowest_round_trip
 
 from harness.devices.protocol import DeviceDefaults
 from harness.errors import LinkError
@@ -275,6 +276,7 @@ def test_realtime_pacing_at_115200_baud(
     reader = Reader(board)
     dev = StandIn()
     dev.mode = "scan"
+    waking_before = slowest_round_trip()
     server = DeviceServer(dev, pty, mode="realtime", baudrate=115200, revolution_period_s=period)
     with server:
         reader.start()
@@ -314,7 +316,11 @@ def test_realtime_pacing_at_115200_baud(
     # holds back (a rehearsal's full suite read 25 % slow while the server kept its pace).
     assert abs(pacing.mean_rate_error_pct) < 20
     starts = [d.started_at for d in deliveries]
-    assert all(abs((b - a) - period) < 0.2 * period for a, b in pairwise(starts))
+    # A revolution starts when the server's thread wakes for its slot: late by as long as
+    # this machine keeps a woken thread from a core now (a round trip is two wake-ups).
+    woken = 2 * max(waking_before, slowest_round_trip())
+    spacing = [round(b - a, 3) for a, b in pairwise(starts)]
+    assert all(abs(s - period) < max(0.2 * period, woken) for s in spacing), (spacing, woken)
     assert stats.underruns <= 1 and stats.overrun_bytes == 0
 
 
