@@ -91,11 +91,15 @@ def _write_results(path: Path, entries: list[dict[str, Any]], **state: Any) -> N
 
 
 def link_options_from(data: dict[str, Any]) -> Any:
+    """The LinkOptions `write_job` wrote, as they were: JSON made each tuple a list
+    (params, launch, topic_params, board_commands) and the LIDAR mount a dict."""
+    from harness.lidar.mount import LidarMount
     from harness.links.base import LinkOptions
 
     known = {f.name for f in fields(LinkOptions)}
-    values = {k: v for k, v in data.items() if k in known}
-    values["params"] = tuple(values.get("params", ()))
+    values = {k: tuple(v) if isinstance(v, list) else v for k, v in data.items() if k in known}
+    if isinstance(values.get("lidar_mount"), dict):
+        values["lidar_mount"] = LidarMount(**values["lidar_mount"])
     return LinkOptions(**values)
 
 
