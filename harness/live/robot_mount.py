@@ -22,6 +22,7 @@ from harness.scenario.model_files import (
     robot_models_dir,
 )
 from harness.scenario.schema import Scenario
+from harness.scenario.urdf_chain import chain_to_root, joint_origin, joints_by_child
 
 
 @dataclass(frozen=True)
@@ -62,38 +63,15 @@ def _rpy_quaternion(roll: float, pitch: float, yaw: float) -> tuple[float, float
     return _multiply(_multiply(qz, qy), qx)
 
 
-def _three(text: str | None) -> tuple[float, float, float]:
-    parts = (text or "").split()
-    return (
-        (float(parts[0]), float(parts[1]), float(parts[2])) if len(parts) == 3 else (0.0, 0.0, 0.0)
-    )
-
-
-def _joint_placement(joint: ET.Element) -> Placement:
-    origin = joint.find("origin")
-    if origin is None:
-        return Placement()
-    return Placement(_three(origin.get("xyz")), _rpy_quaternion(*_three(origin.get("rpy"))))
-
-
 def lidar_placement(urdf: ET.Element, link: str) -> Placement:
     """Where `link` sits in the URDF's root link (the robot's base_footprint), joints at zero."""
     if link not in {element.get("name") for element in urdf.findall("link")}:
         raise ConfigError(f"robot.lidar_link: no link named {shown(link)!r} in the robot's URDF")
-    joint_to = {
-        child.get("link"): joint
-        for joint in urdf.findall("joint")
-        if (child := joint.find("child")) is not None
-    }
-    chain: list[ET.Element] = []
-    name: str | None = link
-    while name in joint_to and len(chain) < len(joint_to):  # a checked URDF is a tree
-        chain.append(joint_to[name])
-        parent = joint_to[name].find("parent")
-        name = parent.get("link") if parent is not None else None
+    joints = joints_by_child(urdf)
     placement = Placement()
-    for joint in reversed(chain):
-        placement = placement.then(_joint_placement(joint))
+    for child in reversed(chain_to_root(joints, link)[:-1]):  # from the root down
+        xyz, rpy = joint_origin(joints[child])
+        placement = placement.then(Placement(xyz, _rpy_quaternion(*rpy)))
     return placement
 
 

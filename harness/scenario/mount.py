@@ -32,6 +32,7 @@ from harness.lidar.mount import FORWARD, LidarMount
 from harness.safe_text import shown
 from harness.scenario.model_files import find_model_file, parse_xml, robot_models_dir
 from harness.scenario.schema import DEFAULT_DEVICE_LINK, Scenario
+from harness.scenario.urdf_chain import chain_to_root, joint_origin, joints_by_child, parent_link
 
 __all__ = ["TILT_TOLERANCE_DEG", "lidar_mount", "scenario_mount", "urdf_mount"]
 
@@ -59,26 +60,8 @@ def _rpy(roll: float, pitch: float, yaw: float) -> np.ndarray:
 
 def _joint_rotation(joint: ET.Element) -> np.ndarray:
     """The rotation of a joint's child frame in its parent's (its origin's rpy)."""
-    origin = joint.find("origin")
-    text = (origin.get("rpy") if origin is not None else None) or "0 0 0"
-    try:
-        roll, pitch, yaw = (float(v) for v in text.split())
-    except ValueError:  # model_files.check_model_file refuses these first
-        raise ConfigError(f"joint {joint.get('name')!r}: rpy is not 3 numbers") from None
-    return _rpy(roll, pitch, yaw)
-
-
-def _parent_link(joint: ET.Element) -> str:
-    parent = joint.find("parent")
-    return parent.get("link", "") if parent is not None else ""
-
-
-def _chain(parents: dict[str, ET.Element], link: str) -> list[str]:
-    """`link` and its ancestors up to the root (bounded: a loop ends it)."""
-    chain = [link]
-    while chain[-1] in parents and len(chain) <= len(parents):
-        chain.append(_parent_link(parents[chain[-1]]))
-    return chain
+    _, rpy = joint_origin(joint)
+    return _rpy(*rpy)
 
 
 def _down_to(
@@ -91,7 +74,7 @@ def _down_to(
         rotation = _joint_rotation(joint) @ rotation
         if joint.get("type") != "fixed":
             moving = f"{joint.get('type')} joint {joint.get('name')!r}"
-        link = _parent_link(joint)
+        link = parent_link(joint)
     return rotation, moving
 
 
@@ -110,13 +93,10 @@ def urdf_mount(
     scan, device = repr(shown(scan_link, 100)), repr(shown(device_link, 100))
     if scan_link not in links:
         raise ConfigError(f"robot.lidar_link: no link named {scan} in {model}")
-    parents: dict[str, ET.Element] = {}
-    for joint in root.findall("joint"):
-        child, parent = joint.find("child"), joint.find("parent")
-        if child is not None and parent is not None:
-            parents.setdefault(child.get("link", ""), joint)
+    parents = joints_by_child(root)
     what = f"robot.lidar_device_link: {device} in {model}"
-    scan_chain, device_chain = _chain(parents, scan_link), _chain(parents, device_link)
+    scan_chain = chain_to_root(parents, scan_link)
+    device_chain = chain_to_root(parents, device_link)
     common = next((link for link in scan_chain if link in device_chain), None)
     if common is None:
         raise ConfigError(f"{what} is not joined to {scan}")
