@@ -40,6 +40,23 @@ motion:
 threshold: 0.5
 """
 
+# drive_past_10m in about 15 ticks: a wall behind, driven away from until beyond range_max
+# (2 m here): its warning must clear, and then nothing is in range.
+DRIVE_AWAY = """\
+description: Start near a wall and drive away beyond range_max, where every beam reads +inf.
+lidar:
+  preset: gazebo
+  range_max: 2.0
+obstacles:
+  - {type: wall, start: [-0.4, -3.0], end: [-0.4, 3.0], thickness: 0.1}
+motion:
+  segments:
+    - linear: 2.0
+      until: {distance: 2.5}
+    - until: {duration: 0.5}
+threshold: 0.5
+"""
+
 
 def nothing_in_range() -> str:
     """out_of_range with a sixth of its turn: every beam +inf, a few ticks."""

@@ -269,9 +269,9 @@ class Ros2Link(Link):
             if gone:
                 raise LinkError(gone)
             expired = time.monotonic() >= deadline or elsewhere.settled()
-            self._gave_up_early_s = elsewhere.gave_up_after
             self._check_types(named_only=not expired)
             if expired:
+                self._gave_up_early_s = elsewhere.gave_up_after
                 raise NeverReady(self._never_ready())
             if self._clock_before_ready() and time.monotonic() >= clock_due:
                 self.observer.publish_clock(0.0)  # a node may wait for /clock before it subscribes

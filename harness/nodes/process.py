@@ -201,6 +201,7 @@ class NodeProcess:
         self._stop_requested = False
         self.started_at = 0.0  # monotonic: when `start` set it on its way
         self._start_pending = False  # started without waiting: `await_started` waits
+        self._last_words_read = False  # `_last_words` has waited for the output's end
         self.how = "started as a command"  # how `start` started it, for the user
 
     def start(self, *, wait: bool = True) -> None:
@@ -396,9 +397,13 @@ class NodeProcess:
         """Once the node has exited: let its output's readers take what is still in the
         pipes (bounded: a process it left behind may hold them open), so its last stderr
         lines are in the tail before a crash is explained. A loaded machine may not have
-        run the reader thread yet when the exit is seen."""
+        run the reader thread yet when the exit is seen. Once, within one bound."""
+        if self._last_words_read:
+            return
+        self._last_words_read = True
+        end = time.monotonic() + LAST_WORDS_S
         for output in self._outputs.values():
-            output.join(LAST_WORDS_S)
+            output.join(max(0.0, end - time.monotonic()))
 
     def exit_summary(self, when: str = "") -> str:
         """`exited with code 1 <when>; last stderr: ...` for failure explanations."""

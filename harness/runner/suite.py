@@ -94,7 +94,7 @@ def run_suite(
                         body_opens=True,
                     )
                 except ConfigError as err:
-                    if not results and index == 0:
+                    if index == 0:
                         raise  # found before anything ran: a usage error (exit 2)
                     # Scenarios were judged: they keep their rows, this one says why.
                     result = not_started_as(scenario, link_name, settings)(

@@ -25,26 +25,12 @@ from grading_class import (
     script_student,
     snapshot,
 )
-from short_scenarios import NEAR_WALL, nothing_in_range
+from short_scenarios import DRIVE_AWAY, NEAR_WALL, nothing_in_range
 
 pytestmark = [pytest.mark.ros, pytest.mark.slow, pytest.mark.timeout(240)]
 
 # The lab's scenarios in 46 ticks instead of 293: what costs is each student's build and
 # nodes, not the ticks. Each still catches what its lab scenario does.
-DRIVE_AWAY = """\
-description: Start near a wall and drive away beyond range_max, where every beam reads +inf.
-lidar:
-  preset: gazebo
-  range_max: 2.0
-obstacles:
-  - {type: wall, start: [-0.4, -3.0], end: [-0.4, 3.0], thickness: 0.1}
-motion:
-  segments:
-    - linear: 2.0
-      until: {distance: 2.5}
-    - until: {duration: 0.5}
-threshold: 0.5
-"""
 OUT_OF_RANGE = "nothing_in_range"  # out_of_range, a sixth of its turn
 LAB_SCENARIOS = ("wall_ahead", "drive_away", OUT_OF_RANGE)
 

@@ -12,26 +12,11 @@ from pathlib import Path
 import pytest
 from command_line import COMMAND
 from grading_class import STUDENT_NODE, patch
-from short_scenarios import NEAR_WALL, nothing_in_range
+from short_scenarios import DRIVE_AWAY, NEAR_WALL, nothing_in_range
 
 pytestmark = [pytest.mark.ros, pytest.mark.slow, pytest.mark.timeout(300)]
 
 DELAY_S = 0.3  # a scan's callback, before it answers
-# drive_past_10m in about 15 ticks: its warning must clear, and then nothing is in range.
-DRIVE_AWAY = """\
-description: Start near a wall and drive away beyond range_max, where every beam reads +inf.
-lidar:
-  preset: gazebo
-  range_max: 2.0
-obstacles:
-  - {type: wall, start: [-0.4, -3.0], end: [-0.4, 3.0], thickness: 0.1}
-motion:
-  segments:
-    - linear: 2.0
-      until: {distance: 2.5}
-    - until: {duration: 0.5}
-threshold: 0.5
-"""
 SCENARIOS = {"wall_ahead": NEAR_WALL, "drive_away": DRIVE_AWAY, "clear": nothing_in_range()}
 
 
