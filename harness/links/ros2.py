@@ -31,7 +31,6 @@ from __future__ import annotations
 
 import contextlib
 import time
-from collections import deque
 from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -47,6 +46,7 @@ from harness.links.topic_advice import (
     topics_elsewhere,
     untaken_topic_parameter,
 )
+from harness.links.watchdogs import FloodWatch, SilenceWatch, Topics, strangers_problem
 from harness.nodes.command import (
     NodeCommand,
     node_arguments,
@@ -70,7 +70,6 @@ if TYPE_CHECKING:  # numpy and rclpy are imported when the first link starts, af
 POLL_S = 0.05  # longest single spin; liveness of the node is checked this often
 READY_POLL_S = 0.005  # spins while waiting for the graph, whose changes wake no spin
 MIN_GRACE_S = 0.002  # wait for a Bool after the String while the order is unknown
-STOPPED_AFTER = 3  # consecutive missed deadlines end the run
 WARM_UP_RETRY_S = 0.5  # resend the first scan (or a warm-up scan) this often until answered
 BOOL_DISCOVERY_S = 0.25  # before the first scan: for a Bool writer the graph does not show yet
 FIRST_RETRY_MAX_S = 2.0  # the first scan's resends back off up to this interval
@@ -78,10 +77,6 @@ FIRST_RETRY_MAX_S = 2.0  # the first scan's resends back off up to this interval
 # a participant that never names itself (no ROS node) is sent its first scan after this.
 NAMED_WAIT_S = 0.5
 CATCH_UP_S = 2.0  # after a missed deadline, wait this long (at least) for the late answer
-FLOOD_SCANS = 5  # a flood is judged over this many recent scans, in which a topic carried
-FLOOD_PER_SCAN = 5  # more than this many messages a scan,
-FLOOD_MIN = 30  # this many at least,
-FLOOD_RATE_HZ = 200.0  # and this many a second (a 10 Hz timer during long waits is no flood)
 LOUD_BYTES = 1 << 20  # a node that wrote more than this is told how much, in the diagnostics
 
 
@@ -169,18 +164,14 @@ class Ros2Link(Link):
         self._delay = 0.0  # seconds the next scan is held (link fault)
         self._bool_first_seen = 0
         self._bool_after_gap = 0.0  # longest String -> Bool gap seen, seconds
-        self._silent_scans = 0
-        self._silent_empty = 0  # of those, scans with no valid return
-        self._silent_bools = 0  # Bools the node published for them (so it is not stuck)
-        self._answered_empty = False  # the node answered a scan with no valid return
-        self._late_in_streak: tuple[int, float] | None = None  # (tick, after) of a late answer
+        o = options
+        topics = Topics(self.command.description, o.scan_topic, o.status_topic, o.warning_topic)
+        self._silence = SilenceWatch(topics, options.scan_timeout)
+        self._flood = FloodWatch(options.status_topic, options.warning_topic)
         self._copies = 1  # copies of the scan just sent (the first one is resent until answered)
         self._alive_until = 0.0  # perf_counter until which the node counts as running
-        self._counted = (0, 0)  # statuses and Bools heard, all told, when the last collect ended
         self._warmed_up = False
         self._notes: list[str] | None = None  # notices(), taken once
-        # (statuses, Bools, seconds) of each recent exchange, for flood checks
-        self._recent: deque[tuple[int, int, float]] = deque(maxlen=FLOOD_SCANS)
         self.startup_s = 0.0
         self._started = False
         self._start_error: Exception | None = None
@@ -404,7 +395,7 @@ class Ros2Link(Link):
         obs, opts = self.observer, self.options
         self._await_bool_writer()  # its first Bool must reach us
         bool_matched = obs.warning_publishers() > 0
-        self._counted = (obs.heard["status"], obs.heard["warning"])
+        self._flood.restart(obs.heard["status"], obs.heard["warning"])
         first_at = time.perf_counter()
         deadline = first_at + opts.ready_timeout
         first_ns = time.time_ns()
@@ -561,7 +552,7 @@ class Ros2Link(Link):
         self._wait_for(lambda: False, self._grace())  # the answer's Bool, if any
         obs.drain()
         obs.inbox.clear()
-        self._counted = (obs.heard["status"], obs.heard["warning"])
+        self._flood.restart(obs.heard["status"], obs.heard["warning"])
         self._warmed_up = True
 
     def stop(self) -> None:
@@ -811,23 +802,17 @@ class Ros2Link(Link):
         if silence is not None and answers.problem is None:
             answers.problem, answers.silent = silence, True
         elif not (may_be_ignored and answers.timed_out):  # a node may skip such a scan
-            self._watch_silence(answers, tick, empty=not scan.valid_mask().any())
-        self._watch_flood(answers)
+            self._silence.see(answers, tick, empty=not scan.valid_mask().any())
+        heard = self.observer.heard
+        self._flood.see(
+            answers, heard["status"], heard["warning"], time.perf_counter() - self._sent_at
+        )
         return answers
 
     def _strangers(self) -> str | None:
-        """Why a scan got several answers, when it is not the node's doing: someone else
-        in this run's domain (then the run is the harness's problem, not the node's)."""
         assert self.observer is not None
-        crowd = self.observer.strangers()
-        if not crowd:
-            return None
-        domain = f" ({self.domain.domain_id})" if self.domain is not None else ""
-        return (
-            f"another ROS node shares this run's domain{domain}: {crowd}; "
-            "the answers cannot be told apart (a node left running by an earlier run, or "
-            "one started with this ROS_DOMAIN_ID)"
-        )
+        domain_id = self.domain.domain_id if self.domain is not None else None
+        return strangers_problem(self.observer.strangers(), domain_id)
 
     def _one_answer_of_the_copies(self, answers: Answers) -> None:
         """The first scan went out several times: keep the first copy's answer (the node saw
@@ -841,33 +826,6 @@ class Ros2Link(Link):
         """Has the status answering the scan just sent arrived?"""
         assert self.observer is not None
         return self.observer.heard_since("status", self._sent_ns)
-
-    def _watch_flood(self, answers: Answers) -> None:
-        """End the run when the node publishes far more than one message a scan on a topic."""
-        assert self.observer is not None
-        heard = self.observer.heard
-        statuses, bools = heard["status"], heard["warning"]
-        self._recent.append(
-            (
-                statuses - self._counted[0],
-                bools - self._counted[1],
-                time.perf_counter() - self._sent_at,
-            )
-        )
-        self._counted = (statuses, bools)
-        if answers.problem is not None:
-            return
-        seconds = sum(recent[2] for recent in self._recent)
-        topics = (self.options.status_topic, self.options.warning_topic)
-        for which, topic in enumerate(topics):
-            count = sum(recent[which] for recent in self._recent)
-            many = count >= FLOOD_MIN and count > FLOOD_PER_SCAN * len(self._recent)
-            if many and count >= FLOOD_RATE_HZ * seconds:
-                answers.problem = (
-                    f"node floods {topic}: {count} messages in {seconds:.2f} s over the last "
-                    f"{len(self._recent)} scans (one per scan expected)"
-                )
-                return
 
     def _sort(self, answers: Answers, heard: Iterable[Heard], mine) -> None:
         """Split what arrived into this scan's answers and late ones; learn the Bool order."""
@@ -924,58 +882,3 @@ class Ros2Link(Link):
 
     def _settled(self) -> None:
         """Hook: what `settle` heard is in the inbox, before its answers get their ticks."""
-
-    def _watch_silence(self, answers: Answers, tick: int, *, empty: bool = False) -> None:
-        """End the run when the node misses its deadline on several scans in a row
-        (`empty`: this scan had no valid return)."""
-        if not answers.timed_out:
-            self._silent_scans = self._silent_empty = self._silent_bools = 0
-            self._late_in_streak = None
-            self._answered_empty = self._answered_empty or (empty and bool(answers.statuses))
-            return
-        self._silent_scans += 1
-        self._silent_empty += empty
-        self._silent_bools += sum(
-            1 for r in answers.late if r.tick == tick and isinstance(r.value, bool)
-        )
-        came_late = [r for r in answers.late if r.tick == tick and isinstance(r.value, str)]
-        if came_late:
-            self._late_in_streak = (tick, came_late[0].after)
-        if self._silent_scans < STOPPED_AFTER or answers.problem is not None:
-            return
-        deadline = f"the {self.options.scan_timeout:g} s deadline"
-        if came_late:
-            answers.problem = (
-                f"node answers too late: {self._silent_scans} scans in a row missed {deadline} "
-                f"(the last answer came after {came_late[0].after:.2f} s)"
-            )
-        elif self._late_in_streak is not None:
-            # Slow, not stopped: an earlier scan of the streak was answered, late, and this
-            # one's answer had not come when the harness stopped waiting for it.
-            late_tick, after = self._late_in_streak
-            answers.problem = (
-                f"node answers too late: {self._silent_scans} scans in a row missed {deadline} "
-                f"(tick {late_tick}'s answer came after {after:.2f} s; the last scan's had not "
-                "come when the harness stopped waiting)"
-            )
-        elif self._silent_empty == self._silent_scans and not self._answered_empty:
-            answers.problem = (
-                f"node {self.command.description} is running and subscribed to "
-                f"{self.options.scan_topic} but published nothing on {self.options.status_topic} "
-                f"for {self._silent_scans} scans in a row, none of which had a valid return: a "
-                'status is expected when nothing is in range too (e.g. "no obstacle")'
-            )
-        elif self._silent_bools:
-            answers.problem = (
-                f"node stopped answering: no status on {self.options.status_topic} for "
-                f"{self._silent_scans} scans in a row, though it published "
-                f"{self.options.warning_topic} for them (it is running and not stuck in a "
-                "callback: its status is not published for every scan)"
-            )
-        else:
-            answers.problem = (
-                f"node stopped answering: no status on {self.options.status_topic} for "
-                f"{self._silent_scans} scans in a row (the node is still running: stuck in a "
-                "callback, or not publishing)"
-            )
-        answers.silent = True  # the node runs: its silence is its verdict
