@@ -6,13 +6,28 @@
 - ``rplidar``, ``ldlidar``: a board's driver reading an emulated device on a
   serial line (``board``), its nodes answering over ROS 2.
 
-Each link lives in its own module here and registers itself by name with
-``@register``; ``create_link("ros2", options)`` imports ``harness.links.ros2``
-on demand, so the pure parts of the harness never import rclpy or pyserial.
-A new link is a new module with a ``Link`` subclass (``base``); a module that
-several links share is named in ``base.HELPER_MODULES``.
+What each link is (runs a node, uses a serial line, which device) is
+declared once, in ``kinds``: a table that imports nothing, from which every
+list of links the commands and the pytest plugin show is derived. Each
+link's class lives in its own module here and registers itself by name with
+``@register``, checked against its row; ``create_link("ros2", options)``
+imports ``harness.links.ros2`` on demand, so the pure parts of the harness
+never import rclpy or pyserial. A new link is a row in ``kinds`` and a new
+module with a ``Link`` subclass (``base``); one from outside the harness
+calls ``kinds.declare``.
 """
 
-from harness.links.base import Link, LinkOptions, create_link, known_links, register
+from harness import lazy_exports
 
-__all__ = ["Link", "LinkOptions", "create_link", "known_links", "register"]
+_EXPORTS = {
+    "Link": "base",
+    "LinkOptions": "base",
+    "create_link": "base",
+    "known_links": "base",
+    "register": "base",
+    "LinkKind": "kinds",
+    "declare": "kinds",
+    "link_kind": "kinds",
+}
+__all__ = sorted(_EXPORTS)
+__getattr__ = lazy_exports(__name__, _EXPORTS)

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import importlib
-import pkgutil
 import time
 from abc import ABC, abstractmethod
 from collections.abc import Callable
@@ -12,6 +11,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, ClassVar, TypeVar
 
 from harness.errors import ConfigError
+from harness.links.kinds import link_kind, link_names
 from harness.nodes.setup_problems import is_ros_module
 
 if TYPE_CHECKING:  # naming the links and their options needs none of these (nor numpy)
@@ -171,12 +171,19 @@ L = TypeVar("L", bound=type[Link])
 
 
 def register(name: str) -> Callable[[L], L]:
-    """Class decorator: make a link available under `name` (once)."""
+    """Class decorator: make a link available under `name` (once), as ``kinds`` declares
+    it: a class whose own ClassVars say otherwise than its row is refused."""
 
     def decorate(cls: L) -> L:
         known = _REGISTRY.get(name)
         if known is not None and _where(known) != _where(cls):  # a re-import may replace it
             raise RuntimeError(f"link {name!r} is registered twice")
+        kind = link_kind(name)
+        if cls.serial_line != kind.serial_line:
+            raise RuntimeError(
+                f"link {name!r}: the class says serial_line={cls.serial_line}, "
+                f"harness.links.kinds says {kind.serial_line}"
+            )
         cls.name = name
         _REGISTRY[name] = cls
         return cls
@@ -188,17 +195,9 @@ def _where(cls: type[Link]) -> str:
     return f"{cls.__module__}.{cls.__qualname__}"
 
 
-# Modules of this package that are not links themselves: the contract, and
-# what several links share.
-HELPER_MODULES = ("base", "board", "board_session", "processor_child")
-
-
 def known_links() -> list[str]:
-    """Names of the link modules shipped in this package."""
-    import harness.links as package
-
-    found = pkgutil.iter_modules(package.__path__)
-    return sorted(m.name for m in found if m.name not in HELPER_MODULES)
+    """Names of the links the harness knows (``kinds``), sorted."""
+    return link_names()
 
 
 def create_link(name: str, options: LinkOptions, session: Any = None) -> Link:
@@ -209,12 +208,11 @@ def create_link(name: str, options: LinkOptions, session: Any = None) -> Link:
 
 
 def link_class(name: str) -> type[Link]:
-    """The class registered as `name`, importing its module on first use."""
+    """The class registered as `name`, importing its module (``kinds``) on first use."""
     if name not in _REGISTRY:
-        if name not in known_links():
-            raise ConfigError(f"unknown link {name!r} (known: {', '.join(known_links())})")
+        kind = link_kind(name)  # ConfigError naming the known ones
         try:
-            importlib.import_module(f"harness.links.{name}")
+            importlib.import_module(kind.module)
         except ImportError as err:
             hint = ""
             if is_ros_module(err.name or ""):
@@ -223,4 +221,6 @@ def link_class(name: str) -> type[Link]:
                     " or source ROS 2 Jazzy)"
                 )
             raise ConfigError(f"link {name!r} cannot start: {err}{hint}") from None
+        if name not in _REGISTRY:
+            raise RuntimeError(f"{kind.module} registers no link {name!r}")
     return _REGISTRY[name]
