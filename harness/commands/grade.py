@@ -49,7 +49,7 @@ if TYPE_CHECKING:  # imported when grading starts (the parser is built for any c
 NAME = "grade"
 HELP = "build and test every student's node in DIR; write the class table (CSV, HTML)"
 
-NODE_LINKS = ("ros2", "rplidar", "ldlidar")  # the links that start a node
+NODE_LINKS = importlib.import_module("harness.links.kinds").node_links()  # start a node
 NOT_FOR_GRADING = {
     "node": "each student's node comes from their folder",
     "workspace": "each student's folder is built into --out",

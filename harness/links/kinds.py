@@ -108,8 +108,9 @@ def link_kind(name: str) -> LinkKind:
 
 
 def node_links() -> list[str]:
-    """The links that start a node (grade, audit: a student's code is a node)."""
-    return [name for name in link_names() if KINDS[name].runs_node]
+    """The links that start a node (grade, audit: a student's code is a node), in
+    declaration order."""
+    return [kind.name for kind in KINDS.values() if kind.runs_node]
 
 
 def serial_links() -> list[str]:
