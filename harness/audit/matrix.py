@@ -20,10 +20,12 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any, Protocol
 
+from harness.judge.verdicts import RunVerdict
+
 __all__ = ["CONTROL_NOT_RUN", "Flip", "KillMatrix", "kill_matrix"]
 
-FAILED = ("FAIL", "ERROR")
-NOT_RUN = "NOT RUN"
+FAILED = (RunVerdict.FAIL, RunVerdict.ERROR)
+NOT_RUN = RunVerdict.NOT_RUN
 # why a mutant that failed only where the correct node could not run is not judged
 CONTROL_NOT_RUN = "the correct node could not run it"
 
@@ -106,11 +108,11 @@ def _control_failures(
     unjudged: set[str] = set()
     for scenario in scenarios:
         verdicts = control.verdicts(scenario)
-        if verdicts and all(v == "PASS" for v in verdicts):
+        if verdicts and all(v == RunVerdict.PASS for v in verdicts):
             continue
         why = control.first_failure(scenario) or control.error or "not run"
-        unsound[scenario] = f"{'/'.join(verdicts) or NOT_RUN}: {why}"
-        if not verdicts or any(v in ("ERROR", NOT_RUN) for v in verdicts):
+        unsound[scenario] = f"{'/'.join(verdicts) or NOT_RUN.value}: {why}"
+        if not verdicts or any(v in (RunVerdict.ERROR, NOT_RUN) for v in verdicts):
             unjudged.add(scenario)
     return unsound, unjudged
 

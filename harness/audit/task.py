@@ -21,6 +21,7 @@ from pathlib import Path
 from typing import Any
 
 from harness.audit.mutants import CONTROL
+from harness.judge.verdicts import RunVerdict
 from harness.links.base import LinkOptions
 from harness.runner.settings import RunSettings
 
@@ -85,13 +86,13 @@ class UnitResult:
         found = []
         for run in self.runs:
             entry = next((e for e in run["results"] if e["scenario"] == scenario), None)
-            found.append(entry["verdict"] if entry else "NOT RUN")
+            found.append(entry["verdict"] if entry else RunVerdict.NOT_RUN.value)
         return found
 
     def first_failure(self, scenario: str) -> str:
         for run in self.runs:
             for entry in run["results"]:
-                if entry["scenario"] == scenario and entry["verdict"] != "PASS":
+                if entry["scenario"] == scenario and entry["verdict"] != RunVerdict.PASS:
                     return str(entry.get("first_failure") or "")
         return ""
 
