@@ -12,6 +12,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from harness.bench.stage import StageResult
+from harness.links.kinds import INPROCESS, ROS2
 
 __all__ = [
     "GRADE_KEYS",
@@ -93,8 +94,8 @@ OVERHEAD_FORMULA = (
 _THROUGHPUT = {
     "raycast": "raycast",
     "synthesis": "synthesis",
-    "inprocess": "inprocess",
-    "ros2": "ros2_lockstep",
+    INPROCESS: INPROCESS,
+    ROS2: "ros2_lockstep",
     "serial": "serial_lockstep",
 }
 
@@ -145,7 +146,7 @@ def _extra(stage: StageResult | None, key: str) -> Any:
 def _children_peak_mb(stages: Mapping[str, StageResult]) -> float:
     """The most memory the processes of one link stage held at once (node, board driver)."""
     most = 0.0
-    for name in ("ros2", "serial"):
+    for name in (ROS2, "serial"):
         stage = stages.get(name)
         if stage is not None:
             peaks = (stage.extra.get("node_peak_rss_mb"), stage.extra.get("driver_peak_rss_mb"))
@@ -163,7 +164,7 @@ def figures(stages: Mapping[str, StageResult], harness_peak_rss_mb: float) -> di
     for stage_name, prefix in _THROUGHPUT.items():
         stage = stages.get(stage_name)
         out[f"{prefix}_scans_per_s"] = stage.scans_per_s if stage else None
-    raycast, ros2, serial = stages.get("raycast"), stages.get("ros2"), stages.get("serial")
+    raycast, ros2, serial = stages.get("raycast"), stages.get(ROS2), stages.get("serial")
     pacing, suite = stages.get("pacing"), stages.get("suite")
     out["raycast_truth_ms"] = _extra(raycast, "truth_ms")
     out["synthesis_harsh_scans_per_s"] = _extra(stages.get("synthesis"), "harsh_scans_per_s")
@@ -172,7 +173,7 @@ def figures(stages: Mapping[str, StageResult], harness_peak_rss_mb: float) -> di
     out["ros2_wait_ms_median"] = _extra(ros2, "wait_ms_median")
     out["ros2_scan_ms"] = ros2.scan_s * 1000.0 if ros2 else None
     out["overhead_ratio"] = _extra(ros2, "overhead_ratio")  # each round against its own floor
-    out["inprocess_cpu_ms_per_scan"] = _extra(stages.get("inprocess"), "cpu_ms_per_scan")
+    out["inprocess_cpu_ms_per_scan"] = _extra(stages.get(INPROCESS), "cpu_ms_per_scan")
     out["ros2_cpu_ms_per_scan"] = _extra(ros2, "cpu_ms_per_scan")
     out["ros2_node_cpu_ms_per_scan"] = _extra(ros2, "node_cpu_ms_per_scan")
     out["serial_cpu_ms_per_scan"] = _extra(serial, "cpu_ms_per_scan")

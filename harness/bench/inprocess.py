@@ -1,4 +1,4 @@
-"""Stage 'inprocess': the whole lockstep loop through the inprocess link, no ROS.
+"""The inprocess stage: the whole lockstep loop through the inprocess link, no ROS.
 
 Simulation, faults, the link, the oracle and the records. The reference
 logic runs in a child forked from the harness (as every processing
@@ -11,19 +11,20 @@ from __future__ import annotations
 from harness.bench.stage import StageResult, run_through, simulated_seconds
 from harness.bench.workload import Workload
 from harness.links.base import LinkOptions, create_link
+from harness.links.kinds import INPROCESS
 
 
 def measure_inprocess(workload: Workload) -> StageResult:
     """Scans per second through the inprocess link and the oracle."""
     options = LinkOptions(threshold=workload.threshold, scan_rate_hz=workload.scan_rate_hz)
-    link = create_link("inprocess", options)
+    link = create_link(INPROCESS, options)
     try:
         link.open()
         run = run_through(link, workload)
     finally:
         link.close()
     return StageResult(
-        "inprocess",
+        INPROCESS,
         len(run.result.records),
         run.seconds,
         simulated_seconds(run.result),

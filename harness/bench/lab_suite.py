@@ -33,6 +33,7 @@ from harness.bench.suite_commands import alternate, cli_wall_s
 from harness.bench.workload import Workload
 from harness.errors import HarnessError
 from harness.links.base import LinkOptions
+from harness.links.kinds import INPROCESS, ROS2
 from harness.runner.suite import run_suite
 from harness.scenario.files import shipped_scenarios
 from harness.scenario.schema import Scenario
@@ -54,7 +55,7 @@ def measure_suite(
     source, colcon = lab_package_source(), colcon_program()  # before anything is measured
     scenarios = list(workload.scenarios)
     started = time.perf_counter()
-    results = run_suite(scenarios, "ros2", LinkOptions())
+    results = run_suite(scenarios, ROS2, LinkOptions())
     seconds = time.perf_counter() - started
     scans = sum(len(r.records) for r in results)
     simulated = sum(r.records[-1].t + r.records[-1].scan.scan_time for r in results if r.records)
@@ -90,7 +91,7 @@ def _shipped_suite(
         {
             "suite": [*names],
             "student_suite": [*names, *workspace.run_args()],
-            "inprocess_suite": [*names, "--link", "inprocess"],
+            "inprocess_suite": [*names, "--link", INPROCESS],
         },
         runs,
     )
@@ -110,7 +111,7 @@ def _shipped_suite(
 def _split(prefix: str, node: str, scenarios: Sequence[Scenario], options: LinkOptions) -> Figures:
     """The suite in this process over ROS 2: what it waited for in series (all must pass)."""
     started = time.perf_counter()
-    results = run_suite(scenarios, "ros2", options)
+    results = run_suite(scenarios, ROS2, options)
     seconds = time.perf_counter() - started
     failed = [r for r in results if not r.ok]
     if failed:

@@ -1,4 +1,4 @@
-"""Stage 'ros2': lockstep with the bundled reference node in its own process over Fast DDS.
+"""The ros2 stage: lockstep with the bundled reference node in its own process over Fast DDS.
 
 The link is opened (node started, graph matched: ``node_startup_s``), the
 first scan is exchanged once untimed, then the workload's scans go through
@@ -24,6 +24,7 @@ from harness.bench.stage import LinkRun, StageResult, run_through, simulated_sec
 from harness.bench.stats import median, overhead_ratio, percentile
 from harness.bench.workload import Workload, prepared_frames
 from harness.links.base import Link, LinkOptions, create_link
+from harness.links.kinds import ROS2
 
 PING_PONGS = 100  # exchanges of one scan that give the round trip
 ROUNDS = 3  # ping-pong and timed run, this many times on one open link (the median kept)
@@ -219,4 +220,4 @@ def measure_ros2(workload: Workload, rounds: int = ROUNDS) -> StageResult:
     """The ros2 link: the harness publishes /scan to the node; each round measures its floor."""
     from harness.bench.raycast import measure_raycast
 
-    return measure_link("ros2", workload, rounds, floor=lambda: measure_raycast(workload).scan_s)
+    return measure_link(ROS2, workload, rounds, floor=lambda: measure_raycast(workload).scan_s)

@@ -18,6 +18,7 @@ from harness.bench.figures import OVERHEAD_FORMULA, check_targets, figures
 from harness.bench.stage import StageResult
 from harness.bench.workload import LAB_TRIO, Workload, lab_workload
 from harness.errors import ConfigError, HarnessError
+from harness.links.kinds import INPROCESS, ROS2
 
 
 @dataclass(frozen=True)
@@ -98,11 +99,11 @@ def _measure(name: str, plan: BenchPlan) -> StageResult:
         from harness.bench.synthesis import measure_synthesis
 
         return measure_synthesis(plan.workload)
-    if name == "inprocess":
+    if name == INPROCESS:
         from harness.bench.inprocess import measure_inprocess
 
         return measure_inprocess(plan.workload)
-    if name == "ros2":
+    if name == ROS2:
         from harness.bench.ros2_lockstep import measure_ros2
 
         return measure_ros2(plan.workload)

@@ -76,11 +76,12 @@ def _started(server: DeviceServer, count: int) -> Callable[[object], bool]:
 
 def measure_pacing(scenario: Scenario, seconds: float) -> StageResult:
     """Stream about `seconds` of revolutions in real time; the line's rate and jitter."""
-    from harness.devices.profiles import PROFILES
+    from harness.devices.profiles import profile as device_profile
+    from harness.links.kinds import default_serial_link, link_kind
     from harness.serial_line.ports import PtyPort
     from harness.serial_line.server import DeviceServer
 
-    profile = PROFILES["rplidar"]
+    profile = device_profile(str(link_kind(default_serial_link()).device))
     period = scenario.lidar_spec.scan_time
     count = max(3, math.ceil(seconds / period))
     device = profile.make_device(scenario.lidar_spec.rate_hz)

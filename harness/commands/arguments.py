@@ -21,7 +21,8 @@ from typing import TYPE_CHECKING
 
 from harness.errors import ConfigError
 from harness.lidar.mount import LidarMount, parse_mount
-from harness.links.base import LinkOptions, known_links
+from harness.links.base import LinkOptions
+from harness.links.kinds import default_link, either, link_kind, link_names, serial_links
 from harness.ros.names import (
     InvalidName,
     check_parameter_name,
@@ -34,8 +35,6 @@ from harness.ros.names import (
 if TYPE_CHECKING:
     from harness.runner.settings import RunSettings
 
-DEFAULT_LINK = "ros2"
-SERIAL_LINKS = ("rplidar", "ldlidar")
 NODE_OPTIONS = ("node", "package", "executable", "workspace")
 MAX_WAIT_S = 86400.0
 #: How every command shows a --faults value: a profile name or an inline fault, comma-separated.
@@ -398,14 +397,14 @@ def add_node_options(
 def add_link_option(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--link",
-        default=DEFAULT_LINK,
-        help=f"one of {', '.join(known_links())} (default {DEFAULT_LINK})",
+        default=default_link(),
+        help=f"one of {', '.join(link_names())} (default {default_link()})",
     )
 
 
 def add_device_options(parser: argparse.ArgumentParser) -> None:
     """Where the scans go besides ROS 2: a physical port, or a Python function."""
-    serial = parser.add_argument_group("serial links (rplidar, ldlidar)")
+    serial = parser.add_argument_group(f"serial links ({', '.join(serial_links())})")
     serial.add_argument(
         "--port",
         metavar="DEV",
@@ -431,7 +430,8 @@ def add_device_options(parser: argparse.ArgumentParser) -> None:
         "the FOSSBot v2's A1 has its zero to the right), forward (zero straight ahead), or "
         "DEG[,mirrored] (the device's zero, degrees counter-clockwise from forward)",
     )
-    inprocess = parser.add_argument_group("inprocess link")
+    functions = [name for name in link_names() if not link_kind(name).runs_node]
+    inprocess = parser.add_argument_group(f"{either(functions)} link")
     inprocess.add_argument(
         "--processor",
         metavar="MODULE:FUNCTION",
@@ -486,13 +486,15 @@ def check_link_options(args: argparse.Namespace) -> LinkOptions:
     mistakes, and topics and parameters must work (`link_options`)."""
     port = getattr(args, "port", None)
     processor = getattr(args, "processor", None)
+    kind = link_kind(args.link)
+    serial = f"--link {either(serial_links())}"
     if port is not None:
         check_port("--port", port)
-    if port and args.link not in SERIAL_LINKS:
-        raise ConfigError(f"--port needs --link rplidar or ldlidar, not {args.link}")
+    if port and not kind.serial_line:
+        raise ConfigError(f"--port needs {serial}, not {args.link}")
     board = getattr(args, "board_command", None)
-    if board and args.link not in SERIAL_LINKS:
-        raise ConfigError(f"--board-command needs --link rplidar or ldlidar, not {args.link}")
+    if board and not kind.serial_line:
+        raise ConfigError(f"--board-command needs {serial}, not {args.link}")
     if board and port:
         raise ConfigError(
             "--board-command runs the board's software on the virtual board; with --port the "
@@ -502,19 +504,21 @@ def check_link_options(args: argparse.Namespace) -> LinkOptions:
         from harness.links.board_session import check_board_commands
 
         check_board_commands(tuple(board))  # each program must exist: exit 2 now, not later
-    if getattr(args, "lidar_mount", None) is not None and args.link not in SERIAL_LINKS:
+    if getattr(args, "lidar_mount", None) is not None and not kind.serial_line:
         raise ConfigError(
-            f"--lidar-mount needs --link rplidar or ldlidar (the {args.link} link sends the "
-            "scan frame itself)"
+            f"--lidar-mount needs {serial} (the {args.link} link sends the scan frame itself)"
         )
-    if processor and args.link != "inprocess":
-        raise ConfigError(f"--processor needs --link inprocess (the {args.link} link runs a node)")
-    if args.link == "inprocess":
+    functions = [name for name in link_names() if not link_kind(name).runs_node]
+    if processor and kind.runs_node:
+        raise ConfigError(
+            f"--processor needs --link {either(functions)} (the {args.link} link runs a node)"
+        )
+    if not kind.runs_node:
         given = [f"--{name}" for name in NODE_OPTIONS if getattr(args, name)] + (
             ["--param"] if args.param else []
         )
         if given:
-            raise ConfigError(f"{given[0]} needs a link that runs a node, not --link inprocess")
+            raise ConfigError(f"{given[0]} needs a link that runs a node, not --link {args.link}")
     return link_options(args)
 
 

@@ -28,11 +28,11 @@ from harness.commands.arguments import (
 )
 from harness.commands.cluster_options import add_cluster_options, describe_cluster
 from harness.errors import ConfigError
+from harness.links.kinds import node_links
 from harness.report.console_text import print_safe as say
 
 NAME = "audit"
 HELP = "run a library of typical node mistakes through the suite: which does it catch?"
-NODE_LINKS = ("ros2", "rplidar", "ldlidar")
 REPEAT_SEED_BASE = 1000  # repeat k > 0 runs every scenario with seed 1000 + k
 
 
@@ -115,8 +115,8 @@ def run(args: argparse.Namespace, console: Console) -> int:
     if args.list:
         return _list(console)
     check_cluster_options(args.scheduler, args.workers)
-    if args.link not in NODE_LINKS:
-        raise ConfigError(f"--link {args.link}: audit runs nodes (use {', '.join(NODE_LINKS)})")
+    if args.link not in node_links():
+        raise ConfigError(f"--link {args.link}: audit runs nodes (use {', '.join(node_links())})")
     check_status_regex(args)
     mutants = _chosen_mutants(args.mutant)
     scenarios = selected_scenarios(args.scenarios)

@@ -14,13 +14,14 @@ import argparse
 from rich.console import Console
 
 from harness.commands.arguments import FAULTS_METAVAR, check_port, fault_list, lidar_mount, seed
+from harness.links.kinds import device_names
 
 NAME = "emulate"
 HELP = "serve a scenario's scans as a LIDAR device on a serial port"
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("device", choices=["rplidar", "ldlidar"], help="the LIDAR to emulate")
+    parser.add_argument("device", choices=device_names(), help="the LIDAR to emulate")
     parser.add_argument(
         "--scenario", required=True, metavar="NAME", help="shipped scenario name or scenario file"
     )

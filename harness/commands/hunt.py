@@ -31,6 +31,7 @@ from harness.commands.cluster_options import (
     describe_cluster,
 )
 from harness.errors import ConfigError
+from harness.links.kinds import either, link_kind, link_names
 from harness.report.console_text import print_safe as say
 from harness.safe_text import for_csv, shown
 
@@ -139,10 +140,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace, console: Console) -> int:
     from harness.hunt.search import HuntPlan, optuna_module
 
-    if args.link not in ("ros2", "inprocess"):
-        raise ConfigError(f"--link {args.link}: hunt runs nodes over ros2 (or inprocess)")
+    kind = link_kind(args.link)
+    if kind.serial_line:
+        over = either([name for name in link_names() if not link_kind(name).serial_line])
+        raise ConfigError(f"--link {args.link}: hunt runs nodes over {over}")
     options, judged = checked_runs_options(args, "hunt")
-    if args.link == "ros2":
+    if kind.runs_node:
         from harness.links.ros2 import node_command
 
         node_command(options)  # a missing node program is exit 2 now, not a failed run

@@ -15,6 +15,7 @@ from rich.console import Console
 
 from harness.commands.arguments import given
 from harness.errors import ConfigError
+from harness.links.kinds import either, link_kind, link_names
 
 __all__ = ["add_launch_option", "check_launch"]
 
@@ -38,8 +39,9 @@ def check_launch(args: argparse.Namespace, console: Console) -> None:
     if not getattr(args, "launch", None):
         return
     package, file = args.launch
-    if args.link != "ros2":
-        raise ConfigError(f"--launch needs --link ros2, not {args.link}")
+    if not link_kind(args.link).launches:
+        launched = either([name for name in link_names() if link_kind(name).launches])
+        raise ConfigError(f"--launch needs --link {launched}, not {args.link}")
     if args.node or args.package or args.executable:
         raise ConfigError("--launch starts the node itself: drop --node/--package/--executable")
     if getattr(args, "watch", False):

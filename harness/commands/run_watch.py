@@ -31,6 +31,7 @@ from harness.commands.run_steps import (
     write_report_file,
 )
 from harness.errors import ConfigError
+from harness.links.kinds import link_kind
 
 if TYPE_CHECKING:
     from collections.abc import Callable, Sequence
@@ -50,10 +51,11 @@ def watch_sources(args: argparse.Namespace, options: LinkOptions) -> NodeSources
 
     sources = node_sources(args.link, options).plus(scenario_sources(args.scenarios))
     if not sources.watched:
-        what = "processing function" if args.link == "inprocess" else "node"
+        runs_node = link_kind(args.link).runs_node
+        what = "node" if runs_node else "processing function"
         given = (
             "--processor FILE.py:FUNCTION"
-            if args.link == "inprocess"
+            if not runs_node
             else "--node CMD or --workspace/--package/--executable"
         )
         raise ConfigError(

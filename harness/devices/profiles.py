@@ -74,29 +74,43 @@ def _ldlidar(rate_hz: float) -> LineDevice:
 
 
 PROFILES: dict[str, DeviceProfile] = {
-    "rplidar": DeviceProfile(
-        name="rplidar",
-        description="Slamtec RPLIDAR A1M8 (the FOSSBot v2's LIDAR), 115200 baud",
-        baudrate=115200,
-        driver_module="harness.board_driver.rplidar_node",
-        make_device=_rplidar,
-        samples_per_rev=lambda device, rate_hz: device.samples_per_revolution(rate_hz),
-        streams_unasked=False,
-        at_beam_angles=lambda device: device.mode != "express",  # standard nodes (or idle)
-    ),
-    "ldlidar": DeviceProfile(
-        name="ldlidar",
-        description="LDROBOT LD06/LD19, 230400 baud, stream only",
-        baudrate=230400,
-        driver_module="harness.board_driver.ldlidar_node",
-        make_device=_ldlidar,
-        samples_per_rev=lambda device, rate_hz: device.samples_per_revolution,
-        streams_unasked=True,
-    ),
+    profile.name: profile
+    for profile in (
+        DeviceProfile(
+            name="rplidar",
+            description="Slamtec RPLIDAR A1M8 (the FOSSBot v2's LIDAR), 115200 baud",
+            baudrate=115200,
+            driver_module="harness.board_driver.rplidar_node",
+            make_device=_rplidar,
+            samples_per_rev=lambda device, rate_hz: device.samples_per_revolution(rate_hz),
+            streams_unasked=False,
+            at_beam_angles=lambda device: device.mode != "express",  # standard nodes (or idle)
+        ),
+        DeviceProfile(
+            name="ldlidar",
+            description="LDROBOT LD06/LD19, 230400 baud, stream only",
+            baudrate=230400,
+            driver_module="harness.board_driver.ldlidar_node",
+            make_device=_ldlidar,
+            samples_per_rev=lambda device, rate_hz: device.samples_per_revolution,
+            streams_unasked=True,
+        ),
+    )
 }
 
 
+def add_profile(device: DeviceProfile) -> DeviceProfile:
+    """Make a LIDAR model known under its name (once), e.g. one from outside the
+    harness, before a link or `emulate` names it; returns it."""
+    known = PROFILES.get(device.name)
+    if known is not None and known != device:
+        raise RuntimeError(f"LIDAR device {device.name!r} is defined twice")
+    PROFILES[device.name] = device
+    return device
+
+
 def profile(name: str) -> DeviceProfile:
+    """The named LIDAR model, or a ConfigError listing the known ones."""
     try:
         return PROFILES[name]
     except KeyError:

@@ -22,6 +22,7 @@ from harness.nodes.command import NodeCommand, workspace_environment
 
 __all__ = ["find_launch_file", "launch_node", "ros2_launch_missing"]
 
+ROS2_PROGRAM = "ros2"  # ros2cli, whose launch verb starts the node
 HELP_TIMEOUT_S = 30.0  # `ros2 launch --help` (ros2cli loads its verbs: a second or two)
 INSTEAD = (
     "source a ROS 2 installation that has it (e.g. `. /opt/ros/jazzy/setup.bash`), or leave "
@@ -33,7 +34,7 @@ INSTEAD = (
 @functools.lru_cache(maxsize=1)
 def ros2_launch_missing() -> str | None:
     """Why `ros2 launch` cannot run here, or None when it can (asked once a process)."""
-    program = shutil.which("ros2")
+    program = shutil.which(ROS2_PROGRAM)
     if program is None:
         return "no ros2 on PATH"
     try:
@@ -82,7 +83,7 @@ def launch_node(package: str, file: str, workspace: str | None) -> NodeCommand:
     prefixes = list(workspace_of(workspace).prefixes) if workspace is not None else []
     env = workspace_environment(prefixes) if prefixes else {}
     return NodeCommand(
-        (shutil.which("ros2") or "ros2", "launch", package, Path(file).name),
+        (shutil.which(ROS2_PROGRAM) or ROS2_PROGRAM, "launch", package, Path(file).name),
         env,
         f"ros2 launch {package} {Path(file).name}",
         launch_arguments=frozenset(launched.arguments),

@@ -113,39 +113,53 @@ def _full_circle(samples: int, *, closed: bool) -> float:
 
 
 PRESETS: dict[str, LidarSpec] = {
-    # The lab's simulator (public FOSSBot Gazebo model): 360 samples from -pi
-    # to pi inclusive, as Gazebo spaces them ((max - min) / (samples - 1)).
-    "gazebo": LidarSpec(
-        name="gazebo",
-        samples=360,
-        angle_min=-math.pi,
-        angle_increment=_full_circle(360, closed=True),
-        range_min=0.12,
-        range_max=12.0,
-        rate_hz=10.0,
-    ),
-    # Slamtec RPLIDAR A1M8 as the FOSSBot v2 bridge publishes it: 360 one-degree
-    # bins, 0 .. 2*pi - step.
-    "rplidar_a1": LidarSpec(
-        name="rplidar_a1",
-        samples=360,
-        angle_min=0.0,
-        angle_increment=_full_circle(360, closed=False),
-        range_min=0.15,
-        range_max=12.0,
-        rate_hz=5.5,
-    ),
-    # LDROBOT LD19/LD06: 4500 samples/s at 10 Hz = 450 points per turn.
-    "ld19": LidarSpec(
-        name="ld19",
-        samples=450,
-        angle_min=0.0,
-        angle_increment=_full_circle(450, closed=False),
-        range_min=0.02,
-        range_max=12.0,
-        rate_hz=10.0,
-    ),
+    spec.name: spec
+    for spec in (
+        # The lab's simulator (public FOSSBot Gazebo model): 360 samples from -pi
+        # to pi inclusive, as Gazebo spaces them ((max - min) / (samples - 1)).
+        LidarSpec(
+            name="gazebo",
+            samples=360,
+            angle_min=-math.pi,
+            angle_increment=_full_circle(360, closed=True),
+            range_min=0.12,
+            range_max=12.0,
+            rate_hz=10.0,
+        ),
+        # Slamtec RPLIDAR A1M8 as the FOSSBot v2 bridge publishes it: 360 one-degree
+        # bins, 0 .. 2*pi - step.
+        LidarSpec(
+            name="rplidar_a1",
+            samples=360,
+            angle_min=0.0,
+            angle_increment=_full_circle(360, closed=False),
+            range_min=0.15,
+            range_max=12.0,
+            rate_hz=5.5,
+        ),
+        # LDROBOT LD19/LD06: 4500 samples/s at 10 Hz = 450 points per turn.
+        LidarSpec(
+            name="ld19",
+            samples=450,
+            angle_min=0.0,
+            angle_increment=_full_circle(450, closed=False),
+            range_min=0.02,
+            range_max=12.0,
+            rate_hz=10.0,
+        ),
+    )
 }
+
+
+def add_preset(spec: LidarSpec) -> LidarSpec:
+    """Make a LIDAR's preset known under its name (once), e.g. a LIDAR from outside
+    the harness, before a scenario names it; returns it."""
+    known = PRESETS.get(spec.name)
+    if known is not None and known != spec:
+        raise RuntimeError(f"lidar preset {spec.name!r} is defined twice")
+    spec.check()
+    PRESETS[spec.name] = spec
+    return spec
 
 
 def preset(name: str) -> LidarSpec:

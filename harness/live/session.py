@@ -25,13 +25,14 @@ from harness.errors import ConfigError, Interrupted, LinkError
 from harness.judge.records import RunResult, TickRecord
 from harness.lidar.scan import Scan
 from harness.links.base import LinkOptions, create_link
+from harness.links.kinds import ROS2
 from harness.links.ros2 import harness_observer
 from harness.live.drive import CommandWatchdog
 from harness.live.judge import LiveJudge
 from harness.live.world import LiveWorld
 from harness.ros.domain import reserve_domain
-from harness.runner.scenario_run import scenario_options
-from harness.runner.settings import RunSettings, effective_seed, fault_profile, judging
+from harness.runner.plan import plan_one
+from harness.runner.settings import RunSettings
 from harness.scenario.schema import Scenario
 from harness.sim.motion import Pose
 from harness.sim.world import TIME_STEP
@@ -111,8 +112,8 @@ class LiveSession:
             raise ConfigError(f"--rate must be a positive number, got {settings.rate}")
         self.scenario = scenario
         self.settings = settings
-        self.options = scenario_options(scenario, options, settings.run)
-        self.profile = fault_profile(scenario, settings.run)
+        self.plan = plan_one(scenario, "live", options, settings.run)
+        self.options, self.profile = self.plan.options, self.plan.profile
         if self.profile.link.items:
             kinds = ", ".join(f.kind for f in self.profile.link.items)
             raise ConfigError(f"faults {kinds}: link faults apply to `run`, not to a live session")
@@ -130,14 +131,14 @@ class LiveSession:
 
     def run(self) -> RunResult | None:
         """Run until the duration is reached, Ctrl-C, or the node stops; always clean up."""
-        rng = np.random.default_rng(effective_seed(self.scenario, self.settings.run))
+        rng = np.random.default_rng(self.plan.seed)
         link: Any = None
         domain = None
         observer: Observer | None = None
         started = time.perf_counter()
         try:
             # The ros2 link starts the node, waits for it and explains what goes wrong.
-            link = create_link("ros2", self.options) if self.settings.node else None
+            link = create_link(ROS2, self.options) if self.settings.node else None
             with LiveWorld(self.scenario) as world, remembered_ctrl_c() as ctrl_c:
                 if link is not None:
                     link.open()  # the node is up and reads /scan (bounded, explained)
@@ -166,8 +167,8 @@ class LiveSession:
 
     def _judge(self) -> LiveJudge:
         """The judge, and the result it fills (dropped at the end if nothing answered)."""
-        oracle, self.result = judging(self.scenario, "live", self.settings.run, self.profile)
-        return LiveJudge(oracle, self.result, on_tick=self._judged)
+        self.result = self.plan.result()
+        return LiveJudge(self.plan.oracle(), self.result, on_tick=self._judged)
 
     def _judged(self, record: TickRecord) -> None:
         if self.view is not None:

@@ -22,8 +22,9 @@ from typing import TYPE_CHECKING, Any, NoReturn
 import pytest
 
 from harness.errors import ConfigError, HarnessError
+from harness.links.kinds import link_kind
 from harness.pytest_plugin.cases import HilCase, split_faults
-from harness.pytest_plugin.options import DEFAULT_PORT_WAIT_S, SERIAL_LINKS
+from harness.pytest_plugin.options import DEFAULT_PORT_WAIT_S
 from harness.pytest_plugin.result import HilResult
 
 if TYPE_CHECKING:
@@ -124,7 +125,7 @@ class Hil:
         o = self.options
         node = o.node or (f"{o.package} {o.executable}" if o.package else None)
         what = f"node {node!r}" if node else "the reference node"
-        if self.link == "inprocess":
+        if not link_kind(self.link).runs_node:
             what = f"processor {o.processor!r}" if o.processor else "the reference processing"
         return f"<hil: {self.link} link, {what}>"
 
@@ -161,7 +162,7 @@ class Hil:
             overrides = {**overrides, "params": tuple(params)}
         overrides = {**overrides, **_checked_numbers(overrides)}
         options = replace(self.options, **overrides)
-        if link not in SERIAL_LINKS and "port" not in overrides:
+        if not link_kind(link).serial_line and "port" not in overrides:
             options = replace(options, port=None)  # the board's port concerns board links only
         return options
 
@@ -251,7 +252,8 @@ class Hil:
     def _run(self, scenario: Scenario, link: str, options: LinkOptions, settings: Any) -> HilResult:
         from harness.runner.scenario_run import run
 
-        physical = link in SERIAL_LINKS and options.port is not None
+        kind = link_kind(link)
+        physical = kind.serial_line and options.port is not None
         domain_id = options.domain_id
         try:
             with ExitStack() as held:
@@ -261,7 +263,7 @@ class Hil:
                     assert options.port is not None
                     label = f"--hil-port {options.port}"
                     held.enter_context(hold_port(options.port, self.port_wait, label=label))
-                elif link != "inprocess" and domain_id is None:
+                elif kind.runs_node and domain_id is None:
                     from harness.ros.domain import reserve_domain
 
                     domain_id = held.enter_context(reserve_domain()).domain_id
@@ -270,5 +272,5 @@ class Hil:
         except HarnessError as err:  # ConfigError (node, link, port) or no free domain
             problem = str(err)
         else:
-            return HilResult(raw, domain_id=None if link == "inprocess" else domain_id)
+            return HilResult(raw, domain_id=domain_id if kind.runs_node else None)
         _fail(problem)

@@ -19,9 +19,15 @@ from typing import Any
 
 import pytest
 
-SERIAL_LINKS = ("rplidar", "ldlidar")
-DEFAULT_LINK = "ros2"
-DEFAULT_BOARD_LINK = "rplidar"
+from harness.links.kinds import (
+    default_link,
+    default_serial_link,
+    either,
+    link_kind,
+    link_names,
+    serial_links,
+)
+
 DEFAULT_TIMEOUT_S = 1.0
 DEFAULT_READY_TIMEOUT_S = 20.0
 DEFAULT_PORT_WAIT_S = 300.0  # a whole board run, in real time, may be ahead in the queue
@@ -41,11 +47,9 @@ def _lazy(name: str, *args: str) -> Callable[[str], Any]:
 
 
 def _link(text: str) -> str:
-    from harness.links.base import known_links
-
-    if text not in known_links():
+    if text not in link_names():
         raise argparse.ArgumentTypeError(
-            f"unknown link {text!r} (known: {', '.join(known_links())})"
+            f"unknown link {text!r} (known: {', '.join(link_names())})"
         )
     return text
 
@@ -74,8 +78,10 @@ OPTIONS = (
     _Option(
         "link",
         "NAME",
-        "link to the software under test: ros2 (default), inprocess, rplidar, ldlidar; "
-        "hil tests on a board use rplidar unless this names ldlidar",
+        f"link to the software under test: {default_link()} (default), "
+        f"{', '.join(n for n in link_names() if n != default_link())}; hil tests on a board "
+        f"use {default_serial_link()} unless this names "
+        f"{either([n for n in serial_links() if n != default_serial_link()])}",
         _link,
     ),
     _Option("node", "CMD", 'node under test as a shell command, e.g. "python3 my_node.py"'),
@@ -152,7 +158,7 @@ def add_options(parser: pytest.Parser) -> None:
 class HilConfig:
     """The session's settings; `given` says where each came from, for messages."""
 
-    link: str | None = None  # None: ros2 for runs, rplidar for a board
+    link: str | None = None  # None: the default link for runs, the default serial one for a board
     node: str | None = None
     package: str | None = None
     executable: str | None = None
@@ -169,11 +175,11 @@ class HilConfig:
 
     @property
     def run_link(self) -> str:
-        return self.link if self.link is not None else DEFAULT_LINK
+        return self.link if self.link is not None else default_link()
 
     @property
     def board_link(self) -> str:
-        return self.link if self.link in SERIAL_LINKS else DEFAULT_BOARD_LINK
+        return self.link if self.link in serial_links() else default_serial_link()
 
     def source(self, name: str) -> str:
         """How the user gave `name`: "--hil-node" or "hil_node in pytest.ini"."""
@@ -259,11 +265,11 @@ def check_config(cfg: HilConfig, config: pytest.Config) -> None:
         raise pytest.UsageError(f"{src('node')} and {src(other)}: give one or the other")
     if bool(cfg.package) != bool(cfg.executable):
         raise pytest.UsageError(f"{src('package')} and {src('executable')} go together")
-    if cfg.link == "inprocess":
+    if cfg.link is not None and not link_kind(cfg.link).runs_node:
         for name in ("node", "package", "param"):
             if getattr(cfg, name):
                 raise pytest.UsageError(
-                    f"{src(name)} needs a link that runs a node, not --hil-link inprocess"
+                    f"{src(name)} needs a link that runs a node, not --hil-link {cfg.link}"
                 )
     if cfg.param:
         from harness.commands.arguments import check_parameters
@@ -281,10 +287,10 @@ def check_config(cfg: HilConfig, config: pytest.Config) -> None:
             check_port("--hil-port", cfg.port)  # a typo is a usage error, not N failed tests
         except ConfigError as err:
             raise pytest.UsageError(str(err)) from None
-    if cfg.port is not None and cfg.link is not None and cfg.link not in SERIAL_LINKS:
+    if cfg.port is not None and cfg.link is not None and not link_kind(cfg.link).serial_line:
         raise pytest.UsageError(
             f"--hil-port drives a board through its LIDAR line: --hil-link must be "
-            f"{' or '.join(SERIAL_LINKS)}, not {cfg.link}"
+            f"{either(serial_links())}, not {cfg.link}"
         )
     if cfg.domain_id is not None and cfg.port is None and _workers(config) > 1:
         raise pytest.UsageError(

@@ -28,7 +28,6 @@ import pytest
 
 from harness.pytest_plugin.cases import MARKER, MARKER_HELP, HilCase
 from harness.pytest_plugin.options import (
-    SERIAL_LINKS,
     HilConfig,
     add_options,
     check_config,
@@ -169,8 +168,9 @@ def hil_link(hil_config: HilConfig) -> str:
 def hil_link_options(hil_config: HilConfig, hil_node: NodeUnderTest, hil_link: str) -> LinkOptions:
     """Link settings for every run of the test (the runner fills in threshold and rate)."""
     from harness.links.base import LinkOptions
+    from harness.links.kinds import link_kind
 
-    physical = hil_link in SERIAL_LINKS and hil_config.port is not None
+    physical = link_kind(hil_link).serial_line and hil_config.port is not None
     return LinkOptions(
         scan_timeout=hil_config.timeout,
         ready_timeout=hil_config.ready_timeout,

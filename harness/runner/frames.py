@@ -23,6 +23,7 @@ from harness.judge.oracle import Oracle
 from harness.judge.records import RunResult, TickRecord
 from harness.lidar.scan import Scan
 from harness.links.base import Link
+from harness.links.kinds import either, serial_links
 
 
 @dataclass(frozen=True)
@@ -42,7 +43,7 @@ def check_link_faults(faults: LinkFaults, link: Link) -> None:
     if faults.on_line and not link.serial_line:
         kinds = ", ".join(f.kind for f in faults.items if f.kind.startswith("line_"))
         raise ConfigError(
-            f"faults {kinds}: need a serial link (rplidar or ldlidar), not {link.name!r}"
+            f"faults {kinds}: need a serial link ({either(serial_links())}), not {link.name!r}"
         )
     if faults.stale_stamps and link.serial_line:
         raise ConfigError(

@@ -261,7 +261,9 @@ def processor_sources(processor: str | None) -> NodeSources:
 def node_sources(link: str, options: LinkOptions) -> NodeSources:
     """The files of the node (or processing function) `options` name; empty for the
     bundled ones. ConfigError, one line, when the named ones cannot be found."""
-    if link == "inprocess":
+    from harness.links.kinds import link_kind
+
+    if not link_kind(link).runs_node:
         return processor_sources(options.processor)
     if options.node:
         return command_sources(options.node)
