@@ -16,11 +16,11 @@ from harness.judge.oracle import Oracle
 from harness.judge.records import RunResult, TickRecord
 from harness.judge.run_hints import run_hint
 from harness.lidar.scan import Scan
-from harness.links import LinkOptions, create_link
+from harness.links import LinkOptions
 from harness.nodes.process import last_error
 from harness.report.terminal import print_results
-from harness.runner.scenario_run import run_scenario
-from harness.runner.settings import RunSettings, effective_threshold
+from harness.runner import scenario_run
+from harness.runner.settings import RunSettings
 from harness.scenario.files import resolve_scenario
 
 THRESHOLD = 0.5
@@ -309,12 +309,8 @@ def test_a_passing_run_has_no_hint() -> None:
 
 def run_function(scenario_name: str, fn: str) -> RunResult:
     scenario = resolve_scenario(scenario_name)
-    settings = RunSettings()
-    options = LinkOptions(
-        threshold=effective_threshold(scenario, settings), processor=f"{FUNCTIONS}:{fn}"
-    )
-    with create_link("inprocess", options) as link:
-        return run_scenario(scenario, link, settings)
+    options = LinkOptions(processor=f"{FUNCTIONS}:{fn}")
+    return scenario_run.run(scenario, "inprocess", options, RunSettings())
 
 
 @pytest.mark.parametrize(

@@ -8,9 +8,9 @@ from pathlib import Path
 import pytest
 
 from harness.judge.records import RunResult
-from harness.links import LinkOptions, create_link
-from harness.runner.scenario_run import run_scenario
-from harness.runner.settings import RunSettings, effective_threshold
+from harness.links import LinkOptions
+from harness.runner import scenario_run
+from harness.runner.settings import RunSettings
 from harness.scenario.files import resolve_scenario, shipped_scenarios
 
 STUDENTS = Path(__file__).parent / "student_functions.py"
@@ -21,11 +21,7 @@ SHIPPED = [s.name for s in shipped_scenarios()]
 def run(name: str, processor: str | None = None, **settings) -> RunResult:
     scenario = resolve_scenario(name)
     run_settings = RunSettings(**settings)
-    options = LinkOptions(
-        threshold=effective_threshold(scenario, run_settings), processor=processor
-    )
-    with create_link("inprocess", options) as link:
-        return run_scenario(scenario, link, run_settings)
+    return scenario_run.run(scenario, "inprocess", LinkOptions(processor=processor), run_settings)
 
 
 @pytest.mark.parametrize("name", SHIPPED)

@@ -9,7 +9,7 @@ import pytest
 
 from harness.errors import ConfigError
 from harness.links.base import LinkOptions
-from harness.runner.scenario_run import node_topic_options, scenario_options
+from harness.runner.plan import node_topic_options, plan_run
 from harness.runner.settings import RunSettings
 from harness.scenario.files import resolve_scenario
 
@@ -37,8 +37,8 @@ def test_the_lab_parameters_get_the_scenario_topics() -> None:
 
 def test_only_the_links_that_publish_the_scans_set_them() -> None:
     scenario = resolve_scenario("obstacle_at_side")
-    ros2 = scenario_options(scenario, LinkOptions(), RunSettings(), "ros2")
-    board = scenario_options(scenario, LinkOptions(), RunSettings(), "rplidar")
+    ros2 = plan_run(scenario, "ros2", LinkOptions(), RunSettings()).options
+    board = plan_run(scenario, "rplidar", LinkOptions(), RunSettings()).options
     assert ros2.scan_topic == "/fossbot2/scan" and board.scan_topic == "/scan"
     assert board.params == ()
 

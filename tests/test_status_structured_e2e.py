@@ -8,9 +8,9 @@ from pathlib import Path
 import pytest
 
 from harness.judge.records import RunResult
-from harness.links import LinkOptions, create_link
-from harness.runner.scenario_run import run_scenario
-from harness.runner.settings import RunSettings, effective_threshold
+from harness.links import LinkOptions
+from harness.runner import scenario_run
+from harness.runner.settings import RunSettings
 from harness.scenario.files import resolve_scenario, shipped_scenarios
 
 FUNCTIONS = Path(__file__).parent / "structured_functions.py"
@@ -20,9 +20,7 @@ SHIPPED = [s.name for s in shipped_scenarios()]
 def run(name: str, processor: str) -> RunResult:
     scenario = resolve_scenario(name)
     settings = RunSettings()
-    options = LinkOptions(threshold=effective_threshold(scenario, settings), processor=processor)
-    with create_link("inprocess", options) as link:
-        return run_scenario(scenario, link, settings)
+    return scenario_run.run(scenario, "inprocess", LinkOptions(processor=processor), settings)
 
 
 @pytest.mark.parametrize("fn", ["json_with_infinity", "printed_dict", "yaml_lines"])

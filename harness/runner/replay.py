@@ -89,6 +89,9 @@ def replay(
         faults = f"{faults}; link: {link_faults.describe()}"
 
     def body(link: Link) -> RunResult:
+        check_link_faults(link_faults, link)
+        opening = time.perf_counter()
+        link.open()
         started = time.perf_counter()
         rule = warning_when_clear or "optional"
         oracle = Oracle(
@@ -100,7 +103,7 @@ def replay(
         replayed = RunResult(
             name, link.name, seed, threshold, faults, noise_sigma, warning_rule=rule
         )
-        check_link_faults(link_faults, link)
+        replayed.startup_s = started - opening
         judge_frames(
             frames(recording), link, oracle, replayed, on_tick=on_tick, link_faults=link_faults
         )

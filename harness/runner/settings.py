@@ -8,8 +8,6 @@ from typing import Any
 
 from harness.errors import ConfigError
 from harness.faults.sensor import FaultProfile, build_profile
-from harness.judge.oracle import Oracle
-from harness.judge.records import RunResult
 from harness.scenario.checks import check_run_length, threshold_problem
 from harness.scenario.schema import Scenario
 
@@ -32,30 +30,6 @@ class RunSettings:
 def effective_seed(scenario: Scenario, settings: RunSettings) -> int:
     """The run's seed: the override, else the scenario's."""
     return settings.seed if settings.seed is not None else scenario.seed
-
-
-def judging(
-    scenario: Scenario, link_name: str, settings: RunSettings, profile: FaultProfile
-) -> tuple[Oracle, RunResult]:
-    """The oracle for one run of `scenario`, and the empty result its verdicts go into."""
-    threshold = effective_threshold(scenario, settings)
-    rule = warning_rule(scenario, settings)
-    oracle = Oracle(
-        threshold,
-        noise_sigma=profile.noise_sigma,
-        status_pattern=settings.status_pattern,
-        warning_required_when_clear=rule == "required",
-    )
-    result = RunResult(
-        scenario=scenario.name,
-        link=link_name,
-        seed=effective_seed(scenario, settings),
-        threshold=threshold,
-        faults=profile.name,
-        noise_sigma=profile.noise_sigma,
-        warning_rule=rule,
-    )
-    return oracle, result
 
 
 def warning_rule(scenario: Scenario, settings: RunSettings) -> str:

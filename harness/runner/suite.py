@@ -13,14 +13,8 @@ from harness.links.base import Link, LinkOptions, create_link, link_class
 from harness.nodes.forkserver import scope as fork_servers
 from harness.nodes.setup_problems import setup_problem
 from harness.runner.link_pipeline import LinkPipeline
-from harness.runner.scenario_run import (
-    closed,
-    not_started_as,
-    run_mount,
-    run_scenario,
-    run_through,
-    scenario_options,
-)
+from harness.runner.plan import plan_suite
+from harness.runner.scenario_run import closed, run_scenario, run_through
 from harness.runner.settings import RunSettings
 from harness.scenario.schema import Scenario
 
@@ -62,20 +56,19 @@ def run_suite(
         return results
     cls = link_class(link_name)
     cls.prepare(options)
-    if cls.serial_line:  # one device on one robot serves the whole run
-        options = run_mount(scenarios, options)
-    first = scenario_options(scenarios[0], options, settings, link_name)
-    with fork_servers(), _explicit_domain(link_name, options), cls.run_session(first) as session:
+    plans = plan_suite(scenarios, link_name, options, settings)  # before anything starts
+    first = plans[0].options
+    with fork_servers(), _explicit_domain(link_name, first), cls.run_session(first) as session:
 
         def make(index: int) -> Link:
-            link_options = scenario_options(scenarios[index], options, settings, link_name)
-            return create_link(link_name, link_options, session)
+            return create_link(link_name, plans[index].options, session)
 
         pipeline = LinkPipeline(make, len(scenarios), overlap=_links_overlap(link_name, options))
         failed_start: str | None = None
         index = 0
         try:
-            for index, scenario in enumerate(scenarios):
+            for index, plan in enumerate(plans):
+                scenario = plan.scenario
                 if failed_start is not None:
                     pipeline.drain()
                     reason = f"not run: the node did not start in {failed_start}"
@@ -87,19 +80,14 @@ def run_suite(
                     taking = time.perf_counter() - started
                     result = run_through(
                         link,
-                        lambda link, s=scenario: run_scenario(
-                            s, link, settings, on_tick=on_tick, open_link=True
-                        ),
-                        not_started_as(scenario, link_name, settings),
-                        body_opens=True,
+                        lambda link, p=plan: run_scenario(p, link, on_tick=on_tick),
+                        plan.not_started,
                     )
                 except ConfigError as err:
                     if index == 0:
                         raise  # found before anything ran: a usage error (exit 2)
                     # Scenarios were judged: they keep their rows, this one says why.
-                    result = not_started_as(scenario, link_name, settings)(
-                        f"could not start: {err}", ""
-                    )
+                    result = plan.not_started(f"could not start: {err}", "")
                     result.not_started = True
                     result.startup_s = time.perf_counter() - started
                     failed_start = scenario.name

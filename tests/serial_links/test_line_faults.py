@@ -25,6 +25,7 @@ from harness.judge.records import RunResult
 from harness.lidar.scan import Scan
 from harness.links.base import Link, LinkOptions
 from harness.report.summary import tick_entry
+from harness.runner.plan import plan_one
 from harness.runner.scenario_run import run_scenario, with_link
 from harness.runner.settings import RunSettings
 from harness.scenario.files import resolve_scenario
@@ -59,25 +60,18 @@ def run_on_line(
 ) -> LineRun:
     """`scenario_run.run`, opened by hand to read the server's LineDamage counters."""
     scenario = resolve_scenario(SCENARIO)
-    options = LinkOptions(
-        node=node,
-        threshold=scenario.threshold,
-        scan_rate_hz=scenario.lidar_spec.rate_hz,
-        scan_timeout=DEADLINE_S,
-    )
+    options = LinkOptions(node=node, scan_timeout=DEADLINE_S)
+    # As planned for one scenario, the device mounted straight ahead (no robot model's mount):
+    # the seeds below are where the line eats what the tests name.
+    plan = plan_one(scenario, link_name, options, RunSettings(seed=seed, faults=faults))
     damage: list[LineDamage] = []
 
     def body(link: Link) -> RunResult:
-        result = run_scenario(scenario, link, RunSettings(seed=seed, faults=faults))
+        result = run_scenario(plan, link)
         damage.append(link.server.damage)  # type: ignore[attr-defined]  # a BoardLink
         return result
 
-    def not_started(reason: str, diagnostics: str) -> RunResult:
-        return RunResult(
-            scenario.name, link_name, 0, 0.5, "", error=reason, diagnostics=diagnostics
-        )
-
-    result = with_link(link_name, options, body, not_started)
+    result = with_link(link_name, plan.options, body, plan.not_started)
     assert damage, f"the run never started: {result.error}\n{result.diagnostics}"
     line = damage[0]
     assert isinstance(line, LineDamage), "the server carried no LineDamage"
@@ -307,7 +301,7 @@ def test_answers_to_the_idle_stream_published_late_are_set_aside() -> None:
     """The first exchange after the idle stream: the driver published one scan in it, the
     node answered three (two to idle revolutions a lagging driver published late): the
     last status and its Bool are the tick's, the others late answers of no tick."""
-    from harness.links.board import _set_aside_answers_to_the_idle_stream
+    from harness.links.board_idle import set_aside_answers_to_the_idle_stream
 
     answers = Answers(
         statuses=[
@@ -317,7 +311,7 @@ def test_answers_to_the_idle_stream_published_late_are_set_aside() -> None:
         ],
         warnings=[Received(False, 0.01, source_ns=999), Received(False, 0.03, source_ns=2_999)],
     )
-    _set_aside_answers_to_the_idle_stream(answers, 1)
+    set_aside_answers_to_the_idle_stream(answers, 1)
     assert [r.value for r in answers.statuses] == ["Min distance: 1.462 m"]
     assert [r.source_ns for r in answers.warnings] == [2_999]
     assert sorted(r.source_ns for r in answers.late) == [999, 1_000, 2_000]
