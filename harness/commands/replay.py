@@ -19,8 +19,8 @@ from harness.commands.arguments import (
     fault_list,
     given,
     seed,
-    topic_option,
 )
+from harness.commands.node_names import topic_option
 from harness.errors import ConfigError, Interrupted
 
 if TYPE_CHECKING:  # numpy comes with it: not needed to build the parser

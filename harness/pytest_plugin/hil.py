@@ -41,7 +41,7 @@ RUNNER_FIELDS = ("threshold", "scan_rate_hz")
 
 def _run_names() -> dict[str, str]:
     """How a failure names hil.run's arguments: ``scan_topic=`` for the CLI's --scan-topic."""
-    from harness.commands.arguments import CLI_NAMES
+    from harness.commands.node_names import CLI_NAMES
 
     return {field: f"{field}=" for field in CLI_NAMES}
 
@@ -189,7 +189,7 @@ class Hil:
             from harness.judge.status import compile_status_pattern
 
             compile_status_pattern(status_regex)
-        from harness.commands.arguments import checked_node_options
+        from harness.commands.node_names import checked_node_options
 
         options = checked_node_options(self._options(link, overrides), _run_names())
         return chosen, fault_items, options

@@ -272,7 +272,7 @@ def check_config(cfg: HilConfig, config: pytest.Config) -> None:
                     f"{src(name)} needs a link that runs a node, not --hil-link {cfg.link}"
                 )
     if cfg.param:
-        from harness.commands.arguments import check_parameters
+        from harness.commands.node_names import check_parameters
         from harness.errors import ConfigError
 
         try:  # each item is checked as it is read; here: none given twice
