@@ -47,6 +47,7 @@ if TYPE_CHECKING:  # pydantic only when a scenario is at hand
 
 __all__ = [
     "ArtifactWriter",
+    "PromisedArtifactWriter",
     "ReportFolder",
     "ScenarioFiles",
     "WorldArtifactWriter",
@@ -79,7 +80,18 @@ class WorldArtifactWriter:
     write: Callable[[Path, RunResult, Scenario], Path]
 
 
-Writer = ArtifactWriter | WorldArtifactWriter
+@dataclass(frozen=True)
+class PromisedArtifactWriter:
+    """A per-scenario file another process writes later, from what `write(final, result)`
+    leaves for it (``grade`` draws its students' plots outside their sandboxes): the
+    report names `final` as if written; `write` returns it."""
+
+    name: str
+    suffix: str
+    write: Callable[[Path, RunResult], Path]
+
+
+Writer = ArtifactWriter | WorldArtifactWriter | PromisedArtifactWriter
 
 
 def _write_plot(path: Path, result: RunResult) -> Path:
@@ -145,8 +157,11 @@ def _write_via_temporary(
     """Run `writer` on a hidden temporary file, then rename it to `final` (atomic).
 
     A writer that returns another path chose its own; it answers for it.
-    None: a world writer without the scenario, so nothing written.
+    None: a world writer without the scenario, so nothing written. A promised file is
+    left to its writer (it lands atomically where another process writes it).
     """
+    if isinstance(writer, PromisedArtifactWriter):
+        return writer.write(final, result)
     if isinstance(writer, ArtifactWriter):
         write = writer.write
         return fill_atomically(
