@@ -32,7 +32,7 @@ from harness.commands.arguments import (
 )
 from harness.commands.cluster_options import add_cluster_options, describe_cluster, workers
 from harness.commands.sandbox_options import add_sandbox_options, check_workers, sandbox_limits
-from harness.errors import ConfigError, one_line
+from harness.errors import ConfigError
 from harness.grading import LAB_EXECUTABLE, LAB_PACKAGE
 from harness.grading.discover import GRADES_MARKER, Student, absolute
 from harness.holder_lock import HolderLock
@@ -286,6 +286,7 @@ def run(args: argparse.Namespace, console: Console) -> int:
     from harness.cluster.client import check_cluster_options, dashboard
     from harness.cluster.progress import add_task, task_progress
     from harness.cluster.soon import client_soon
+    from harness.commands.grade_audit import class_audit
     from harness.grading.build import colcon_executable
     from harness.grading.class_table import (
         class_csv,
@@ -360,6 +361,7 @@ def run(args: argparse.Namespace, console: Console) -> int:
             },
             sandbox=sandbox,
             sandbox_checked=args.scheduler is None,  # the embedded cluster's host is this one
+            defer_plots=True,  # drawn by each worker beside its next student's run
         )
         if replaced:
             console.print(replaced, markup=False, highlight=False)
@@ -396,7 +398,7 @@ def run(args: argparse.Namespace, console: Console) -> int:
         wall_s = time.monotonic() - started
         _write_gradescope(found.students, grades, plan, out, enabled=args.gradescope)
         grades = scored_rows(grades, plan, roster, config, console)
-        audit_line = None if args.no_audit else _audit(console, client, scenarios, config, out)
+        audit_line = None if args.no_audit else class_audit(console, client, scenarios, config, out)
         meta = [
             ("scenarios", ", ".join(names)),
             ("score", _score_words(plan)),
@@ -556,58 +558,3 @@ def _write_gradescope(
         path = out / "students" / student.slug / "gradescope" / "results.json"
         path.parent.mkdir(parents=True, exist_ok=True)
         write_atomically(path, json.dumps(data, indent=2).encode())
-
-
-def _audit(
-    console: Console, client: object, scenarios: list[Scenario], config: GradeConfig, out: Path
-) -> str | None:
-    """Which typical mistakes these scenarios let pass (harness.audit), from the cache or
-    run now on the class's cluster; the warning line naming them, or None. An audit that
-    cannot be made is said, never a reason to fail the grading."""
-    import json
-    from dataclasses import replace
-
-    from harness.atomic_write import write_atomically
-    from harness.audit.known import audit_warning, known_audit
-    from harness.audit.task import AuditConfig
-
-    audit = AuditConfig(
-        scenarios=config.scenarios,
-        scenario_refs=config.scenario_refs,
-        link=config.link,
-        options=replace(config.options, node=None, package=None, executable=None),
-        settings=config.settings,
-        seeds=(config.settings.seed,),
-        units_dir=out.resolve() / "audit",
-    )
-    console.print(
-        "checking which typical mistakes these scenarios catch (fossbot-hil audit)...",
-        markup=False,
-        highlight=False,
-    )
-    try:
-        data, cached = known_audit(client, audit, scenarios)
-    except Exception as err:  # noqa: BLE001 - the grades are written; the audit is advice
-        return f"warning: the audit could not run: {type(err).__name__}: {one_line(err)}"
-    write_atomically(out / "audit.json", json.dumps(data, indent=2).encode())
-    words = " ".join(_scenario_words(scenarios))
-    warning = audit_warning(data, words)
-    if warning is None:
-        killed = len(data.get("mutants", []))
-        return f"these scenarios catch all {killed} typical mistakes{' (cached)' if cached else ''}"
-    return warning
-
-
-def _scenario_words(scenarios: list[Scenario]) -> list[str]:
-    """How a command line names each scenario: a shipped one by name, others by file."""
-    import shlex
-
-    from harness.scenario.files import shipped_dir
-
-    shipped = shipped_dir().resolve()
-    return [
-        s.name
-        if not s.source or Path(s.source).resolve().parent == shipped
-        else shlex.quote(s.source)
-        for s in scenarios
-    ]

@@ -29,6 +29,7 @@ from harness.grading.build import build_student
 from harness.grading.class_table import ERROR, NOT_RUN, PASS, StudentGrade
 from harness.grading.discover import Student
 from harness.grading.hidden import HiddenScenario, scrub_folder
+from harness.grading.plots import PLOT_WAIT_S, plots_drawn, plotter
 from harness.grading.process import TERM_GRACE_S, Finished, StopFlag, run_bounded
 from harness.grading.scoring import held_of
 from harness.grading.worker import write_job
@@ -71,6 +72,9 @@ class GradeConfig:
     # True: the grader has found that its host can sandbox, and every worker runs there
     # (the embedded cluster), so a worker need not try again before its first student.
     sandbox_checked: bool = False
+    # True: each student's plots are drawn by the worker after their run, beside the next
+    # student's (harness.grading.plots); `grade_class` waits for them before it returns.
+    defer_plots: bool = False
 
     @property
     def unheld(self) -> dict[str, tuple[int, int]]:
@@ -309,6 +313,7 @@ def _grade(student: Student, config: GradeConfig, cancel: StopFlag) -> StudentGr
     if cancel.is_set():
         return without_run("interrupted", build_s)
     options = _run_options(student, config, folder)
+    plots = grader / "plots" if config.defer_plots else None
     job = write_job(
         grader / "job.json",
         scenarios=list(config.scenario_refs),
@@ -321,6 +326,7 @@ def _grade(student: Student, config: GradeConfig, cancel: StopFlag) -> StudentGr
         hidden={
             n: {"label": h.label, "show_failure": h.show_failure} for n, h in config.hidden.items()
         },
+        plots=plots,
     )
     finished = run_bounded(
         _judging_command(job, student, config, folder, grader),
@@ -330,6 +336,8 @@ def _grade(student: Student, config: GradeConfig, cancel: StopFlag) -> StudentGr
         cwd=folder,
         cancel=cancel,
     )
+    if plots is not None and plots.is_dir():  # drawn while the worker's next student runs
+        plotter().submit(plots, folder / "report" / "scenarios", grader / "plot-errors.log")
     data = _read_results(grader / "results.json")
     verdicts, failures = verdicts_and_failures(data, finished, config, folder, options.node)
     first = next((failures[n] for n in config.scenarios if n in failures), "")
@@ -412,7 +420,8 @@ def grade_class(
     so a worker holds only the student it grades. Open the client with
     ``retries=WORKER_RETRIES``: a student whose grading kills its worker is
     then run once more elsewhere (a worker can die for reasons of its own)
-    before their row says so. `on_graded` gets each row as it comes, with
+    before their row says so. With `config.defer_plots`, it returns once every
+    worker has drawn its students' plots (bounded). `on_graded` gets each row as it comes, with
     how many students are being graded then. On Ctrl-C (or SIGTERM) the
     running builds and suites are stopped, each within its bounded grace,
     before KeyboardInterrupt goes on up.
@@ -439,7 +448,16 @@ def grade_class(
             stop.set()
             _wait_for_running(list(window.running), client)
         raise
+    if config.defer_plots:
+        _wait_for_plots(client)
     return [grades[i] for i in range(len(students))]
+
+
+def _wait_for_plots(client: Any) -> None:
+    """Every worker's students' plots drawn (each worker waits at most PLOT_WAIT_S); a
+    worker that went away took its undrawn plots with it."""
+    with contextlib.suppress(Exception):
+        client.run(plots_drawn, PLOT_WAIT_S)
 
 
 def _task_key(student: Student) -> str:
