@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 
 from harness.devices import rplidar as rp
+from harness.devices import rplidar_scans as scans
 from harness.devices.profiles import profile
 from harness.devices.revolution import device_angle_deg, samples_at_beams
 from harness.lidar.scan import Scan
@@ -34,7 +35,7 @@ def decoded_standard(scan: Scan, rate_hz: float) -> list[tuple[float, float]]:
     device.set_motor(True)
     assert device.receive(rp.encode_request(rp.CMD_SCAN))
     samples = profile("rplidar").revolution(device, scan, rate_hz, scan.range_max)
-    nodes = rp.decode_standard(device.encode_revolution(samples))
+    nodes = scans.decode_standard(device.encode_revolution(samples))
     return [(s.angle_deg, s.distance_mm) for s in nodes]
 
 

@@ -16,6 +16,7 @@ import pytest
 from harness.board_driver.binning import ld_ranges, rplidar_ranges
 from harness.devices import ldlidar as ld
 from harness.devices import rplidar as rp
+from harness.devices import rplidar_scans as scans
 from harness.devices.profiles import profile
 from harness.devices.revolution import Sample, device_angle_deg, samples_at_beams, samples_from_scan
 from harness.lidar.mount import FORWARD, LidarMount
@@ -56,7 +57,7 @@ def a1_round_trip(scan: Scan, mount: LidarMount, invert: bool, offset_deg: float
     device.set_motor(True)
     assert device.receive(rp.encode_request(rp.CMD_SCAN))
     samples = profile("rplidar").revolution(device, scan, 5.5, scan.range_max, mount=mount)
-    nodes = rp.decode_standard(device.encode_revolution(samples))
+    nodes = scans.decode_standard(device.encode_revolution(samples))
     angles = np.array([s.angle_deg for s in nodes])
     distances = np.array([s.distance_mm for s in nodes])
     return rplidar_ranges(

@@ -15,6 +15,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from harness.devices import rplidar as rp
+from harness.devices import rplidar_scans as scans
 from harness.devices.revolution import Sample
 
 SERIAL = bytes(range(0x30, 0x40))
@@ -153,11 +154,11 @@ def test_scan_and_force_scan_descriptors() -> None:
 def test_standard_node_golden_bytes() -> None:
     # quality 47, start: 47<<2 | 0b01 = 0xbd; 270 deg = 17280 q6 -> (17280<<1)|1 = 0x8701;
     # 1000 mm = 4000 q2 = 0x0fa0.
-    assert rp.encode_node(Sample(270.0, 1000.0, 47), start=True) == hx("bd 01 87 a0 0f")
+    assert scans.encode_node(Sample(270.0, 1000.0, 47), start=True) == hx("bd 01 87 a0 0f")
     # Not a start: !S set; quality 1; 0.5 deg = 32 q6 -> 0x0041; 0.25 mm = 1 q2.
-    assert rp.encode_node(Sample(0.5, 0.25, 1), start=False) == hx("06 41 00 01 00")
+    assert scans.encode_node(Sample(0.5, 0.25, 1), start=False) == hx("06 41 00 01 00")
     # No return: quality forced to 0 whatever the sample says.
-    assert rp.encode_node(Sample(90.0, 0.0, 40), start=False) == hx(
+    assert scans.encode_node(Sample(90.0, 0.0, 40), start=False) == hx(
         "02 01 2d 00 00"
     )  # 5760 q6 -> 0x2d01
 
@@ -166,14 +167,14 @@ def test_one_revolution_has_one_start_flag_on_the_smallest_angle() -> None:
     samples = uniform(360, offset=0.3)
     rotated = samples[100:] + samples[:100]  # a list that does not begin at the start
     for given_samples in (samples, rotated):
-        nodes = rp.decode_standard_nodes(scanning().encode_revolution(given_samples))
+        nodes = scans.decode_standard_nodes(scanning().encode_revolution(given_samples))
         flags = [start for _, start in nodes]
         assert flags.count(True) == 1 and flags[0]
         assert nodes[0][0].angle_deg == min(s.angle_deg for s, _ in nodes)
 
 
 def test_an_angle_just_below_360_does_not_wrap_to_zero() -> None:
-    nodes = rp.decode_standard_nodes(
+    nodes = scans.decode_standard_nodes(
         scanning().encode_revolution(uniform(4) + [Sample(359.999, 1.0, 5)])
     )
     assert [s.angle_deg for s, _ in nodes] == [0.0, 90.0, 180.0, 270.0, 359.984375]
@@ -194,7 +195,7 @@ def test_an_angle_just_below_360_does_not_wrap_to_zero() -> None:
 )
 def test_standard_round_trip_within_quantisation(values) -> None:
     samples = sorted((Sample(a, d, q) for a, d, q in values), key=lambda s: s.angle_deg)
-    decoded = rp.decode_standard(rp.encode_standard(samples))
+    decoded = scans.decode_standard(scans.encode_standard(samples))
     first = min(range(len(samples)), key=lambda i: round(samples[i].angle_deg * 64))
     for want, got in zip(samples[first:] + samples[:first], decoded, strict=True):
         # Half a q6 step; just below 360 the last step is kept rather than wrapped to 0.
@@ -206,11 +207,11 @@ def test_standard_round_trip_within_quantisation(values) -> None:
 
 def test_decode_standard_rejects_broken_nodes() -> None:
     with pytest.raises(ValueError):
-        rp.decode_standard(hx("bf 01 87 a0 0f"))  # S and !S both set
+        scans.decode_standard(hx("bf 01 87 a0 0f"))  # S and !S both set
     with pytest.raises(ValueError):
-        rp.decode_standard(hx("bd 00 87 a0 0f"))  # check bit clear
+        scans.decode_standard(hx("bd 00 87 a0 0f"))  # check bit clear
     with pytest.raises(ValueError):
-        rp.decode_standard(hx("bd 01 87 a0"))  # not a whole node
+        scans.decode_standard(hx("bd 01 87 a0"))  # not a whole node
 
 
 # -- express scan ----------------------------------------------------------------------
@@ -244,7 +245,7 @@ def test_express_capsule_golden_bytes() -> None:
     samples = [Sample(10.0 + k * 0.25, 100.0 * k, 47) for k in range(32)]
     cabins = [(100 * 2 * c, 0, 100 * (2 * c + 1), 0) for c in range(16)]
     expected = hand_capsule(10 * 64, True, cabins)
-    assert rp.encode_capsule(samples, 18.0, start_flag=True) == expected
+    assert scans.encode_capsule(samples, 18.0, start_flag=True) == expected
     assert len(expected) == 84 and expected[0] >> 4 == 0xA and expected[1] >> 4 == 0x5
 
 
@@ -257,8 +258,8 @@ def test_express_capsule_angle_compensation_bits() -> None:
     cabins = [(1000, 0, 1000, 0) for _ in range(16)]
     cabins[0] = (1000, 0, 1000, 12)
     cabins[1] = (1000, 20, 1000, 0)
-    assert rp.encode_capsule(samples, 18.0) == hand_capsule(640, False, cabins)
-    decoded = rp.decode_express(
+    assert scans.encode_capsule(samples, 18.0) == hand_capsule(640, False, cabins)
+    decoded = scans.decode_express(
         hand_capsule(640, False, cabins), hand_capsule(18 * 64, False, cabins)
     )
     assert decoded[1].angle_deg == pytest.approx(8.75) and decoded[2].angle_deg == pytest.approx(
@@ -274,7 +275,7 @@ def test_express_round_trip_within_capsule_resolution() -> None:
     assert len(stream) % 84 == 0
     capsules = [stream[i : i + 84] for i in range(0, len(stream), 84)]
     decoded = [
-        s for a, b in zip(capsules, capsules[1:], strict=False) for s in rp.decode_express(a, b)
+        s for a, b in zip(capsules, capsules[1:], strict=False) for s in scans.decode_express(a, b)
     ]
     sent = [s for r in revolutions for s in r][: len(decoded)]
     assert len(decoded) >= 2 * per_rev
@@ -282,8 +283,8 @@ def test_express_round_trip_within_capsule_resolution() -> None:
         # dtheta is 1/8 deg (half a step of rounding) plus the SDK's floor to q6.
         assert angle_error(want.angle_deg, got.angle_deg) <= 1 / 16 + 1 / 64 + 1e-9
         assert abs(want.distance_mm - got.distance_mm) <= 0.5  # whole millimetres
-    assert [rp.capsule_start_flag(c) for c in capsules].count(True) == 1
-    assert rp.capsule_start_flag(capsules[0])
+    assert [scans.capsule_start_flag(c) for c in capsules].count(True) == 1
+    assert scans.capsule_start_flag(capsules[0])
 
 
 def test_express_restarts_after_the_motor_stalls() -> None:
@@ -293,18 +294,18 @@ def test_express_restarts_after_the_motor_stalls() -> None:
     assert dev.encode_revolution(uniform(700)) == b""
     dev.set_motor(True)
     again = dev.encode_revolution(uniform(700))
-    assert rp.capsule_start_flag(first[:84]) and rp.capsule_start_flag(again[:84])
-    assert not rp.capsule_start_flag(again[84:168])
+    assert scans.capsule_start_flag(first[:84]) and scans.capsule_start_flag(again[:84])
+    assert not scans.capsule_start_flag(again[84:168])
 
 
 def test_decode_express_checks_capsules() -> None:
     good = hand_capsule(0, False, [(0, 0, 0, 0)] * 16)
     with pytest.raises(ValueError):
-        rp.decode_express(good[:-1], good)
+        scans.decode_express(good[:-1], good)
     with pytest.raises(ValueError):
-        rp.decode_express(bytes([good[0] ^ 1]) + good[1:], good)  # checksum
+        scans.decode_express(bytes([good[0] ^ 1]) + good[1:], good)  # checksum
     with pytest.raises(ValueError):
-        rp.decode_express(bytes([0x50 | (good[0] & 0xF)]) + good[1:], good)  # sync nibble
+        scans.decode_express(bytes([0x50 | (good[0] & 0xF)]) + good[1:], good)  # sync nibble
 
 
 def test_express_modes_the_emulator_does_not_stream_are_ignored() -> None:

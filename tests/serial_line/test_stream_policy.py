@@ -9,6 +9,7 @@ import pytest
 
 from harness.devices import ldlidar as ld
 from harness.devices import rplidar as rp
+from harness.devices import rplidar_scans as scans
 from harness.devices.ldlidar import LdlidarDevice
 from harness.devices.revolution import Sample
 from harness.devices.rplidar import RplidarDevice
@@ -43,13 +44,13 @@ def test_lockstep_extra_sends_each_revolution_whole_then_its_start_marker() -> N
     p, counts = policy(device)
     r0, r1 = revolution(20), revolution(20, 2000.0)
     p.advance(0.0, (r0, 0, 0.1, 1))
-    marker = rp.encode_standard([no_return(r0[0])])
-    assert bytes(p.stream) == rp.encode_standard(r0) + marker
+    marker = scans.encode_standard([no_return(r0[0])])
+    assert bytes(p.stream) == scans.encode_standard(r0) + marker
     assert p.marker_sent and p.marker_size == 1
     (sent,) = drain(p, 0.01)
     assert (sent.tick, sent.push_id, sent.repeat) == (0, 1, False)
     p.advance(0.02, (r1, 1, 0.1, 2))
-    assert bytes(p.stream) == rp.encode_standard(r1) + rp.encode_standard([no_return(r1[0])])
+    assert bytes(p.stream) == scans.encode_standard(r1) + scans.encode_standard([no_return(r1[0])])
     assert (counts.revolutions_sent, counts.markers_sent, counts.revolutions_whole) == (2, 2, 1)
 
 
@@ -60,8 +61,8 @@ def test_lockstep_replace_leaves_out_what_the_marker_stood_for() -> None:
     p.advance(0.0, (r0, 0, 0.1, 1))
     drain(p, 0.0)
     p.advance(0.0, (r1, 1, 0.1, 2))
-    nodes = rp.decode_standard_nodes(bytes(p.stream))
-    assert [s for s, _ in nodes[:-1]] == rp.decode_standard(rp.encode_standard(r1[1:]))
+    nodes = scans.decode_standard_nodes(bytes(p.stream))
+    assert [s for s, _ in nodes[:-1]] == scans.decode_standard(scans.encode_standard(r1[1:]))
     assert not any(start for _, start in nodes[:-1])  # its start flag went with the marker
 
 
@@ -114,11 +115,11 @@ def test_realtime_waits_for_the_slot_and_marks_an_underrun() -> None:
     r0 = revolution(10)
     assert p.slot_open(0.0)
     p.advance(0.0, (r0, 0, 0.1, 1))
-    assert bytes(p.stream) == rp.encode_standard(r0)  # no marker: the next follows on its own
+    assert bytes(p.stream) == scans.encode_standard(r0)  # no marker: the next follows on its own
     drain(p, 0.05)
     assert not p.slot_open(0.05) and p.next_action_at(0.05, pushed=True, idling=False) == 0.1
     p.advance(0.1, None)  # the slot came, nothing new: close the revolution
-    assert counts.underruns == 1 and bytes(p.stream) == rp.encode_standard([no_return(r0[0])])
+    assert counts.underruns == 1 and bytes(p.stream) == scans.encode_standard([no_return(r0[0])])
 
 
 def test_continuous_realtime_repeats_half_a_period_after_the_marker() -> None:
