@@ -38,13 +38,12 @@ from typing import TYPE_CHECKING
 from harness.errors import ConfigError, LinkError, NeverReady
 from harness.judge.answers import Answers, Received
 from harness.links.base import Link, LinkOptions, register
+from harness.links.node_notes import WiringNotes, output_notes
 from harness.links.topic_advice import (
     BOOL_TYPE,
     ELSEWHERE_GRACE_S,
     ElsewhereWatch,
     topic_hints,
-    topics_elsewhere,
-    untaken_topic_parameter,
 )
 from harness.links.watchdogs import FloodWatch, SilenceWatch, Topics, strangers_problem
 from harness.nodes.command import (
@@ -63,7 +62,7 @@ from harness.ros.domain import (
 )
 
 if TYPE_CHECKING:  # numpy and rclpy are imported when the first link starts, after its node
-    from harness.launch_files.run_check import Asked, LaunchCheck  # read for --package, --launch
+    from harness.launch_files.run_check import LaunchCheck  # read for --package, --launch
     from harness.lidar.scan import Scan
     from harness.ros.observer import Heard, Observer
 
@@ -77,7 +76,6 @@ FIRST_RETRY_MAX_S = 2.0  # the first scan's resends back off up to this interval
 # a participant that never names itself (no ROS node) is sent its first scan after this.
 NAMED_WAIT_S = 0.5
 CATCH_UP_S = 2.0  # after a missed deadline, wait this long (at least) for the late answer
-LOUD_BYTES = 1 << 20  # a node that wrote more than this is told how much, in the diagnostics
 
 
 def node_command(options: LinkOptions) -> NodeCommand:
@@ -152,7 +150,7 @@ class Ros2Link(Link):
     def __init__(self, options: LinkOptions, session: LaunchCheck | None = None) -> None:
         super().__init__(options)
         self.command = node_command(options)  # resolve now: bad input exits 2 early
-        self.launch_check = session  # the run's launch files, checked once a run
+        self._wiring = WiringNotes(options, session)  # the run's launch files, if any
         self.process: NodeProcess | None = None
         self.observer: Observer | None = None
         self.domain: DomainReservation | None = None
@@ -171,7 +169,6 @@ class Ros2Link(Link):
         self._copies = 1  # copies of the scan just sent (the first one is resent until answered)
         self._alive_until = 0.0  # perf_counter until which the node counts as running
         self._warmed_up = False
-        self._notes: list[str] | None = None  # notices(), taken once
         self.startup_s = 0.0
         self._started = False
         self._start_error: Exception | None = None
@@ -584,86 +581,18 @@ class Ros2Link(Link):
         """
         if self.process is None:
             return ""
-        parts = []
-        for which in ("stderr", "stdout"):
-            tail = self.process.tail(which)
-            written = self.process.output_bytes(which)
-            if written > LOUD_BYTES:
-                parts.append(f"node {which}: {written / 1e6:.0f} MB written (last lines below)")
-            if tail:
-                parts.append(f"node {which} (last lines):\n{tail}")
-        parts += self._graph_notes()
+        parts = output_notes(self.process)
+        parts += self._wiring.graph_notes(
+            self.observer, warmed_up=self._warmed_up, running=not self._node_exited()
+        )
         self.stop()
         return "\n".join(parts)
 
-    def _graph_notes(self) -> list[str]:
-        """Topic trouble in the graph at the end (a publisher made after it was ready)."""
-        obs = self.observer
-        if obs is None or not obs.usable:
-            return []
-        notes = [f"wrong message type: {w}" for w in obs.wrong_types()]
-        return notes or self.notices()
-
     def notices(self) -> list[str]:
-        """How the node is wired (`_topic_notices`), then what its launch files get
-        wrong (`_launch_notices`)."""
-        return self._topic_notices() + self._launch_notices()
-
-    def _launch_notices(self) -> list[str]:
-        """The run's launch-file notes; the first scenario whose node is up at its end
-        asks the node which parameters it declares."""
-        check = self.launch_check
-        if check is None:
-            return []
-        obs = self.observer
-        up = obs is not None and obs.usable and self._warmed_up and not self._node_exited()
-        return check.notes(self._ask_parameters if up else None)
-
-    def _ask_parameters(self) -> Asked:
-        """(the node under test's name, the parameters it declares), or why not known."""
-        from harness.ros.parameters import declared_parameters, node_on
-
-        assert self.observer is not None
-        opts = self.options
-        node = node_on(self.observer.node, [(opts.status_topic, True), (opts.scan_topic, False)])
-        if node is None:
-            return f"no node publishes {opts.status_topic} or reads {opts.scan_topic}"
-        declared = declared_parameters(self.observer.context, node)
-        return declared if isinstance(declared, str) else (node.lstrip("/"), declared)
-
-    def _topic_notices(self) -> list[str]:
-        """A warning that never came on the warning topic: on which topic the node
-        publishes its Bool instead, and the option that names it (else the graph).
-        Taken once, before `diagnostics` stops the node; the diagnostics repeat it."""
-        if self._notes is not None:
-            return list(self._notes)
-        obs, opts = self.observer, self.options
-        self._notes = []
-        if obs is None or not obs.usable or not self._warmed_up or obs.wrong_types():
-            return []
-        if obs.heard["warning"] or obs.warning_publishers():
-            return []
-        elsewhere = topics_elsewhere(obs.node, BOOL_TYPE, opts.warning_topic, publishers=True)
-        untaken = untaken_topic_parameter(
-            opts, opts.topic_params[2], opts.warning_topic, self._ask_parameters
+        """How the node is wired, then what its launch files get wrong (node_notes)."""
+        return self._wiring.notices(
+            self.observer, warmed_up=self._warmed_up, running=not self._node_exited()
         )
-        if len(elsewhere) == 1 and untaken is not None:
-            self._notes.append(f"the node publishes a Bool on {elsewhere[0]}, not {untaken}")
-        elif len(elsewhere) == 1:
-            self._notes.append(
-                f"the node publishes a Bool on {elsewhere[0]}, not {opts.warning_topic}: pass "
-                f"--warning-topic {elsewhere[0]} if that is the lab's name"
-            )
-        elif elsewhere:
-            self._notes.append(
-                f"the node publishes Bools on {', '.join(elsewhere)}, not {opts.warning_topic}: "
-                "pass --warning-topic with the lab's name"
-            )
-        else:
-            self._notes.append(
-                f"no Bool came on {opts.warning_topic} all run; the graph: {obs.node_topics()}"
-            )
-        return list(self._notes)
 
     # -- lockstep ---------------------------------------------------------
     def send(self, scan: Scan, tick: int, *, clock: float | None = None) -> None:
