@@ -105,8 +105,15 @@ def for_csv(text: str) -> str:
     return f"'{text}" if text.startswith(CSV_FORMULA_STARTS) else text
 
 
-def shown(text: str, limit: int = 200) -> str:
-    """`text` for a one-line message: non-printable characters escaped, long text shortened."""
+def shown(text: str, limit: int = 200, *, quoted: bool = False) -> str:
+    """`text` for a one-line message: non-printable characters escaped, long text shortened.
+
+    `quoted`: in quotes, as ``repr`` writes it, for a name whose spaces or
+    emptiness the reader must see (a topic, a parameter rule); cut at the end.
+    """
+    if quoted:
+        text = repr(text)
+        return text if len(text) <= limit else f"{text[: limit - 4]}...{text[-1]}"
     if not text.isprintable():
         text = repr(text)[1:-1]
     if len(text) > limit:

@@ -26,8 +26,8 @@ from harness.links.kinds import default_link, either, link_kind, link_names, ser
 from harness.ros.names import (
     InvalidName,
     check_parameter_rule,
-    shown,
 )
+from harness.safe_text import shown
 
 if TYPE_CHECKING:
     from harness.runner.settings import RunSettings
@@ -157,9 +157,9 @@ def expanded(option: str, value: str, *, command: bool = False) -> str:
     try:
         result = (expand_command if command else expand_path)(value)
     except NotExpanded as err:
-        raise ConfigError(f"{option} {shown(value)}: {err}") from None
+        raise ConfigError(f"{option} {shown(value, quoted=True)}: {err}") from None
     if not result.strip() and value.strip():
-        raise ConfigError(f"{option} {shown(value)}: expands to nothing")
+        raise ConfigError(f"{option} {shown(value, quoted=True)}: expands to nothing")
     return result
 
 

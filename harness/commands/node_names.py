@@ -19,7 +19,7 @@ from harness.ros.names import (
     check_parameter_rule,
     parameter_target,
     resolve_topic,
-    shown,
+    shown_name,
 )
 
 #: How the command line names each LinkOptions field in a message (with the
@@ -40,7 +40,7 @@ def topic_option(label: str, value: object) -> str:
     try:
         return resolve_topic(value)  # type: ignore[arg-type] - resolve_topic checks the type
     except InvalidName as err:
-        shown_value = shown(value) if isinstance(value, str) else repr(value)[:60]
+        shown_value = shown_name(value) if isinstance(value, str) else repr(value)[:60]
         raise ConfigError(f"{label}{shown_value}: {err}") from None
 
 
@@ -63,7 +63,7 @@ def check_parameters(
             check_parameter_name(threshold_param)
         except InvalidName as err:
             option = names["threshold_param"]
-            raise ConfigError(f"{option}{shown(threshold_param)}: {err}") from None
+            raise ConfigError(f"{option}{shown_name(threshold_param)}: {err}") from None
     threshold_name = parameter_target(f"{threshold_param}:=") if threshold_param else None
     seen: dict[tuple[str, str], str] = {}
     for rule in params:
@@ -74,13 +74,13 @@ def check_parameters(
         target = parameter_target(rule)
         if target in seen:
             raise ConfigError(
-                f"{label}{shown(seen[target])} and {label}{shown(rule)} set the same "
+                f"{label}{shown_name(seen[target])} and {label}{shown_name(rule)} set the same "
                 "parameter: ROS 2 would silently keep the last; give it once"
             )
         seen[target] = rule
         if target[1] == "use_sim_time":
             raise ConfigError(
-                f"{label}{shown(rule)} sets use_sim_time, which the harness passes itself "
+                f"{label}{shown_name(rule)} sets use_sim_time, which the harness passes itself "
                 "(true: the node's time is the harness's /clock, the simulated time of "
                 "each scan); leave it out"
             )
@@ -88,7 +88,7 @@ def check_parameters(
             value = rule.partition(":=")[2]
             threshold = names["threshold"]
             raise ConfigError(
-                f"{label}{shown(rule)} sets {target[1]!r}, the parameter the harness passes "
+                f"{label}{shown_name(rule)} sets {target[1]!r}, the parameter the harness passes "
                 f"the threshold in ({threshold.rstrip(' =')}, default the scenario's): the node "
                 f"and the oracle would disagree; use {threshold}{value.strip()} instead "
                 f"(or {names['threshold_param']}'' if the node must not get the threshold)"
@@ -109,8 +109,8 @@ def checked_node_options(options: LinkOptions, names: Mapping[str, str] = CLI_NA
         if topic in first_with:
             other = first_with[topic]
             raise ConfigError(
-                f"{names[field]}{shown(getattr(options, field))}: the same topic as "
-                f"{names[other]}{shown(getattr(options, other))} ({topic}); the scan, the "
+                f"{names[field]}{shown_name(getattr(options, field))}: the same topic as "
+                f"{names[other]}{shown_name(getattr(options, other))} ({topic}); the scan, the "
                 "status and the warning need a topic each"
             )
         first_with[topic] = field

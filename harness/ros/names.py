@@ -25,7 +25,10 @@ What the harness accepts (README, "The command line"):
 from __future__ import annotations
 
 import re
+from functools import partial
 from typing import Any
+
+from harness.safe_text import shown
 
 __all__ = [
     "MAX_TOPIC_LENGTH",
@@ -36,7 +39,8 @@ __all__ = [
     "parameter_name_problem",
     "parameter_target",
     "resolve_topic",
-    "shown",
+    "SHOWN_LIMIT",
+    "shown_name",
     "topic_name_problem",
 ]
 
@@ -44,17 +48,13 @@ __all__ = [
 MAX_TOPIC_LENGTH = 247
 _ALNUM = frozenset("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789")
 _DIGITS = frozenset("0123456789")
-_SHOWN = 60  # characters of a refused name shown in the message
+SHOWN_LIMIT = 60  # characters of a refused name shown in the message
+#: A name as a message shows it: quoted (spaces and '' visible), cut past SHOWN_LIMIT.
+shown_name = partial(shown, limit=SHOWN_LIMIT, quoted=True)
 
 
 class InvalidName(ValueError):
     """A name ROS 2 (or the harness) refuses; the message is one line without the option."""
-
-
-def shown(name: str) -> str:
-    """`name` quoted for a one-line message: escapes visible, long names cut."""
-    text = repr(name)
-    return text if len(text) <= _SHOWN else f"{text[: _SHOWN - 4]}...{text[-1]}"
 
 
 # -- topic names: rcl_validate_topic_name, rmw_validate_full_topic_name -------
@@ -286,16 +286,17 @@ def check_parameter_rule(rule: Any) -> str:
     if not isinstance(rule, str):
         raise InvalidName(f"expected NAME:=VALUE text, got {type(rule).__name__}")
     name, sep, value = rule.partition(":=")
+    text = shown_name(rule)
     if not sep or not name or not value or any(c.isspace() for c in name):
-        raise InvalidName(f"expected NAME:=VALUE, got {shown(rule)}")
+        raise InvalidName(f"expected NAME:=VALUE, got {text}")
     if "\0" in rule:
-        raise InvalidName(f"ROS 2 cannot parse {shown(rule)}: it holds a NUL character")
+        raise InvalidName(f"ROS 2 cannot parse {text}: it holds a NUL character")
     problem = parameter_name_problem(name)
     if problem is not None:
-        raise InvalidName(f"ROS 2 cannot parse {shown(rule)}: {problem}")
+        raise InvalidName(f"ROS 2 cannot parse {text}: {problem}")
     problem = _rclpy_rule_problem(rule)
     if problem is not None:
-        raise InvalidName(f"ROS 2 cannot parse {shown(rule)}: {problem}")
+        raise InvalidName(f"ROS 2 cannot parse {text}: {problem}")
     return rule
 
 
