@@ -4,21 +4,21 @@ A student's judging process (in its sandbox) leaves each scenario's plot as
 its data (``harness.report.plot.series_data``, JSON) in the grader's own
 folder for that student, and its report names the PNG as usual. The worker
 that graded the student then draws the PNGs into the student's report in a
-process of its own at a lower priority, while its next student runs:
-matplotlib is imported once a worker instead of once a student, and the
-drawing takes what CPU the runs leave. ``grade_class`` waits (bounded) for
-every worker's plots before it returns, the waiting thread drawing what is
-left at the worker's own priority, so the reports are whole when ``grade``
-ends. The data is read as JSON only and the PNG's name is checked:
+process of its own while its next student runs: matplotlib is imported
+once a worker instead of once a student, and the drawing runs beside the
+next run instead of before it. It runs at the worker's priority: at a nice
+value of 10 it starved whenever the machine had other work (its plots then
+waited for the class's end, 20 s after the last student on a machine at load
+11). ``grade_class`` waits (bounded) for every worker's plots before it
+returns, the waiting thread drawing what is still queued, so the reports are
+whole when ``grade`` ends. The data is read as JSON only and the PNG's name is checked:
 nothing a judging process writes can make the grader run code or write
 outside the student's report.
 """
 
 from __future__ import annotations
 
-import contextlib
 import json
-import os
 import queue
 import re
 import subprocess
@@ -38,7 +38,6 @@ if TYPE_CHECKING:
 __all__ = ["PLOT_WAIT_S", "PlotRequests", "Plotter", "draw_requested", "plots_drawn", "plotter"]
 
 REQUEST_SUFFIX = ".plot.json"
-PLOT_NICE = 10  # added to the plotting process's nice value: the runs come first
 DONE = b"done\n"
 # For a worker's plots once its last student is graded: a student's seven plots take
 # about 1.5 CPU-s, and a worker may have several students' left on a loaded machine.
@@ -101,12 +100,11 @@ Job = tuple[Path, Path, Path]  # the plots' data, the report's scenarios folder,
 
 
 class Plotter:
-    """Draws students' plots in a process of lower priority (started when first needed,
-    matplotlib imported there once), fed a student at a time by a thread of ours. A
-    process, not a thread of the worker: a thread of low priority holding the worker's
-    GIL would hold up the worker's own threads whenever the machine is busy. What is
-    still queued when the command waits is drawn by the waiting thread itself, at the
-    worker's priority; so is a student's plots if the process is lost."""
+    """Draws students' plots in a process of its own (started when first needed,
+    matplotlib imported there once), fed a student at a time by a thread of ours: the
+    drawing never holds the worker's GIL. What is still queued when the command waits
+    is drawn by the waiting thread itself; so is a student's plots if the process is
+    lost."""
 
     def __init__(self) -> None:
         self._jobs: queue.SimpleQueue[Job] = queue.SimpleQueue()
@@ -167,8 +165,8 @@ class Plotter:
 
     def wait_drawn(self, timeout: float) -> bool:
         """Wait up to `timeout` s for every plot given so far; True if all are drawn.
-        The waiting thread draws what is still queued itself, at its own priority: once
-        no student runs, the plots left are what the command waits for."""
+        The waiting thread draws what is still queued itself: once no student runs, the
+        plots left are what the command waits for."""
         deadline = time.monotonic() + timeout
         while time.monotonic() < deadline:
             try:
@@ -203,8 +201,6 @@ async def plots_drawn(timeout: float = PLOT_WAIT_S) -> bool:
 def main() -> int:
     """The plotting process: a JSON job a line on stdin, ``done`` a line on stdout once
     drawn; it ends with its stdin (the worker that started it is gone)."""
-    with contextlib.suppress(OSError):
-        os.setpriority(os.PRIO_PROCESS, 0, min(19, os.getpriority(os.PRIO_PROCESS, 0) + PLOT_NICE))
     for line in sys.stdin.buffer:
         try:
             job = json.loads(line)
