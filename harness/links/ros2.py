@@ -37,11 +37,11 @@ from typing import TYPE_CHECKING
 
 from harness.errors import ConfigError, LinkError, NeverReady
 from harness.judge.answers import Answers, Received
+from harness.links import start_explanations
 from harness.links.base import Link, LinkOptions, register
 from harness.links.node_notes import WiringNotes, output_notes
 from harness.links.topic_advice import (
     BOOL_TYPE,
-    ELSEWHERE_GRACE_S,
     ElsewhereWatch,
     topic_hints,
 )
@@ -294,61 +294,32 @@ class Ros2Link(Link):
     def _never_ready(self) -> str:
         """Why the node is not ready: what the harness waited for, and what was missing."""
         assert self.observer is not None
-        opts = self.options
+        obs, opts = self.observer, self.options
         reads = self._reads_scans()
-        publishes = self.observer.status_sub.get_publisher_count() > 0
-        missing = [
-            *([] if reads else [f"subscribe to {opts.scan_topic}"]),
-            *([] if publishes else [f"publish {opts.status_topic}"]),
-        ]
-        reason = (
-            f"it did not {' or '.join(missing)}" if missing else "it was ready only as time ran out"
-        )
-        if not reads:
-            if self._clock_before_ready():
-                reason += " (the harness published /clock, time 0, all the while)"
-            else:
-                reason += (
-                    " (the harness publishes /clock only once the node is ready, so a node "
-                    f"that waits for /clock before it subscribes to {opts.scan_topic} never "
-                    "starts)"
-                )
-        return (
-            f"node {self.command.description} never became ready within "
-            f"{self._ready_bound_said()}: the harness waited for it to subscribe to "
-            f"{opts.scan_topic} and publish {opts.status_topic}, but {reason} "
-            f"({self.observer.graph_summary()})"
-            + topic_hints(self.observer.node, opts, reads=reads, publishes=publishes)
-        )
-
-    def _ready_bound_said(self) -> str:
-        """How long the harness waited for readiness, in words (it stops early once the
-        node is seen using other topics)."""
-        bound = f"{self.options.ready_timeout:g} s"
-        if self._gave_up_early_s is None:
-            return bound
-        return (
-            f"{self._gave_up_early_s:.1f} s (of the {bound} allowed: it uses other topics, "
-            f"seen for {ELSEWHERE_GRACE_S:g} s)"
-        )
+        publishes = obs.status_sub.get_publisher_count() > 0
+        return start_explanations.never_ready(
+            self.command.description,
+            opts,
+            reads=reads,
+            publishes=publishes,
+            clock_all_along=self._clock_before_ready(),
+            waited=start_explanations.ready_bound_said(opts.ready_timeout, self._gave_up_early_s),
+            graph=obs.graph_summary(),
+        ) + topic_hints(obs.node, opts, reads=reads, publishes=publishes)
 
     def _check_types(self, *, named_only: bool = False) -> None:
-        """Fail at once, naming it, when the node publishes what can never reach the harness:
-        another message type on a topic, or best-effort where the harness needs reliable.
+        """Fail at once, naming it, when the node publishes what can never reach the harness.
 
         With `named_only`, a wrong type waits until discovery has told which
         node owns the endpoint, so the explanation can name it.
         """
         assert self.observer is not None
-        wrong = self.observer.wrong_types(named_only=named_only)
-        if wrong:
-            raise LinkError(
-                f"node {self.command.description} uses the wrong message type: "
-                f"{'; '.join(wrong)} (DDS connects only equal types, so nothing crosses)"
-            )
-        qos = self.observer.qos_mismatches()
-        if qos:
-            raise LinkError(f"node {self.command.description} cannot be heard: {'; '.join(qos)}")
+        obs = self.observer
+        why = start_explanations.unheard(
+            self.command.description, obs.wrong_types(named_only=named_only), obs.qos_mismatches()
+        )
+        if why is not None:
+            raise LinkError(why)
 
     # Hooks a link that delivers scans another way (a device and its driver)
     # overrides; the lockstep machinery below stays the same.
@@ -412,7 +383,9 @@ class Ros2Link(Link):
                 break  # answered; or the node is gone, which collect reports at this tick
             self._check_types()
             if time.perf_counter() >= deadline:  # judged at this tick (collect): silent
-                self._first_silence = self._never_answered(scan, copies)
+                self._first_silence = start_explanations.never_answered(
+                    self.command.description, opts, scan, copies
+                )
                 self._first_waited = time.perf_counter() - first_at
                 break
         self._copies = copies
@@ -485,27 +458,6 @@ class Ros2Link(Link):
             1 for h in self.observer.inbox if h.kind == "status" and h.source_ns >= source_ns
         )
 
-    def _never_answered(self, scan: Scan, copies: int) -> str:
-        """Why the node's first answer never came: silent on a scan with nothing in range,
-        or silent altogether."""
-        from harness.judge.oracle import summarise_scan
-
-        opts = self.options
-        if not scan.valid_mask().any():
-            return (
-                f"node {self.command.description} is running and subscribed to "
-                f"{opts.scan_topic} but published nothing on {opts.status_topic} for "
-                f"{copies} scans (the first scan, sent {copies} times over "
-                f"{opts.ready_timeout:g} s), none of which had a valid return "
-                f"({summarise_scan(scan)}): a status is expected when nothing is in range "
-                'too (e.g. "no obstacle")'
-            )
-        return (
-            f"node {self.command.description} never answered a scan within "
-            f"{opts.ready_timeout:g} s (it subscribes to {opts.scan_topic} and publishes "
-            f"{opts.status_topic}, but no status arrived)"
-        )
-
     def warm_up(self, scan: Scan) -> None:
         """Exchange a scan until the node's answer reaches us, then forget it (the
         benchmarks' untimed first exchange, and a run whose first scan a node may ignore).
@@ -536,7 +488,9 @@ class Ros2Link(Link):
             # one swapped for best-effort, say): what can never be heard is said now.
             self._check_types()
             if time.perf_counter() >= deadline:
-                raise LinkError(self._never_answered(scan, copies))
+                raise LinkError(
+                    start_explanations.never_answered(self.command.description, opts, scan, copies)
+                )
         if obs.node.count_publishers(opts.warning_topic) > 0:
             self._wait_for(lambda: obs.warning_publishers() > 0, WARM_UP_RETRY_S)
         # By now the node's other publishers are known too; give discovery a
