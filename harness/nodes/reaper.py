@@ -152,8 +152,19 @@ class Reaper:
 
 
 def _signal_group(pid: int, sig: int) -> None:
-    """Signal the node's process group (it leads its own session), and the node itself."""
-    for send in (os.killpg, os.kill):
+    """Signal the node's process group (it leads its own session); the node itself too
+    only if it has left that group.
+
+    Never twice to the node: a Python node's exit on a second SIGINT depends on when it
+    comes. Its handler ran for the first; from its interpreter's teardown on, the default
+    action is back, and the second kills it (exit -2, a clean stop judged a crash). A
+    stop preempted between two sends, on a loaded machine, was seen to land there.
+    """
+    try:
+        in_group = os.getpgid(pid) == pid
+    except (ProcessLookupError, PermissionError):
+        in_group = False
+    for send in (os.killpg,) if in_group else (os.killpg, os.kill):
         try:
             send(pid, sig)
         except (ProcessLookupError, PermissionError):

@@ -21,6 +21,7 @@ from harness.links.base import LinkOptions
 from harness.nodes.command import NodeCommand, reference_node, ros_arguments
 from harness.nodes.forkserver import ForkedSupervisor, ForkServer, _exit_code
 from harness.nodes.process import FORK_SERVER_SETTING, NodeProcess
+from harness.nodes.reaper import _signal_group
 from harness.ros.domain import discovery_environment, reserve_domain
 from harness.runner.suite import run_suite
 from harness.scenario.files import resolve_scenario
@@ -69,6 +70,73 @@ def test_turned_off_the_node_starts_as_a_command(monkeypatch: pytest.MonkeyPatch
         assert isinstance(process._popen, subprocess.Popen)
         assert wait_until(lambda: "threshold 0.4 m" in process.tail("stderr"), 15), process.tail()
         assert process.stop() == 0
+
+
+# Counts the SIGINTs it gets, one line each, and stops 0.3 s after the first: a second
+# SIGINT sent in that time is counted (a real node's would come during its teardown,
+# when the default action is back, and kill it: exit -2).
+COUNTING_NODE = """
+import signal, sys, time
+stop = 0.0
+def on_sigint(signum, frame):
+    global stop
+    with open(sys.argv[1], "a") as handle:
+        handle.write("SIGINT\\n")
+    stop = stop or time.monotonic() + 0.3
+signal.signal(signal.SIGINT, on_sigint)
+print("up", flush=True)
+end = time.monotonic() + 30
+while time.monotonic() < end and not (stop and time.monotonic() >= stop):
+    time.sleep(0.01)
+"""
+
+
+@pytest.mark.parametrize("fork_server", ["1", "0"])
+def test_a_node_is_sent_sigint_once(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, fork_server: str
+) -> None:
+    """The stop signals the node's process group, which the node leads: not the node too.
+    Twice, a stop preempted between the sends (a loaded machine) killed a node that was
+    stopping cleanly (the reference node exited -2, not 0)."""
+    monkeypatch.setenv(FORK_SERVER_SETTING, fork_server)
+    script, count = tmp_path / "counting_node.py", tmp_path / "sigints"
+    script.write_text(COUNTING_NODE)
+    process = NodeProcess(NodeCommand((sys.executable, str(script), str(count))), [], {})
+    process.start()
+    assert wait_until(lambda: "up" in process.tail("stdout"), 15), process.tail()
+    assert process.stop() == 0
+    assert process.stopped_by == "SIGINT"
+    assert count.read_text().splitlines() == ["SIGINT"]
+
+
+# A group leader that counts the SIGRTMINs it gets: real-time signals queue, so two sent
+# are two taken, however close together (two SIGINTs may merge into one).
+QUEUED_COUNTER = """
+import os, signal, sys
+signal.pthread_sigmask(signal.SIG_BLOCK, [signal.SIGRTMIN])
+print("up", flush=True)
+count = 0
+while signal.sigtimedwait([signal.SIGRTMIN], 10 if count == 0 else 0.5) is not None:
+    count += 1
+print(count, flush=True)
+"""
+
+
+def test_the_stop_signals_a_node_leading_its_group_once() -> None:
+    """A signal of the stop reaches the node once: its group's, not its group's and its own."""
+    child = subprocess.Popen(
+        [sys.executable, "-c", QUEUED_COUNTER],
+        stdout=subprocess.PIPE,
+        text=True,
+        start_new_session=True,
+    )
+    try:
+        assert child.stdout is not None and child.stdout.readline() == "up\n"
+        _signal_group(child.pid, signal.SIGRTMIN)
+        assert child.communicate(timeout=20)[0] == "1\n"
+    finally:
+        child.kill()
+        child.wait(timeout=10)
 
 
 def test_a_server_that_cannot_import_its_module_is_not_used() -> None:
