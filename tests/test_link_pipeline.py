@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 
 from harness.links.base import Link, LinkOptions
-from harness.runner.link_pipeline import AHEAD, BEHIND, LinkPipeline
+from harness.runner.link_pipeline import AHEAD, BEHIND, LinkPipeline, ReportsBehind
 
 
 class Recorded(Link):
@@ -93,3 +93,40 @@ def test_drain_closes_a_link_whose_run_raised() -> None:
     links.drain()
     links.drain()  # again: nothing more to do
     assert log == ["start 0", "stop 0", "close 0"]
+
+
+def test_a_serial_links_pipeline_starts_the_next_one_ahead_and_leaves_none_behind() -> None:
+    """ahead=1, behind=0 (a board's links share one device): while scenario i runs, only
+    i + 1 is up beside it, and i is closed before i + 1 is taken."""
+    log: list[str] = []
+    links = LinkPipeline(lambda i: Recorded(i, log), 3, overlap=True, ahead=1, behind=0)
+    link = links.take(0)
+    assert log == ["start 0", "start 1"]
+    links.retire(link, lambda waited: None)
+    assert log[-2:] == ["stop 0", "close 0"]
+    link = links.take(1)
+    assert log[-1] == "start 2"
+    links.retire(link, lambda waited: None)
+    links.drain()
+    assert [e for e in log if e.startswith("close")] == ["close 0", "close 1", "close 2"]
+
+
+def test_reports_behind_wait_for_finish_and_come_in_order() -> None:
+    """Reports behind (a serial link's device streams in real time): none while the
+    suite runs, all in order at finish, once."""
+    seen: list[int] = []
+    reports = ReportsBehind(seen.append, behind=True)
+    for i in range(5):
+        reports(i)
+    assert seen == []
+    reports.finish()
+    reports.finish()
+    assert seen == [0, 1, 2, 3, 4]
+
+
+def test_reports_not_behind_are_made_at_once() -> None:
+    seen: list[int] = []
+    reports = ReportsBehind(seen.append, behind=False)
+    reports(3)
+    assert seen == [3]
+    reports.finish()

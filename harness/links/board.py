@@ -39,10 +39,23 @@ from harness.judge.answers import Answers
 from harness.lidar.mount import LidarMount
 from harness.lidar.scan import Scan
 from harness.links.base import LinkOptions
-from harness.links.board_session import BoardSession
-from harness.links.ros2 import POLL_S, Ros2Link
-from harness.nodes.quiescence import Quiescence
-from harness.ros.observer import Heard
+from harness.links.board_idle import (
+    IDLE_LAST_ANSWER_S,
+    IdleStreamEnd,
+    set_aside_answers_to_the_idle_stream,
+)
+from harness.links.board_pairing import pair_with_driver_scans
+from harness.links.board_session import BoardSession, remappable, takes_remaps
+from harness.links.ros2 import (
+    POLL_S,
+    Ros2Link,
+    harness_observer,
+    node_command,
+    node_parameters,
+)
+from harness.nodes.command import node_arguments
+from harness.nodes.process import NodeProcess
+from harness.ros.observer import Heard, Observer
 
 if TYPE_CHECKING:
     from harness.serial_line.diagnosis import LineReport
@@ -54,14 +67,6 @@ LOST_IN_A_ROW = 5  # line faults: this many revolutions without a driver scan is
 # (the FOSSBot v2's agent) yields none of 5 or fewer.
 SPARSE_RETURNS = 5
 SPARSE_WAIT_S = 0.25  # at least this long for the board's scan of such a revolution
-IDLE_ANSWER_S = 1.0  # before the first tick: for the node to answer the idle stream (each wait)
-STREAM_QUIET_REVOLUTIONS = 3  # no board scan of the idle stream in this many: none is coming
-IDLE_QUIET_MAX_S = 2.0  # longest wait for a lagging driver's last idle revolutions
-# Longest wait for a node (that answered the idle stream) to answer its last revolutions
-# and fall quiet: answered later, during the first tick, one would be taken for the first
-# tick's answer (seen in CI: out_of_range's tick 0 answered with approach_wall's last).
-IDLE_LAST_ANSWER_S = 3.0
-IDLE_IN_FLIGHT_S = 0.03  # then for an answer already published to reach us
 
 
 def board_options(options: LinkOptions) -> LinkOptions:
@@ -78,7 +83,7 @@ def board_options(options: LinkOptions) -> LinkOptions:
     return options
 
 
-class BoardLink(Ros2Link):
+class BoardLink(IdleStreamEnd, Ros2Link):
     """A LIDAR device emulated on a serial line, read by the board's own driver."""
 
     sets_node_topics = False  # the board's driver publishes the scan topic for the run
@@ -90,7 +95,9 @@ class BoardLink(Ros2Link):
     # was still matching), and the device must not be kept waiting while the node
     # answers nothing: the driver gives up on a silent line.
     copies_queue = False
-    starts_ahead = False  # one line, one board at a time
+    # One line, one board; but on the virtual board the next scenario's node comes up
+    # while this one runs, answering on topics of its own (`links_ahead`).
+    starts_ahead = True
 
     def __init__(self, options: LinkOptions, session: BoardSession | None = None) -> None:
         options = board_options(options)
@@ -117,6 +124,26 @@ class BoardLink(Ros2Link):
         # answered none before the first tick, so how many it owes is not known).
         self._idle_owed = False
         self._idle_quiet_s = 0.0  # three revolutions at the first scan's rate
+        # The node's status and warning topics, its own in the run's domain (remapped),
+        # or None: the options' (no session shared, a physical board, a launch file).
+        self._own_topics: tuple[str, str] | None = None
+        if session is not None and not self.physical and takes_remaps(self.command):
+            self._own_topics = session.node_topics(options.status_topic, options.warning_topic)
+
+    @classmethod
+    def links_ahead(cls, options: LinkOptions) -> int:
+        """How many links a suite starts beyond the running one: on the virtual board the
+        next, so its node and world are ready before this scenario's last revolution. It
+        hears this scenario's scans on the board's scan topic but answers on topics of its
+        own (``BoardSession.node_topics``), which only its own link hears. None on a
+        physical board, for a node a launch file starts, or for private topic names."""
+        if options.port is not None or not remappable(options.status_topic, options.warning_topic):
+            return 0
+        try:
+            command = node_command(options)
+        except ConfigError:
+            return 0  # reported where the link is made
+        return 1 if takes_remaps(command) else 0
 
     @classmethod
     def run_session(cls, options: LinkOptions) -> BoardSession:
@@ -162,10 +189,37 @@ class BoardLink(Ros2Link):
         super().start()
 
     def _start_processes(self, env: dict[str, str]) -> None:
-        assert self.session is not None
-        self.session.set_rate(self.options.scan_rate_hz)
-        if not self.physical:
-            super()._start_processes(env)  # the node under test; the board's software runs
+        if self.physical:
+            return  # the board's software runs its nodes
+        if self._own_topics is None:
+            super()._start_processes(env)  # the node under test, on the options' topics
+            return
+        opts = self.options
+        args = node_arguments(self.command, node_parameters(opts))
+        status, warning = self._own_topics
+        args += ["-r", f"{opts.status_topic}:={status}", "-r", f"{opts.warning_topic}:={warning}"]
+        held = None if self.domain is None else self.domain.fileno()
+        self.process = NodeProcess(self.command, args, env, held=held)
+        self.process.start(wait=False)  # open() waits: the next link starts meanwhile
+        self.node_start = f"{self.command.description}, {self.process.how}"
+
+    def _make_observer(self, domain_id: int) -> Observer:
+        """The harness's node in the run's domain, hearing this link's node only: on its
+        own topics where it has them."""
+        options = self.options
+        if self._own_topics is not None:
+            status, warning = self._own_topics
+            options = replace(options, status_topic=status, warning_topic=warning)
+        return harness_observer(options, domain_id, publish_scans=False)
+
+    def open(self) -> None:
+        """As the ros2 link's; what the observer heard before (a link started ahead, while
+        the scenario before ran) answers nothing of this scenario's; the device takes
+        this scenario's rate (not at `start`: the scenario before may still run)."""
+        super().open()
+        assert self.observer is not None and self.session is not None
+        self.observer.inbox.clear()
+        self.session.set_rate(self.options.scan_rate_hz)  # its turn: the device spins at its rate
 
     def _ready(self) -> bool:
         assert self.observer is not None and self.server is not None
@@ -285,10 +339,6 @@ class BoardLink(Ros2Link):
         self._not_this_revolution(written_ns)
         self._seen = heard.value
         self._scans_from = heard.source_ns
-        if tick >= 0 and not self._gap_measured:  # this scenario's first judged revolution
-            self._gap_measured = True
-            if self.session.judged_at is not None:  # the scenario before judged one
-                self.gap_s = time.perf_counter() - self.session.judged_at
         if self._lost_in_a_row:
             # The last revolution made no scan in time: this one may be it, late (the
             # line ate what closed it), with this revolution's own scan just behind.
@@ -340,105 +390,11 @@ class BoardLink(Ros2Link):
             self._line_damage, self._after_first = self._after_first, None
             self.server.damage = self._line_damage
 
-    def _end_idle_stream(self, scan: Scan) -> None:
-        """Before the first tick: wait (bounded) until the node answers one of the idle
-        stream's scans, so its subscription has matched the board's publisher and the
-        first scan reaches it; stop the idle stream; let the node answer the last scan
-        it made; forget those answers, so none is taken for the first tick's.
-
-        Unlike the ros2 link's node, a board's has heard scans before the first tick:
-        the device streams from the moment the session opens. A node silent when
-        nothing is in range may answer none of an empty room's: each wait is bounded,
-        and none is made when the board publishes no scan of the stream (a driver
-        skipping sparse revolutions).
-        """
-        assert self.observer is not None
-        if self._pushed:
-            return
-        obs = self.observer
-        rate = self._rate(scan)
-        began = time.perf_counter()
-
-        def answering() -> bool:
-            if obs.heard_since("status", 1):
-                return True  # it answered a scan of the stream
-            quiet = not any(h.kind == "scan" for h in obs.inbox)
-            return quiet and time.perf_counter() - began > STREAM_QUIET_REVOLUTIONS / rate
-
-        self._wait_for(answering, IDLE_ANSWER_S)
-        answered = obs.heard_since("status", 1)
-        self._idle_over(rate)
-        # A driver that lags (a loaded machine: it clears its input buffer) still has
-        # idle revolutions to publish: wait, bounded, until it has been quiet for three
-        # revolutions, so the node answers them now, not during the first tick.
-        quiet_s = STREAM_QUIET_REVOLUTIONS / rate
-
-        def driver_quiet() -> bool:
-            last = max((h.arrived for h in obs.inbox if h.kind == "scan"), default=began)
-            return time.perf_counter() - last > quiet_s
-
-        self._wait_for(driver_quiet, IDLE_QUIET_MAX_S)
-        idle = [h.source_ns for h in obs.inbox if h.kind == "scan"]
-        self._idle_quiet_s, self._idle_owed = quiet_s, bool(idle)
-        pids = self._local_pids()
-        if idle and pids:
-            # The node and the board's software run here: wait (bounded) until every
-            # thread of theirs sleeps, so none has a revolution left to answer.
-            # A node that answered none of the stream may be asleep in its first
-            # callback with the rest queued: asleep is not done for it.
-            done = self._wait_for(Quiescence(pids), IDLE_LAST_ANSWER_S) is None
-            self._idle_owed = not (done and answered)
-            self._wait_for(lambda: False, max(self._grace(), IDLE_IN_FLIGHT_S))
-        elif idle and answered:
-            # A node lagging on a loaded machine answers older scans after the last one
-            # was published: wait (bounded) until it answered after the last idle scan and
-            # then said nothing for three revolutions, so no idle answer is left to arrive
-            # during the first tick.
-            def answers_done() -> bool:
-                return obs.heard_since("status", max(idle)) and self._statuses_quiet()
-
-            self._idle_owed = self._wait_for(answers_done, IDLE_LAST_ANSWER_S) == "timeout"
-            self._wait_for(lambda: False, self._grace())  # its Bool, if any
-        obs.drain()
-        obs.inbox.clear()
-
-    def _local_pids(self) -> list[int]:
-        """The node under test and the virtual board's processes (none for a physical
-        board: its software runs elsewhere)."""
-        if self.physical:
-            return []
-        processes = [p for _, p in self.session.processes] if self.session is not None else []
-        processes += [self.process] if self.process is not None else []
-        return [p.node_pid for p in processes if p.node_pid is not None]
-
-    def _idle_over(self, rate: float) -> None:
-        """End the session's idle stream (this scenario's first push comes next); line
-        damage acts from then on."""
-        assert self.server is not None
-        self._pushed = True
-        self._after_idle_stream(rate)
-        if self._line_damage is not None:
-            self.server.damage = self._line_damage
-
     def _rate(self, scan: Scan) -> float:
         return 1.0 / scan.scan_time if scan.scan_time > 0 else self.options.scan_rate_hz
 
     def _reached_node(self) -> bool:
         return self._lost is None  # a revolution the board published no scan of: lost
-
-    def _after_idle_stream(self, rate: float) -> None:
-        """Lockstep: stop the session's idle stream and let the driver's scan of its last
-        revolution come first, so it is never taken for this scenario's."""
-        assert self.session is not None and self.observer is not None
-        since = self.session.end_idle()
-        if since is None:
-            return
-        obs = self.observer
-
-        def idle_scan() -> bool:
-            return any(h.kind == "scan" and h.source_ns >= since for h in obs.inbox)
-
-        self._wait_for(idle_scan, max(self.options.scan_timeout, 1.0 / rate))
 
     def _push(self, samples: list[Any], tick: int, rate: float) -> int | None:
         """Queue the revolution and wait (bounded) until it went out whole; the system time
@@ -562,25 +518,32 @@ class BoardLink(Ros2Link):
         copies, and the node answers in order, so the last answer is the last copy's
         (`collect` keeps it, setting aside what answered the idle stream)."""
 
-    def _statuses_quiet(self) -> bool:
-        """The node said nothing for three revolutions (it has at least answered once)."""
-        assert self.observer is not None
-        last = max((h.arrived for h in self.observer.inbox if h.kind == "status"), default=0.0)
-        return time.perf_counter() - last > self._idle_quiet_s
+    def _between_scenarios(self, tick: int) -> None:
+        """This scenario's first tick is out (its driver scan came, or it was lost): the
+        gap since the scenario before's last tick ended (``gap_s``; its ticks at the
+        end that the board made no scan of belong to it, not to the gap)."""
+        if tick < 0 or self._gap_measured or self.session is None:
+            return
+        self._gap_measured = True
+        if self.session.last_tick_at is not None:  # a scenario ran before on this device
+            self.gap_s = time.perf_counter() - self.session.last_tick_at
 
     def collect(self, scan: Scan, tick: int, *, may_be_ignored: bool = False) -> Answers:
+        self._between_scenarios(tick)
         if self._lost is not None:
             # The node never got this revolution: nothing to wait for. What it
             # publishes meanwhile is sorted by the next exchange, by send time.
+            if self.session is not None:
+                self.session.last_tick_at = time.perf_counter()
             return Answers(lost=self._lost)
         assert self.observer is not None
         self._heard_scans = []
         answers = super().collect(scan, tick, may_be_ignored=may_be_ignored)
         if self._after_idle:
             self._after_idle = False
-            _set_aside_answers_to_the_idle_stream(answers, len(self._heard_scans))
+            set_aside_answers_to_the_idle_stream(answers, len(self._heard_scans))
             answers.owed_before = True  # its answers still to come are newer: this tick's
-        _pair_with_driver_scans(answers, self._heard_scans)
+        pair_with_driver_scans(answers, self._heard_scans)
         if self._repeat_at is not None:  # answers to the device's repeats answer no tick
             answers.first_answer_only()
             self._sends = [*self._sends, (None, self._repeat_at)]
@@ -590,7 +553,7 @@ class BoardLink(Ros2Link):
         if self._delivery_problem and answers.problem is None:
             answers.problem = self._delivery_problem
         if self.session is not None:
-            self.session.judged_at = time.perf_counter()
+            self.session.last_tick_at = time.perf_counter()
         return answers
 
     def _settled(self) -> None:
@@ -634,53 +597,3 @@ class BoardLink(Ros2Link):
         if self.session is not None and self._own_session:
             notes.append(self.session.stop_note())
         return "\n".join(n for n in notes if n)
-
-
-def _set_aside_answers_to_the_idle_stream(answers: Answers, scans: int) -> None:
-    """The first exchange after the idle stream: more statuses than the driver published
-    scans in it means the earliest answer revolutions streamed before (a driver lagging
-    on a loaded machine publishes them late, after the harness stopped waiting for
-    them). The node answers in order, so the last `scans` statuses (and the Bools nearest
-    to them) are this exchange's; the others are kept as late answers of no tick."""
-    statuses = sorted(answers.statuses, key=lambda r: r.source_ns)
-    extra = len(statuses) - max(1, scans)
-    if extra > 0:
-        answers.keep_only(statuses[extra:])
-
-
-def _pair_with_driver_scans(answers: Answers, scans: list[Heard]) -> None:
-    """Give each answer the driver scan it answered.
-
-    Usually the driver made one scan of the revolution. When the line made
-    a revolution late (its scan came with the next one) or split one in
-    two, several came, often published back to back, before the node
-    answered any. The node answers scans in order, so the i-th status
-    answers the i-th scan. With as many Bools as statuses the i-th Bool
-    goes with the i-th status too; otherwise (a Bool published only on
-    change) each goes with the status published nearest to it. Nearness
-    alone misleads when callbacks run back to back on a loaded machine:
-    the next scan's Bool can come closer to the previous status than to
-    its own. The newest scan is this tick's; the earlier ones go with their answers into
-    ``answers.earlier``, each judged on its own.
-    """
-    if len(scans) < 2:
-        return
-    seen = [h.value for h in scans if isinstance(h.value, Scan)]
-    groups = [Answers(seen=scan, waited=answers.waited) for scan in seen]
-    statuses = sorted(answers.statuses, key=lambda r: r.source_ns)
-    for i, item in enumerate(statuses):
-        groups[min(i, len(groups) - 1)].statuses.append(item)
-    warnings = sorted(answers.warnings, key=lambda r: r.source_ns)
-    for i, item in enumerate(warnings):
-        if not statuses:
-            status = len(groups) - 1
-        elif len(warnings) == len(statuses):
-            status = i
-        else:
-            status = min(
-                range(len(statuses)), key=lambda j: abs(statuses[j].source_ns - item.source_ns)
-            )
-        groups[min(status, len(groups) - 1)].warnings.append(item)
-    answers.statuses, answers.warnings = groups[-1].statuses, groups[-1].warnings
-    answers.seen = seen[-1]
-    answers.earlier = list(zip(seen[:-1], groups[:-1], strict=True))

@@ -39,6 +39,7 @@ if TYPE_CHECKING:
 
 PORT_FIELD = "{port}"
 DRIVER_NAME = "the board's LIDAR driver"  # the bundled driver, in messages
+OWN_TOPICS = "/_fossbot_hil"  # where each node under test answers (`node_topics`)
 END_IDLE_S = 1.0  # lockstep: for the idle stream's last revolution to be written
 
 
@@ -52,6 +53,17 @@ def board_command(text: str, port: str = "/dev/null") -> NodeCommand:
     except ConfigError as err:
         raise ConfigError(str(err).replace(shlex.quote(port), PORT_FIELD)) from None
     return NodeCommand(argv, description=f"board command {text!r}")
+
+
+def takes_remaps(command: NodeCommand) -> bool:
+    """Does the node take ``--ros-args`` (so ``-r`` remaps its topics)? Not one a launch
+    file starts: its items are launch arguments."""
+    return command.launch_arguments is None
+
+
+def remappable(*topics: str) -> bool:
+    """Plain names a ``-r`` remap can move (not a private ``~`` or substituted one)."""
+    return all(name and name[0] not in "~{" for name in topics)
 
 
 def check_board_commands(texts: tuple[str, ...]) -> None:
@@ -88,10 +100,12 @@ class BoardSession:
         self.server: DeviceServer | None = None
         self.domain: DomainReservation | None = None
         self.processes: list[tuple[str, NodeProcess]] = []  # (name in messages, process)
-        self.judged_at: float | None = None  # perf_counter of the last judged scan's answers
+        # perf_counter when the last tick's exchange ended (judged, or lost: no board scan)
+        self.last_tick_at: float | None = None
         # Does the board skip revolutions with next to no returns (rplidar's iter_scans
         # does)? None until one such revolution was sent.
         self.skips_sparse: bool | None = None
+        self._nodes = 0  # nodes under test given topics of their own (`node_topics`)
         self._closed = False
 
     # -- life cycle -------------------------------------------------------
@@ -197,6 +211,22 @@ class BoardSession:
         return [
             Sample(angle_deg=360.0 * j / count, distance_mm=0.0, quality=0) for j in range(count)
         ]
+
+    def node_topics(self, status: str, warning: str) -> tuple[str, str] | None:
+        """A status and a warning topic of its own for the next node under test, or None
+        for names that are not plain (a private ``~`` name).
+
+        Every scenario's node hears the board's scan topic in the run's domain;
+        the next one is started while this one runs (``BoardLink.links_ahead``).
+        Each answers on its own names under ``OWN_TOPICS`` (hidden, as a
+        leading underscore makes a ROS name), so one node's answers never reach
+        another scenario's judging; messages still name the options' topics.
+        """
+        if not remappable(status, warning):
+            return None
+        self._nodes += 1
+        prefix = f"{OWN_TOPICS}/node{self._nodes}"
+        return tuple(f"{prefix}/{name.lstrip('/')}" for name in (status, warning))  # type: ignore[return-value]
 
     # -- between and during scenarios -------------------------------------
     def set_rate(self, rate_hz: float) -> None:

@@ -26,6 +26,7 @@ from __future__ import annotations
 import time
 from collections import deque
 from collections.abc import Callable
+from typing import Generic, TypeVar
 
 from harness.errors import ConfigError
 from harness.links.base import Link
@@ -34,6 +35,7 @@ AHEAD = 4  # links started beyond the one running (see the module's docstring)
 BEHIND = 2  # finished links left stopping before the suite waits for the oldest
 
 Closed = Callable[[float], None]  # told the seconds the suite waited for the close
+R = TypeVar("R")
 
 
 class _Unmade:
@@ -46,11 +48,19 @@ class _Unmade:
 class LinkPipeline:
     """Hands out the links of scenarios 0..count-1 in order, started ahead where allowed."""
 
-    def __init__(self, make: Callable[[int], Link], count: int, *, overlap: bool) -> None:
+    def __init__(
+        self,
+        make: Callable[[int], Link],
+        count: int,
+        *,
+        overlap: bool,
+        ahead: int = AHEAD,
+        behind: int = BEHIND,
+    ) -> None:
         self._make = make
         self._count = count
-        self._ahead = AHEAD if overlap else 0
-        self._behind = BEHIND if overlap else 0
+        self._ahead = ahead if overlap else 0
+        self._behind = behind if overlap else 0
         self._started: deque[Link | _Unmade] = deque()  # made and started, not yet taken, in order
         self._next = 0  # the index of the next link to make
         self._stopping: deque[tuple[Link, Closed]] = deque()
@@ -113,3 +123,35 @@ class LinkPipeline:
         finally:
             for link in unused:
                 link.close()
+
+
+class ReportsBehind(Generic[R]):
+    """Hands each finished scenario's result to `report` in order: at once, or with
+    `behind` once the suite's links are done (`finish`).
+
+    A serial link's next scenario follows its device's stream in real time;
+    writing the finished one's report (its plot, its recording: seconds on
+    a loaded machine) between the two would keep the device streaming
+    revolutions nobody judges, and writing it beside the next scenario
+    would take the interpreter from the thread that paces the device's
+    bytes (a revolution was seen to miss its slot). So those reports wait
+    for the device session to end; the verdicts are shown as each scenario
+    is judged (`on_judged`). `finish` reports everything still held, in
+    order, even when the suite is ending on an error.
+    """
+
+    def __init__(self, report: Callable[[R], None], *, behind: bool) -> None:
+        self._report = report
+        self._behind = behind
+        self._held: deque[R] = deque()
+
+    def __call__(self, result: R) -> None:
+        if self._behind:
+            self._held.append(result)
+        else:
+            self._report(result)
+
+    def finish(self) -> None:
+        """Report every result held, in order. Safe to call again."""
+        while self._held:
+            self._report(self._held.popleft())

@@ -12,7 +12,7 @@ from harness.judge.records import RunResult, TickRecord
 from harness.links.base import Link, LinkOptions, create_link, link_class
 from harness.nodes.forkserver import scope as fork_servers
 from harness.nodes.setup_problems import setup_problem
-from harness.runner.link_pipeline import LinkPipeline
+from harness.runner.link_pipeline import AHEAD, BEHIND, LinkPipeline, ReportsBehind
 from harness.runner.plan import plan_suite
 from harness.runner.scenario_run import closed, run_scenario, run_through
 from harness.runner.settings import RunSettings
@@ -46,15 +46,18 @@ def run_suite(
     are marked not run instead of each waiting out its start.
     """
     results: list[RunResult] = []
-
-    def report(result: RunResult) -> None:
-        results.append(result)
-        if on_result is not None:
-            on_result(result)
-
     if not scenarios:
         return results
     cls = link_class(link_name)
+    # A serial link's next scenario follows in real time: the finished ones' reports are
+    # made once its device session is over (ReportsBehind), in order.
+    told = ReportsBehind(on_result, behind=cls.serial_line) if on_result is not None else None
+
+    def report(result: RunResult) -> None:
+        results.append(result)
+        if told is not None:
+            told(result)
+
     cls.prepare(options)
     plans = plan_suite(scenarios, link_name, options, settings)  # before anything starts
     first = plans[0].options
@@ -63,7 +66,8 @@ def run_suite(
         def make(index: int) -> Link:
             return create_link(link_name, plans[index].options, session)
 
-        pipeline = LinkPipeline(make, len(scenarios), overlap=_links_overlap(link_name, options))
+        ahead, behind = _overlap(cls, options)
+        pipeline = LinkPipeline(make, len(scenarios), overlap=ahead > 0, ahead=ahead, behind=behind)
         failed_start: str | None = None
         index = 0
         try:
@@ -107,10 +111,16 @@ def run_suite(
                 pipeline.retire(link, _reporter(result, link, report))
         except KeyboardInterrupt as err:
             pipeline.drain()  # every process reaped; finished scenarios reported first
+            if told is not None:
+                told.finish()
             rest = scenarios[index:]
             raise _suite_interrupted(err, results, rest, link_name, on_result) from None
         finally:  # every link closed (in order: the last results are reported here)
-            pipeline.drain()
+            try:
+                pipeline.drain()
+            finally:
+                if told is not None:
+                    told.finish()
     return results
 
 
@@ -134,9 +144,15 @@ def _reporter(
     return on_closed
 
 
-def _links_overlap(link_name: str, options: LinkOptions) -> bool:
-    """Start links ahead and stop them behind? Only where each has a domain of its own."""
-    return link_class(link_name).starts_ahead and options.domain_id is None
+def _overlap(cls: type[Link], options: LinkOptions) -> tuple[int, int]:
+    """How many links to start ahead and leave stopping behind: where each has a domain
+    of its own, AHEAD and BEHIND; where they share the run's session (a serial link's
+    device and domain), what the class says; else none."""
+    if not cls.starts_ahead:
+        return 0, 0
+    if cls.serial_line:
+        return cls.links_ahead(options), 0  # type: ignore[attr-defined]
+    return (AHEAD, BEHIND) if options.domain_id is None else (0, 0)
 
 
 def _explicit_domain(link_name: str, options: LinkOptions) -> AbstractContextManager[object]:

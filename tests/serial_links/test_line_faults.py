@@ -258,7 +258,7 @@ def test_each_answer_is_judged_against_the_driver_scan_it_answered() -> None:
 def test_answers_are_paired_with_driver_scans_in_order() -> None:
     """Scans published back to back: the i-th status answers the i-th scan, a Bool goes
     with the status published nearest to it."""
-    from harness.links.board import _pair_with_driver_scans
+    from harness.links.board_pairing import pair_with_driver_scans
 
     late, own, scans = back_to_back_scans()
     answers = Answers(
@@ -268,7 +268,7 @@ def test_answers_are_paired_with_driver_scans_in_order() -> None:
         ],
         warnings=[Received(False, 0.01, source_ns=2_001), Received(True, 0.02, source_ns=2_999)],
     )
-    _pair_with_driver_scans(answers, scans)
+    pair_with_driver_scans(answers, scans)
     assert answers.seen is own and [r.value for r in answers.statuses] == ["Min distance: 0.486 m"]
     assert [r.value for r in answers.warnings] == [True]
     ((scan, first),) = answers.earlier
@@ -280,7 +280,7 @@ def test_back_to_back_callbacks_keep_each_bool_with_its_own_status() -> None:
     """Bool before status, callbacks back to back on a loaded machine: the second Bool
     comes 1 us after the first status and 40 us before its own. As many Bools as statuses:
     they pair in order, not by nearness."""
-    from harness.links.board import _pair_with_driver_scans
+    from harness.links.board_pairing import pair_with_driver_scans
 
     late, own, scans = back_to_back_scans()
     answers = Answers(
@@ -290,7 +290,7 @@ def test_back_to_back_callbacks_keep_each_bool_with_its_own_status() -> None:
         ],
         warnings=[Received(False, 0.01, source_ns=1_999), Received(True, 0.02, source_ns=2_001)],
     )
-    _pair_with_driver_scans(answers, scans)
+    pair_with_driver_scans(answers, scans)
     assert [r.value for r in answers.warnings] == [True]
     ((_, first),) = answers.earlier
     assert [r.value for r in first.warnings] == [False]
@@ -322,7 +322,7 @@ def test_answers_to_the_idle_stream_published_late_are_set_aside() -> None:
 def test_a_bool_published_only_on_change_goes_with_the_nearest_status() -> None:
     """Two statuses, one Bool (published on change, after the second status): it is the
     second scan's answer; the first scan has none."""
-    from harness.links.board import _pair_with_driver_scans
+    from harness.links.board_pairing import pair_with_driver_scans
 
     late, own, scans = back_to_back_scans()
     answers = Answers(
@@ -332,7 +332,7 @@ def test_a_bool_published_only_on_change_goes_with_the_nearest_status() -> None:
         ],
         warnings=[Received(True, 0.02, source_ns=3_001)],
     )
-    _pair_with_driver_scans(answers, scans)
+    pair_with_driver_scans(answers, scans)
     assert [r.value for r in answers.warnings] == [True]
     ((_, first),) = answers.earlier
     assert first.warnings == []

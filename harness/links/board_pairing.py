@@ -1,0 +1,55 @@
+"""Which answer answered which driver scan, when one revolution brought several.
+
+Pure: a damaged line can make a revolution late (its scan comes with the
+next one's) or split it in two; the node answers scans in order.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+from harness.judge.answers import Answers
+from harness.lidar.scan import Scan
+
+if TYPE_CHECKING:
+    from harness.ros.observer import Heard
+
+__all__ = ["pair_with_driver_scans"]
+
+
+def pair_with_driver_scans(answers: Answers, scans: list[Heard]) -> None:
+    """Give each answer the driver scan it answered.
+
+    Usually the driver made one scan of the revolution. When the line made
+    a revolution late (its scan came with the next one) or split one in
+    two, several came, often published back to back, before the node
+    answered any. The node answers scans in order, so the i-th status
+    answers the i-th scan. With as many Bools as statuses the i-th Bool
+    goes with the i-th status too; otherwise (a Bool published only on
+    change) each goes with the status published nearest to it. Nearness
+    alone misleads when callbacks run back to back on a loaded machine:
+    the next scan's Bool can come closer to the previous status than to
+    its own. The newest scan is this tick's; the earlier ones go with their answers into
+    ``answers.earlier``, each judged on its own.
+    """
+    if len(scans) < 2:
+        return
+    seen = [h.value for h in scans if isinstance(h.value, Scan)]
+    groups = [Answers(seen=scan, waited=answers.waited) for scan in seen]
+    statuses = sorted(answers.statuses, key=lambda r: r.source_ns)
+    for i, item in enumerate(statuses):
+        groups[min(i, len(groups) - 1)].statuses.append(item)
+    warnings = sorted(answers.warnings, key=lambda r: r.source_ns)
+    for i, item in enumerate(warnings):
+        if not statuses:
+            status = len(groups) - 1
+        elif len(warnings) == len(statuses):
+            status = i
+        else:
+            status = min(
+                range(len(statuses)), key=lambda j: abs(statuses[j].source_ns - item.source_ns)
+            )
+        groups[min(status, len(groups) - 1)].warnings.append(item)
+    answers.statuses, answers.warnings = groups[-1].statuses, groups[-1].warnings
+    answers.seen = seen[-1]
+    answers.earlier = list(zip(seen[:-1], groups[:-1], strict=True))
