@@ -5,4 +5,4 @@ from harness.links.kinds import INPROCESS, ROS2
 # The stages, in the order they run (cheapest first); here so that naming
 # them (`fossbot-hil bench --help`) imports none of them. The two link stages
 # are named after the link they measure.
-STAGES = ("raycast", "synthesis", INPROCESS, ROS2, "serial", "pacing", "suite", "grade")
+STAGES = ("raycast", "synthesis", INPROCESS, ROS2, "serial", "pacing", "suite", "grade", "hil")

@@ -16,6 +16,7 @@ from harness.links.kinds import INPROCESS, ROS2
 
 __all__ = [
     "GRADE_KEYS",
+    "HIL_KEYS",
     "REQUIRED_KEYS",
     "STUDENT_SPLIT_KEYS",
     "SUITE_KEYS",
@@ -52,6 +53,10 @@ GRADE_KEYS = (
     "grade_runs_s",
     "grade_ratio",
 )
+
+#: HIL without gaps (issue 41): a real-time suite over the virtual board, and the gaps
+#: between its scenarios (the device streams on).
+HIL_KEYS = ("hil_suite_s", "hil_gap_median_s", "hil_gap_min_s", "hil_gap_max_s", "hil_gaps")
 
 #: The edit-run loop (issue 13): the shipped suite as a user runs it, and its split.
 SUITE_KEYS = (
@@ -134,6 +139,12 @@ TARGETS = (
         "<= 1.3",
         lambda v: v <= 1.3,
     ),
+    Target(
+        "hil_gap_median_s",
+        "real-time HIL: gap between scenarios, median",
+        "<= 1 s",
+        lambda v: v <= 1.0,
+    ),
     Target("serial_rate_error_pct", "serial byte rate error", "within 1 %", lambda v: abs(v) <= 1),
     Target("serial_jitter_p99_ms", "revolution jitter p99", "< 2 ms", lambda v: v < 2.0),
 )
@@ -187,6 +198,8 @@ def figures(stages: Mapping[str, StageResult], harness_peak_rss_mb: float) -> di
         out[key] = _extra(suite, key)
     for key in GRADE_KEYS:
         out[key] = _extra(stages.get("grade"), key)
+    for key in HIL_KEYS:
+        out[key] = _extra(stages.get("hil"), key)
     out["serial_rate_error_pct"] = _extra(pacing, "reader_rate_error_pct")
     out["serial_jitter_p99_ms"] = _extra(pacing, "reader_jitter_p99_ms")
     out["serial_pacer_rate_error_pct"] = _extra(pacing, "pacer_rate_error_pct")

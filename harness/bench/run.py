@@ -129,6 +129,10 @@ def _measure(name: str, plan: BenchPlan) -> StageResult:
         from harness.bench.grade_class import measure_grade
 
         return measure_grade(plan.grade_students, plan.suite_scenarios, runs=not plan.quick)
+    if name == "hil":
+        from harness.bench.hil_board import QUICK_SUITE, measure_hil
+
+        return measure_hil(QUICK_SUITE if plan.quick else ())
     raise ValueError(name)
 
 
