@@ -52,7 +52,11 @@ class Answering(Node):
         status_type: type = String,
         warning_type: type = Bool,
         status_topic: str | None = None,
+        *,
+        subscribe: bool = True,
     ) -> None:
+        """`subscribe` false: no scan subscription yet (a variant makes it later; one made
+        and destroyed again can stay matched in the harness's view for a while)."""
         super().__init__("fossbot_lidar_node")
         self.declare_parameter("lidar_topic", "/scan")
         self.declare_parameter("lidar_status_topic", "/lidar_status")
@@ -65,8 +69,12 @@ class Answering(Node):
         self.warning_pub = self.create_publisher(
             warning_type, self.get_parameter("warning_topic").value, 10
         )
-        self.sub = self.create_subscription(
-            LaserScan, self.get_parameter("lidar_topic").value, self.on_scan, 10
+        self.sub = (
+            self.create_subscription(
+                LaserScan, self.get_parameter("lidar_topic").value, self.on_scan, 10
+            )
+            if subscribe
+            else None
         )
 
     def on_scan(self, msg: LaserScan) -> None:
@@ -235,11 +243,15 @@ def status_parameter_ignored(pids: Path | None) -> Node:
 
 def waits_for_clock(pids: Path | None) -> Node:
     """Publishes its status and warning at once, but subscribes to the scans only once a
-    /clock message came (a node that needs sim time before it starts its work)."""
+    /clock message came (a node that needs sim time before it starts its work).
+
+    Its scan subscription is never made before that, not even for a moment: one made and
+    destroyed again was seen matched by the harness's /scan writer seconds later (a reader
+    whose removal discovery had not yet told), and the node counted as ready with no clock.
+    """
     from rosgraph_msgs.msg import Clock
 
-    node = Answering()
-    node.destroy_subscription(node.sub)
+    node = Answering(subscribe=False)
     topic = node.get_parameter("lidar_topic").value
 
     def on_clock(msg: Clock) -> None:
@@ -247,7 +259,6 @@ def waits_for_clock(pids: Path | None) -> Node:
             node.get_logger().info(f"first /clock: {msg.clock.sec}.{msg.clock.nanosec:09d}")
             node.sub = node.create_subscription(LaserScan, topic, node.on_scan, 10)
 
-    node.sub = None
     node.clock_sub = node.create_subscription(Clock, "/clock", on_clock, 10)
     return node
 
