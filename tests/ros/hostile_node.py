@@ -23,7 +23,7 @@ from pathlib import Path
 import rclpy
 from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
-from rclpy.qos import qos_profile_sensor_data
+from rclpy.qos import QoSProfile, qos_profile_sensor_data
 from sensor_msgs.msg import LaserScan
 from std_msgs.msg import Bool, Int32, String
 
@@ -54,9 +54,13 @@ class Answering(Node):
         status_topic: str | None = None,
         *,
         subscribe: bool = True,
+        answer_qos: QoSProfile | int = 10,
     ) -> None:
-        """`subscribe` false: no scan subscription yet (a variant makes it later; one made
-        and destroyed again can stay matched in the harness's view for a while)."""
+        """`subscribe` false: no scan subscription yet (a variant makes it later).
+
+        A variant gets its own topics and QoS here, never by destroying an endpoint and
+        making another: one made and destroyed again can stay matched in the harness's
+        view for seconds (a /scan reader so made counted as the node reading the scans)."""
         super().__init__("fossbot_lidar_node")
         self.declare_parameter("lidar_topic", "/scan")
         self.declare_parameter("lidar_status_topic", "/lidar_status")
@@ -65,9 +69,9 @@ class Answering(Node):
         self.threshold = self.get_parameter("threshold").value
         self.before_answer: Callable[[float], None] = lambda stamp: None
         self.status_topic = status_topic or self.get_parameter("lidar_status_topic").value
-        self.status_pub = self.create_publisher(status_type, self.status_topic, 10)
+        self.status_pub = self.create_publisher(status_type, self.status_topic, answer_qos)
         self.warning_pub = self.create_publisher(
-            warning_type, self.get_parameter("warning_topic").value, 10
+            warning_type, self.get_parameter("warning_topic").value, answer_qos
         )
         self.sub = (
             self.create_subscription(
@@ -214,21 +218,12 @@ def warning_as_int32(pids: Path | None) -> Node:
 
 def best_effort(pids: Path | None) -> Node:
     """Publishes status and warning best-effort (sensor-data QoS copied from the scan)."""
-    node = Answering()
-    for pub in (node.status_pub, node.warning_pub):
-        node.destroy_publisher(pub)
-    topics = (node.status_topic, node.get_parameter("warning_topic").value)
-    node.status_pub = node.create_publisher(String, topics[0], qos_profile_sensor_data)
-    node.warning_pub = node.create_publisher(Bool, topics[1], qos_profile_sensor_data)
-    return node
+    return Answering(answer_qos=qos_profile_sensor_data)
 
 
 def status_topic_wrong(pids: Path | None) -> Node:
     """Publishes its status on /lidar_status_wrong, whatever the parameter says."""
-    node = Answering()
-    node.destroy_publisher(node.status_pub)
-    node.status_pub = node.create_publisher(String, "/lidar_status_wrong", 10)
-    return node
+    return Answering(status_topic="/lidar_status_wrong")
 
 
 def status_parameter_ignored(pids: Path | None) -> Node:
