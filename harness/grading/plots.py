@@ -10,10 +10,9 @@ next run instead of before it. It runs at the worker's priority: at a nice
 value of 10 it starved whenever the machine had other work (its plots then
 waited for the class's end, 20 s after the last student on a machine at load
 11). ``grade_class`` waits (bounded) for every worker's plots before it
-returns, the waiting thread drawing what is still queued, so the reports are
-whole when ``grade`` ends. The data is read as JSON only and the PNG's name is checked:
-nothing a judging process writes can make the grader run code or write
-outside the student's report.
+returns, so the reports are whole when ``grade`` ends. The data is read as
+JSON only and the PNG's name is checked: nothing a judging process writes can
+make the grader run code or write outside the student's report.
 """
 
 from __future__ import annotations
@@ -24,7 +23,6 @@ import re
 import subprocess
 import sys
 import threading
-import time
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -102,9 +100,8 @@ Job = tuple[Path, Path, Path]  # the plots' data, the report's scenarios folder,
 class Plotter:
     """Draws students' plots in a process of its own (started when first needed,
     matplotlib imported there once), fed a student at a time by a thread of ours: the
-    drawing never holds the worker's GIL. What is still queued when the command waits
-    is drawn by the waiting thread itself; so is a student's plots if the process is
-    lost."""
+    drawing never holds the worker's GIL. A student's plots are drawn by that thread
+    itself if the process is lost."""
 
     def __init__(self) -> None:
         self._jobs: queue.SimpleQueue[Job] = queue.SimpleQueue()
@@ -165,21 +162,9 @@ class Plotter:
 
     def wait_drawn(self, timeout: float) -> bool:
         """Wait up to `timeout` s for every plot given so far; True if all are drawn.
-        The waiting thread draws what is still queued itself: once no student runs, the
-        plots left are what the command waits for."""
-        deadline = time.monotonic() + timeout
-        while time.monotonic() < deadline:
-            try:
-                job = self._jobs.get_nowait()
-            except queue.Empty:
-                break
-            try:
-                _draw_logged(*job)
-            finally:
-                self._done()
+        (Not drawn here: this process has no matplotlib imported, the plotting one has.)"""
         with self._changed:
-            left = max(0.0, deadline - time.monotonic())
-            return self._changed.wait_for(lambda: self._pending == 0, left)
+            return self._changed.wait_for(lambda: self._pending == 0, timeout)
 
 
 _PLOTTER = Plotter()

@@ -5,12 +5,10 @@ from __future__ import annotations
 
 import json
 import os
-import threading
 from pathlib import Path
 
 import pytest
 
-from harness.grading import plots
 from harness.grading.plots import REQUEST_SUFFIX, PlotRequests, Plotter, draw_requested
 from harness.grading.worker import run_job, write_job
 from harness.judge.records import RunResult
@@ -122,31 +120,3 @@ def test_a_job_with_plots_leaves_them_as_data(tmp_path: Path) -> None:
     assert not list((tmp_path / "report").rglob("*.png"))
     assert draw_requested(tmp_path / "plots", tmp_path / "report" / SCENARIO_FOLDER) == []
     assert (tmp_path / "report" / SCENARIO_FOLDER / "approach_wall.png").is_file()
-
-
-def test_the_waiting_thread_draws_what_is_queued(
-    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
-) -> None:
-    """While the plotting process is busy, `wait_drawn` draws the queued plots itself and
-    returns once every plot is drawn."""
-    started, release = threading.Event(), threading.Event()
-    drawn: list[tuple[str, str]] = []
-    plotter = Plotter()
-
-    def busy_child(job: tuple[Path, Path, Path]) -> bool:
-        drawn.append((job[0].name, "child"))
-        started.set()
-        return release.wait(30.0)
-
-    def here(requests: Path, scenarios: Path) -> list[str]:
-        drawn.append((requests.name, threading.current_thread().name))
-        release.set()
-        return []
-
-    monkeypatch.setattr(plotter, "_in_child", busy_child)
-    monkeypatch.setattr(plots, "draw_requested", here)
-    plotter.submit(tmp_path / "first", tmp_path, tmp_path / "log")
-    assert started.wait(30.0)
-    plotter.submit(tmp_path / "second", tmp_path, tmp_path / "log")
-    assert plotter.wait_drawn(60.0)
-    assert drawn == [("first", "child"), ("second", threading.current_thread().name)]
