@@ -41,6 +41,7 @@ LAYERS: list[set[str]] = [
     {"sim", "record"},
     {"links", "report"},
     {"runner"},
+    {"run_request"},
     {"bench", "grading", "live", "campaign", "hunt"},
     {"watch", "audit"},
     {"commands"},
@@ -91,6 +92,7 @@ PURE = [
     "harness.hunt.space",
     "harness.hunt.shrink",
     "harness.hunt.margin",
+    "harness.run_request",
 ]
 
 
