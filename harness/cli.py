@@ -41,24 +41,6 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def _without_defaults(parser: argparse.ArgumentParser) -> None:
-    """Every option of `parser` and its commands defaults to absent."""
-    parser._defaults.clear()  # argparse has no public way to read back what was typed
-    for action in parser._actions:
-        action.default = argparse.SUPPRESS
-        if isinstance(action, argparse._SubParsersAction):
-            for sub in action.choices.values():
-                _without_defaults(sub)
-
-
-def given_options(parser: argparse.ArgumentParser, argv: Sequence[str] | None) -> frozenset[str]:
-    """The option names (argparse dests) given on the command line, whatever their value:
-    a file's setting yields to the command line only where the user typed one. Parsing
-    again with `parser`'s defaults taken away (it is not used with them after)."""
-    _without_defaults(parser)
-    return frozenset(vars(parser.parse_args(argv)))
-
-
 def _print_error(message: str) -> None:
     """One error on stderr; it may quote a node's text (topic names), so shown safely."""
     from harness.safe_text import clip, for_terminal
@@ -87,7 +69,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             parser.print_help()
             return EXIT_USAGE
         expand_arguments(args)  # ~ and $VAR in paths and commands, as a shell would
-        args.given = given_options(parser, argv)  # what the user typed, apart from defaults
+        args.given = getattr(args, "given", frozenset())  # noted as parsed (arguments.add_row)
         handlers = {m.NAME: m.run for m in command_modules()}
         return handlers[args.command](args, console)
     except ConfigError as err:

@@ -1,6 +1,10 @@
 """Argument types and option groups shared by the commands that run scenarios.
 
-Every type turns bad input into a one-line argparse error (exit 2). The
+The run options come from the run request's table (harness.run_request):
+`add_row` adds one row's flag, type, default and help, and notes in
+``args.given`` that the user typed it; `request_of` makes the command line's
+`RunRequest`, whose checks word their errors with the flags. Every type
+turns bad input into a one-line argparse error (exit 2). The
 checks of the names and parameters a node gets (a topic used twice, a
 parameter that would set the threshold behind the oracle's back) are
 `harness.commands.node_names`, which the pytest plugin calls too; which
@@ -16,61 +20,47 @@ import os
 import stat
 from collections.abc import Callable, Mapping
 from functools import partial
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from harness.commands.node_names import checked_node_options
 from harness.errors import ConfigError
-from harness.lidar.mount import LidarMount, parse_mount
 from harness.links.base import LinkOptions
 from harness.links.kinds import default_link, either, link_kind, link_names, serial_links
-from harness.ros.names import (
-    InvalidName,
-    check_parameter_rule,
-)
+from harness.run_request import OPTIONS, OptionError, RunRequest, option, table, values
+from harness.run_request.request import check_port as request_check_port
+from harness.run_request.table import names as option_names
 from harness.safe_text import shown
 
 if TYPE_CHECKING:
     from harness.runner.settings import RunSettings
 
-NODE_OPTIONS = ("node", "package", "executable", "workspace")
-MAX_WAIT_S = 86400.0
+MAX_WAIT_S = values.MAX_WAIT_S
 #: How every command shows a --faults value: a profile name or an inline fault, comma-separated.
-FAULTS_METAVAR = "FAULT[,FAULT]"
+FAULTS_METAVAR = option("faults").metavar
+
+
+def _typed(read: Callable[[object], Any], names: Mapping[str, str]) -> Callable[[str], Any]:
+    """`read` (a run_request reader) as an argparse type: its problem worded with `names`
+    (after argparse's own "argument --seed:"), one usage line."""
+
+    def parse(text: str) -> Any:
+        try:
+            return read(text)
+        except OptionError as err:
+            raise argparse.ArgumentTypeError(err.render(names)) from None
+
+    parse.__name__ = getattr(read, "__name__", "value")  # argparse names the type in messages
+    return parse
 
 
 def positive(kind: str, maximum: float = math.inf) -> Callable[[str], float]:
     """A finite number above zero (and at most `maximum`), named `kind` in the error."""
-
-    def parse(text: str) -> float:
-        try:
-            value = float(text)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"{kind} must be a number, got {text!r}") from None
-        if not math.isfinite(value) or value <= 0:
-            raise argparse.ArgumentTypeError(f"{kind} must be a positive number, got {text!r}")
-        if value > maximum:
-            raise argparse.ArgumentTypeError(f"{kind} must be at most {maximum:g}, got {text!r}")
-        return value
-
-    return parse
+    return _typed(values.positive(kind, maximum), {kind: kind})
 
 
 def whole_number(kind: str, low: int, high: int | None = None) -> Callable[[str], int]:
     """A whole number from `low` (to `high`), named `kind` in the error."""
-    bounds = f">= {low}" if high is None else f"{low}..{high}"
-
-    def parse(text: str) -> int:
-        try:
-            value = int(text)
-        except ValueError:
-            value = low - 1
-        if value < low or (high is not None and value > high):
-            raise argparse.ArgumentTypeError(
-                f"{kind} must be a whole number {bounds}, got {text[:40]!r}"
-            )
-        return value
-
-    return parse
+    return _typed(values.whole(kind, low, high), {kind: kind})
 
 
 def duration(kind: str) -> Callable[[str], float]:
@@ -79,29 +69,15 @@ def duration(kind: str) -> Callable[[str], float]:
     return positive(kind, MAX_WAIT_S)
 
 
-def seed(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"seed must be a whole number, got {text!r}") from None
-    if not 0 <= value < 2**32:
-        raise argparse.ArgumentTypeError(f"seed must be in 0..2**32-1, got {text!r}")
-    return value
+def row_type(key: str) -> Callable[[str], Any] | None:
+    """The argparse type of the table's option `key` (None: its text as is)."""
+    row = option(key)
+    return None if row.read is None else _typed(row.read, option_names("noun"))
 
 
-domain_id = whole_number("domain id", 0, 232)
-
-
-def param(text: str) -> str:
-    """NAME:=VALUE that ROS 2 itself can parse (harness.ros.names has the rules).
-
-    A rule rcl cannot parse would stop the node before it starts; better a
-    usage error now than a failed run.
-    """
-    try:
-        return check_parameter_rule(text)
-    except InvalidName as err:
-        raise argparse.ArgumentTypeError(str(err)) from None
+seed = row_type("seed")
+domain_id = row_type("domain_id")
+param = row_type("params")
 
 
 def name_list(text: str) -> list[str]:
@@ -181,28 +157,17 @@ def expand_arguments(args: argparse.Namespace) -> None:
         ),
     ]
     for options, expand in expanders:
-        for dest, option in options.items():
+        for dest, flag in options.items():
             if hasattr(args, dest):
-                setattr(args, dest, each(getattr(args, dest), partial(expand, option)))
+                setattr(args, dest, each(getattr(args, dest), partial(expand, flag)))
 
 
 def check_port(option: str, path: str) -> None:
-    """A port the user named must be a device (a tty), not a file or a folder or nothing.
-
-    Checked before the port is locked or opened, so a typo leaves nothing behind.
-    """
-    if not path.strip():
-        raise ConfigError(f"{option} must not be empty")
+    """A port the user named must be a device (a tty): ConfigError naming `option`."""
     try:
-        mode = os.stat(path).st_mode
-    except FileNotFoundError:
-        raise ConfigError(f"{option} {path}: no such device") from None
-    except (OSError, ValueError) as err:
-        raise ConfigError(f"{option} {path}: {getattr(err, 'strerror', None) or err}") from None
-    if stat.S_ISDIR(mode):
-        raise ConfigError(f"{option} {path}: a folder, not a serial port")
-    if not stat.S_ISCHR(mode):
-        raise ConfigError(f"{option} {path}: not a serial port (not a character device)")
+        request_check_port(path)
+    except OptionError as err:
+        raise err.named({"port": option}) from None
 
 
 def fault_list(text: str | None) -> list[str] | None:
@@ -212,39 +177,77 @@ def fault_list(text: str | None) -> list[str] | None:
     return split_fault_text(text) if text else None
 
 
-def add_scenario_overrides(parser: argparse.ArgumentParser) -> None:
-    """--seed and --faults: the same scenarios under other fault draws or profiles."""
-    parser.add_argument("--seed", type=seed, help="override the scenarios' seed")
-    parser.add_argument(
-        "--faults",
-        metavar=FAULTS_METAVAR,
-        help="fault profiles or inline faults such as drop(rate=0.1), replacing the "
-        "scenarios' own (see docs/faults.md)",
+class _Given(argparse.Action):
+    """Stores a value as argparse's store, append and store_true do, and notes in
+    ``args.given`` that the user gave it: a file's setting yields only to a typed one."""
+
+    def __init__(self, *args: Any, repeat: bool = False, switch: bool = False, **kw: Any):
+        self.repeat, self.switch = repeat, switch
+        if switch:
+            kw.update(nargs=0, default=kw.get("default", False))
+        super().__init__(*args, **kw)
+
+    def __call__(
+        self,
+        parser: argparse.ArgumentParser,
+        namespace: argparse.Namespace,
+        values: Any,
+        option_string: str | None = None,
+    ) -> None:
+        if self.switch:
+            values = True
+        elif self.repeat:
+            values = [*(getattr(namespace, self.dest, None) or []), values]
+        setattr(namespace, self.dest, values)
+        namespace.given = frozenset(getattr(namespace, "given", frozenset()) | {self.dest})
+
+
+def add_row(container: Any, key: str, **changes: Any) -> argparse.Action:
+    """The table's option `key` added to a parser or group (its flag, type, default,
+    metavar, help); `changes` are a command's own (its help, its default)."""
+    row = option(key)
+    assert row.cli is not None, f"{key} has no command-line flag"
+    kwargs: dict[str, Any] = {"help": row.help, "default": row.default}
+    if not row.switch:
+        kwargs.update(type=row_type(key), metavar=None if row.choices else row.metavar)
+    if row.repeat:
+        kwargs["default"] = []
+    if row.choices:
+        kwargs["choices"] = row.choices
+    kwargs.update(changes)
+    return container.add_argument(
+        row.cli, action=_Given, repeat=row.repeat, switch=row.switch, **kwargs
     )
 
 
-WARNING_RULES = ("optional", "required")
+def add_scenario_overrides(parser: argparse.ArgumentParser) -> None:
+    """--seed and --faults: the same scenarios under other fault draws or profiles."""
+    add_row(parser, "seed")
+    add_row(parser, "faults")
 
 
-def warning_rule(text: str) -> str:
-    """--warning-when-clear's value (for option parsers without `choices`)."""
-    if text not in WARNING_RULES:
-        raise argparse.ArgumentTypeError(f"give optional or required, got {text[:40]!r}")
-    return text
+WARNING_RULES = table.WARNING_RULES
+warning_rule = row_type("warning_when_clear")
+
+
+def request_of(args: argparse.Namespace, *, check: bool = True) -> RunRequest:
+    """The run request the command line makes (each of the table's options the command
+    has), checked unless `check` is False; ConfigError naming the flags."""
+    present = [row for row in OPTIONS if row.cli is not None and hasattr(args, row.dest)]
+    typed = getattr(args, "given", frozenset())
+    values = {row.key: getattr(args, row.dest) for row in present}
+    if values.get("launch") is not None:
+        values["launch"] = tuple(values["launch"])
+    try:
+        return RunRequest.of(values, {r.key for r in present if r.dest in typed}, check=check)
+    except OptionError as err:
+        raise err.named(option_names("cli")) from None
 
 
 def judging_settings(args: argparse.Namespace) -> RunSettings:
     """The run's overrides from --seed, --threshold, --faults, --status-regex and
     --warning-when-clear (the options of add_scenario_overrides and add_judging_options)."""
-    from harness.runner.settings import RunSettings
-
-    return RunSettings(
-        seed=args.seed,
-        threshold=args.threshold,
-        faults=fault_list(args.faults),
-        status_pattern=args.status_regex,
-        warning_when_clear=args.warning_when_clear,
-    )
+    return request_of(args, check=False).run_settings()
 
 
 def add_judging_options(
@@ -260,33 +263,23 @@ def add_judging_options(
     timeout. `threshold_default` and `rule_default` say where the defaults come from
     (a replay has no scenario)."""
     if threshold:
-        parser.add_argument(
-            "--threshold",
-            type=positive("threshold"),
-            metavar="M",
+        add_row(
+            parser,
+            "threshold",
             help=f"the oracle's warning threshold in metres (default: {threshold_default})",
         )
-    parser.add_argument(
-        "--status-regex",
-        metavar="REGEX",
-        help="parse the status with this regex (named groups distance, angle)",
-    )
-    parser.add_argument(
-        "--warning-when-clear",
-        choices=WARNING_RULES,
+    add_row(parser, "status_regex")
+    add_row(
+        parser,
+        "warning_when_clear",
         help="must the node publish warning False when nothing is within the threshold? "
         "optional (the lab's rule: a Bool only when close passes) or required "
         f"(default: {rule_default})",
     )
-    if not deadline:
-        return
-    parser.add_argument(
-        "--timeout",
-        type=duration("timeout"),
-        default=1.0,
-        metavar="S",
-        help="seconds to wait for the answers to one scan (default 1)",
-    )
+    if deadline:
+        add_row(
+            parser, "scan_timeout", help="seconds to wait for the answers to one scan (default 1)"
+        )
 
 
 #: harness.ros.domain's FIRST_ID..LAST_ID (not imported: building the parser stays light).
@@ -298,6 +291,18 @@ DOMAIN_HELP = (
 REALTIME_HELP = (
     "send each scan at its time, at the sensor's rate, its answers due before the next "
     "(default: lockstep, the next scan once the node answered)"
+)
+NODE_ROWS = (
+    "node",
+    "package",
+    "executable",
+    "workspace",
+    "params",
+    "threshold_param",
+    "scan_topic",
+    "status_topic",
+    "warning_topic",
+    "ready_timeout",
 )
 
 
@@ -314,86 +319,18 @@ def add_node_options(
     `domain_help` or `realtime_help` (argparse.SUPPRESS: refused, so not shown).
     """
     node = parser.add_argument_group(title)
-    node.add_argument(
-        "--node",
-        type=given("--node"),
-        metavar="CMD",
-        help='shell command, e.g. "python3 my_node.py"',
-    )
-    node.add_argument(
-        "--package", type=given("--package"), metavar="PKG", help="package in a colcon workspace"
-    )
-    node.add_argument(
-        "--executable", type=given("--executable"), metavar="EXE", help="executable of --package"
-    )
-    node.add_argument(
-        "--workspace",
-        type=given("--workspace"),
-        metavar="DIR",
-        help="colcon workspace (has install/)",
-    )
-    node.add_argument(
-        "--param",
-        action="append",
-        type=param,
-        default=[],
-        metavar="NAME:=VALUE",
-        help="node parameter, passed verbatim (repeatable)",
-    )
-    node.add_argument(
-        "--threshold-param",
-        default="threshold",
-        metavar="NAME",
-        help="node parameter that receives the threshold (default threshold; '' for none; "
-        "a --param of that name is refused: use --threshold)",
-    )
-    topic_help = "; relative names resolve to /NAME, ~ and {} names are refused"
-    node.add_argument(
-        "--scan-topic",
-        default="/scan",
-        metavar="T",
-        help="LaserScan topic the node reads (default /scan" + topic_help + ")",
-    )
-    node.add_argument(
-        "--status-topic",
-        default="/lidar_status",
-        metavar="T",
-        help="String topic the node answers on (default /lidar_status)",
-    )
-    node.add_argument(
-        "--warning-topic",
-        default="/obstacle_warning",
-        metavar="T",
-        help="Bool warning topic (default /obstacle_warning); the three topics must differ",
-    )
-    node.add_argument(
-        "--ready-timeout",
-        type=duration("ready timeout"),
-        default=20.0,
-        metavar="S",
-        help="seconds for the node to come up (default 20)",
-    )
-    node.add_argument(
-        "--domain-id",
-        type=domain_id,
-        metavar="N",
-        help=domain_help,
-    )
-    node.add_argument(
-        "--ros-network",
-        action="store_true",
-        help="discover beyond localhost (to watch a board on the network)",
-    )
-    node.add_argument(
-        "--realtime",
-        action="store_true",
-        help=realtime_help,
-    )
+    for key in NODE_ROWS:
+        add_row(node, key)
+    add_row(node, "domain_id", help=domain_help)
+    add_row(node, "ros_network")
+    add_row(node, "realtime", help=realtime_help)
 
 
 def add_link_option(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument(
-        "--link",
+    add_row(
+        parser,
+        "link",
+        type=None,  # read when the run is checked: a link declared later is known by then
         default=default_link(),
         help=f"one of {', '.join(link_names())} (default {default_link()})",
     )
@@ -402,46 +339,13 @@ def add_link_option(parser: argparse.ArgumentParser) -> None:
 def add_device_options(parser: argparse.ArgumentParser) -> None:
     """Where the scans go besides ROS 2: a physical port, or a Python function."""
     serial = parser.add_argument_group(f"serial links ({', '.join(serial_links())})")
-    serial.add_argument(
-        "--port",
-        metavar="DEV",
-        help="drive a physical board through this USB-UART, in real time "
-        "(default: a virtual board on a pty)",
-    )
-    serial.add_argument(
-        "--board-command",
-        action="append",
-        type=given("--board-command"),
-        default=[],
-        metavar="CMD",
-        help="virtual board: run the board's own software instead of the bundled driver, "
-        "{port} replaced by the emulated device's path (repeatable; started before the "
-        "first scenario with the run's ROS environment and working modem lines, stopped "
-        "after the last; the device then runs in real time; see docs/hil.md)",
-    )
-    serial.add_argument(
-        "--lidar-mount",
-        type=lidar_mount,
-        metavar="MOUNT",
-        help="how the device sits on the robot: model (default: what the robot model says; "
-        "the FOSSBot v2's A1 has its zero to the right), forward (zero straight ahead), or "
-        "DEG[,mirrored] (the device's zero, degrees counter-clockwise from forward)",
-    )
+    for key in ("port", "board_commands", "lidar_mount"):
+        add_row(serial, key)
     functions = [name for name in link_names() if not link_kind(name).runs_node]
-    inprocess = parser.add_argument_group(f"{either(functions)} link")
-    inprocess.add_argument(
-        "--processor",
-        metavar="MODULE:FUNCTION",
-        help="fn(scan, threshold) -> (status, warning) instead of the reference",
-    )
+    add_row(parser.add_argument_group(f"{either(functions)} link"), "processor")
 
 
-def lidar_mount(text: str) -> LidarMount | None:
-    """--lidar-mount's value (None: the robot model's)."""
-    try:
-        return parse_mount(text)
-    except ConfigError as err:
-        raise argparse.ArgumentTypeError(str(err).removeprefix("--lidar-mount ")) from None
+lidar_mount = row_type("lidar_mount")
 
 
 def link_options(args: argparse.Namespace) -> LinkOptions:
@@ -455,68 +359,19 @@ def link_options(args: argparse.Namespace) -> LinkOptions:
 
 def unchecked_link_options(args: argparse.Namespace) -> LinkOptions:
     """Link settings from the command line as given (`link_options` checks them)."""
-    return LinkOptions(
-        scan_timeout=getattr(args, "timeout", LinkOptions.scan_timeout),
-        ready_timeout=args.ready_timeout,
-        processor=getattr(args, "processor", None),
-        node=args.node,
-        package=args.package,
-        executable=args.executable,
-        workspace=args.workspace,
-        launch=tuple(args.launch) if getattr(args, "launch", None) else None,
-        params=tuple(args.param),
-        threshold_param=args.threshold_param or None,
-        scan_topic=args.scan_topic,
-        status_topic=args.status_topic,
-        warning_topic=args.warning_topic,
-        domain_id=args.domain_id,
-        ros_network=args.ros_network,
-        realtime=args.realtime,
-        port=getattr(args, "port", None),
-        board_commands=tuple(getattr(args, "board_command", ()) or ()),
-        lidar_mount=getattr(args, "lidar_mount", None),
-    )
+    return request_of(args, check=False).link_options()
 
 
 def check_link_options(args: argparse.Namespace) -> LinkOptions:
-    """The link's options, checked: ones the chosen link would silently ignore are
-    mistakes, and topics and parameters must work (`link_options`)."""
-    port = getattr(args, "port", None)
-    processor = getattr(args, "processor", None)
-    kind = link_kind(args.link)
-    serial = f"--link {either(serial_links())}"
-    if port is not None:
-        check_port("--port", port)
-    if port and not kind.serial_line:
-        raise ConfigError(f"--port needs {serial}, not {args.link}")
-    board = getattr(args, "board_command", None)
-    if board and not kind.serial_line:
-        raise ConfigError(f"--board-command needs {serial}, not {args.link}")
-    if board and port:
-        raise ConfigError(
-            "--board-command runs the board's software on the virtual board; with --port the "
-            "physical board runs its own"
-        )
-    if board:
+    """The link's options, checked once by the run request (options the chosen link
+    would silently ignore are mistakes), each board command found, and topics and
+    parameters that work (`checked_node_options`)."""
+    request = request_of(args)
+    if request.board_commands:
         from harness.links.board_session import check_board_commands
 
-        check_board_commands(tuple(board))  # each program must exist: exit 2 now, not later
-    if getattr(args, "lidar_mount", None) is not None and not kind.serial_line:
-        raise ConfigError(
-            f"--lidar-mount needs {serial} (the {args.link} link sends the scan frame itself)"
-        )
-    functions = [name for name in link_names() if not link_kind(name).runs_node]
-    if processor and kind.runs_node:
-        raise ConfigError(
-            f"--processor needs --link {either(functions)} (the {args.link} link runs a node)"
-        )
-    if not kind.runs_node:
-        given = [f"--{name}" for name in NODE_OPTIONS if getattr(args, name)] + (
-            ["--param"] if args.param else []
-        )
-        if given:
-            raise ConfigError(f"{given[0]} needs a link that runs a node, not --link {args.link}")
-    return link_options(args)
+        check_board_commands(request.board_commands)  # each program must exist: exit 2 now
+    return checked_node_options(request.link_options())
 
 
 def check_status_regex(args: argparse.Namespace) -> None:

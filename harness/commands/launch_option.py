@@ -13,24 +13,14 @@ import argparse
 
 from rich.console import Console
 
-from harness.commands.arguments import given
+from harness.commands.arguments import add_row, given, request_of
 from harness.errors import ConfigError
-from harness.links.kinds import either, link_kind, link_names
 
 __all__ = ["add_launch_option", "check_launch"]
 
 
 def add_launch_option(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument(
-        "--launch",
-        nargs=2,
-        type=given("--launch"),
-        metavar=("PACKAGE", "FILE"),
-        help="start the node under test by `ros2 launch PACKAGE FILE` (needs ros2 with its "
-        "launch verb, from a sourced ROS 2; --workspace DIR finds the package), the harness's "
-        "parameters passed as the launch arguments the file declares; instead of "
-        "--node/--package (see docs/launch_files.md)",
-    )
+    add_row(parser, "launch", nargs=2, type=given("--launch"), metavar=("PACKAGE", "FILE"))
 
 
 def check_launch(args: argparse.Namespace, console: Console) -> None:
@@ -39,11 +29,7 @@ def check_launch(args: argparse.Namespace, console: Console) -> None:
     if not getattr(args, "launch", None):
         return
     package, file = args.launch
-    if not link_kind(args.link).launches:
-        launched = either([name for name in link_names() if link_kind(name).launches])
-        raise ConfigError(f"--launch needs --link {launched}, not {args.link}")
-    if args.node or args.package or args.executable:
-        raise ConfigError("--launch starts the node itself: drop --node/--package/--executable")
+    request_of(args)  # with a link that launches, and no other way to start the node
     if getattr(args, "watch", False):
         raise ConfigError("--launch cannot go with --watch: use --package/--executable to watch")
     from harness.launch_files.launch_command import (

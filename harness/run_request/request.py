@@ -56,9 +56,12 @@ class RunRequest:
     given: frozenset[str] = field(default=frozenset(), compare=False)
 
     @classmethod
-    def of(cls, values: Mapping[str, object], given: Collection[str] = ()) -> RunRequest:
+    def of(
+        cls, values: Mapping[str, object], given: Collection[str] = (), *, check: bool = True
+    ) -> RunRequest:
         """A request from `values` (keys of the table; text or typed), each read by its
-        row and the whole checked; OptionError (keys as ``{key}``) for the first problem."""
+        row and (`check`) the whole checked; OptionError (keys as ``{key}``) for the first
+        problem."""
         known = {f.name for f in fields(cls)} - {"given"}
         read: dict[str, Any] = {}
         for key, value in values.items():
@@ -71,7 +74,8 @@ class RunRequest:
             elif value is not None or row.default is None:
                 read[key] = row.value(value)
         request = cls(**read, given=frozenset(given))
-        request.check()
+        if check:
+            request.check()
         return request
 
     def with_values(self, values: Mapping[str, object]) -> RunRequest:
@@ -84,6 +88,8 @@ class RunRequest:
     # -- the checks ---------------------------------------------------------
     def check(self) -> None:
         """Combinations that cannot work; OptionError naming the options as ``{key}``."""
+        if self.port is not None:
+            check_port(self.port)  # a typo in the port is said first, whatever else is wrong
         self._check_node()
         if self.link is not None:
             self._check_link(self.link)
@@ -93,14 +99,12 @@ class RunRequest:
                 "{board_commands} runs the board's software on the virtual board; with "
                 "{port} the physical board runs its own",
             )
-        if self.port is not None:
-            check_port(self.port)
 
     def _check_node(self) -> None:
         if self.node and (self.package or self.executable):
             other = "package" if self.package else "executable"
             raise OptionError("node", f"{{node}} and {{{other}}}: give one or the other")
-        if self.launch and (self.package or self.executable):
+        if self.launch and (self.node or self.package or self.executable):
             raise OptionError(
                 "launch", "{launch} starts the node itself: drop {node}/{package}/{executable}"
             )
@@ -114,10 +118,12 @@ class RunRequest:
         serial = either(serial_links())
         for key in ("port", "board_commands", "lidar_mount"):
             if getattr(self, key) not in (None, ()) and not kind.serial_line:
-                why = " (the {0} link sends the scan frame itself)" if key == "lidar_mount" else ""
-                raise OptionError(
-                    key, f"{{{key}}} needs {{link}} {serial}, not {link}" + why.format(link)
-                )
+                why = f" (the {link} link sends the scan frame itself)"
+                tail = why if key == "lidar_mount" else f", not {link}"
+                raise OptionError(key, f"{{{key}}} needs {{link}} {serial}{tail}")
+        if self.launch and not kind.launches:
+            launched = either([n for n in link_names() if link_kind(n).launches])
+            raise OptionError("launch", f"{{launch}} needs {{link}} {launched}, not {link}")
         if self.processor and kind.runs_node:
             functions = either([n for n in link_names() if not link_kind(n).runs_node])
             why = f"(the {link} link runs a node)"
