@@ -36,6 +36,7 @@ from harness.errors import ConfigError
 from harness.grading import LAB_EXECUTABLE, LAB_PACKAGE
 from harness.grading.discover import GRADES_MARKER, Student, absolute
 from harness.holder_lock import HolderLock
+from harness.links.kinds import node_links
 from harness.report.folder_lock import lock_folder
 
 if TYPE_CHECKING:  # imported when grading starts (the parser is built for any command)
@@ -49,7 +50,7 @@ if TYPE_CHECKING:  # imported when grading starts (the parser is built for any c
 NAME = "grade"
 HELP = "build and test every student's node in DIR; write the class table (CSV, HTML)"
 
-NODE_LINKS = importlib.import_module("harness.links.kinds").node_links()  # start a node
+NODE_LINKS = node_links()  # the links that start a node
 NOT_FOR_GRADING = {
     "node": "each student's node comes from their folder",
     "workspace": "each student's folder is built into --out",
