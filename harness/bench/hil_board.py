@@ -26,6 +26,7 @@ from pathlib import Path
 from harness.bench.stage import StageResult
 from harness.bench.suite_commands import cli_wall_s
 from harness.errors import HarnessError
+from harness.links.kinds import default_serial_link
 
 QUICK_SUITE = ("approach_wall", "reverse_to_wall")  # short, and one gap between them
 ANSWER_WAIT_S = 5.0  # --timeout, as the whole-run tests give a real-time board
@@ -45,7 +46,8 @@ def measure_hil(scenarios: tuple[str, ...] = ()) -> StageResult:
     with tempfile.TemporaryDirectory(prefix="fossbot-hil-bench-hil-") as tmp:
         out = Path(tmp) / "report"
         board = ("--board-command", DRIVER, "--timeout", f"{ANSWER_WAIT_S:g}")
-        wall_s = cli_wall_s([*scenarios, "--link", "rplidar", *board, "--out", str(out)])
+        link = ("--link", default_serial_link())
+        wall_s = cli_wall_s([*scenarios, *link, *board, "--out", str(out)])
         gaps = hil_gaps(out / "summary.json")
     if not gaps:
         raise HarnessError("the real-time suite over the virtual board reported no gap")

@@ -24,6 +24,7 @@ from typing import TYPE_CHECKING, Any
 
 from harness.atomic_write import write_atomically
 from harness.errors import ConfigError
+from harness.links.kinds import ROS2
 from harness.nodes.sandbox_prefix import NODE_SANDBOX_ENV
 
 if TYPE_CHECKING:  # imported by the suite: after the node's fork server has started
@@ -238,7 +239,7 @@ def warm_node_server(job: dict[str, Any]) -> bool:
     from harness.nodes.process import fork_server_enabled
     from harness.nodes.python_script import SERVER_MODULE
 
-    if job.get("link") != "ros2" or not fork_server_enabled():
+    if job.get("link") != ROS2 or not fork_server_enabled():
         return False
     shared(SERVER_MODULE)  # in the sandbox: started in the node's nested one, as later
     return True

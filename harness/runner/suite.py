@@ -10,6 +10,7 @@ from contextlib import AbstractContextManager, nullcontext
 from harness.errors import ConfigError, Interrupted
 from harness.judge.records import RunResult, TickRecord
 from harness.links.base import Link, LinkOptions, create_link, link_class
+from harness.links.kinds import link_kind
 from harness.nodes.forkserver import scope as fork_servers
 from harness.nodes.setup_problems import setup_problem
 from harness.runner.link_pipeline import AHEAD, BEHIND, LinkPipeline, ReportsBehind
@@ -158,7 +159,7 @@ def _overlap(cls: type[Link], options: LinkOptions) -> tuple[int, int]:
 def _explicit_domain(link_name: str, options: LinkOptions) -> AbstractContextManager[object]:
     """An explicit domain id held for the whole suite (each scenario's link takes it again):
     no other run slips in between two scenarios, and an id in use fails before the first."""
-    if options.domain_id is None or link_name == "inprocess":
+    if options.domain_id is None or not link_kind(link_name).runs_node:
         return nullcontext()
     from harness.ros.domain import reserve_domain
 
