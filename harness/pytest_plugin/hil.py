@@ -11,7 +11,6 @@ port, so parallel pytest workers and sessions never meet.
 
 from __future__ import annotations
 
-import math
 import os
 from collections.abc import Callable, Sequence
 from contextlib import ExitStack
@@ -29,6 +28,7 @@ from harness.pytest_plugin.result import HilResult
 
 if TYPE_CHECKING:
     from harness.links.base import LinkOptions
+    from harness.run_request import RunRequest
     from harness.scenario.schema import Scenario
 
     ScenarioRef = str | os.PathLike[str] | HilCase | Scenario
@@ -46,29 +46,20 @@ def _run_names() -> dict[str, str]:
     return {field: f"{field}=" for field in CLI_NAMES}
 
 
-def _checked_numbers(overrides: dict[str, Any]) -> dict[str, Any]:
-    """The waits and the domain id among `overrides`, by the command line's own rules."""
-    import argparse
+def _request(options: LinkOptions, link: str, run: dict[str, Any]) -> RunRequest:
+    """hil.run's arguments as the run request, checked once; ConfigError naming them by
+    hil.run's keywords (``scan_timeout``, ``seed``)."""
+    from harness.run_request import OptionError, RunRequest
+    from harness.run_request.request import NODE_KEYS, link_keys
+    from harness.run_request.table import names
 
-    from harness.commands.arguments import domain_id, duration
-
-    rules = {
-        "scan_timeout": duration("scan_timeout"),
-        "ready_timeout": duration("ready_timeout"),
-        "domain_id": domain_id,
-    }
-    checked: dict[str, Any] = {}
-    for key, rule in rules.items():
-        value = overrides.get(key)
-        if value is None:
-            continue
-        if isinstance(value, bool) or not isinstance(value, (int, float)):
-            raise ConfigError(f"{key} must be a number, got {value!r}"[:200])
-        try:
-            checked[key] = rule(repr(value))
-        except argparse.ArgumentTypeError as err:
-            raise ConfigError(str(err)) from None
-    return checked
+    # A link that runs no node ignores the session's node (hil.run's node keywords too).
+    runs_node = link_kind(link).runs_node
+    values = {k: getattr(options, k) for k in link_keys() if runs_node or k not in NODE_KEYS}
+    try:
+        return RunRequest.of({**values, **run, "link": link}, typed=True)
+    except OptionError as err:
+        raise ConfigError(err.render(names("run"), subject=True)) from None
 
 
 def _fail(message: str) -> NoReturn:
@@ -90,12 +81,6 @@ def _fault_list(faults: Faults) -> list[str | dict[str, Any]] | None:
         raise ConfigError(f"faults must be a name, 'a,b' or a list, got {faults!r}")
     build_profile(items, field_name="faults")
     return items
-
-
-def _rule_problem(rule: str | None) -> str | None:
-    if rule is None or rule in ("optional", "required"):
-        return None
-    return f"warning_when_clear must be 'optional' or 'required', got {rule!r:.40}"
 
 
 class Hil:
@@ -160,7 +145,6 @@ class Hil:
                 got = repr(params)[:60]
                 raise ConfigError(f"params must be a list of NAME:=VALUE items, got {got}")
             overrides = {**overrides, "params": tuple(params)}
-        overrides = {**overrides, **_checked_numbers(overrides)}
         options = replace(self.options, **overrides)
         if not link_kind(link).serial_line and "port" not in overrides:
             options = replace(options, port=None)  # the board's port concerns board links only
@@ -175,24 +159,23 @@ class Hil:
         link: str,
         status_regex: str | None,
         overrides: dict[str, Any],
-    ) -> tuple[Scenario, list[str | dict[str, Any]] | None, LinkOptions]:
+        rule: str | None = None,
+    ) -> tuple[Scenario, list[str | dict[str, Any]] | None, LinkOptions, RunRequest]:
         """The run's arguments, checked; ConfigError names the first bad one."""
         chosen = self._scenario(scenario)
         fault_items = _fault_list(faults)
-        if threshold is not None and not (
-            isinstance(threshold, (int, float)) and math.isfinite(threshold) and threshold > 0
-        ):
-            raise ConfigError(f"threshold must be a positive number of metres, got {threshold!r}")
-        if seed is not None and not (isinstance(seed, int) and 0 <= seed < 2**32):
-            raise ConfigError(f"seed must be a whole number in 0..2**32-1, got {seed!r}")
+        options = self._options(link, overrides)
+        run = {"threshold": threshold, "seed": seed, "warning_when_clear": rule}
+        request = _request(options, link, run)
         if status_regex is not None:
             from harness.judge.status import compile_status_pattern
 
             compile_status_pattern(status_regex)
         from harness.commands.node_names import checked_node_options
 
-        options = checked_node_options(self._options(link, overrides), _run_names())
-        return chosen, fault_items, options
+        numbers = {key: getattr(request, key) for key in ("scan_timeout", "ready_timeout")}
+        options = checked_node_options(replace(options, **numbers), _run_names())
+        return chosen, fault_items, options, request
 
     # -- running ------------------------------------------------------------
     def run(
@@ -222,21 +205,21 @@ class Hil:
         seed = seed if seed is not None else self.seed
         rule = warning_when_clear if warning_when_clear is not None else self.warning_when_clear
         try:
-            chosen, fault_items, options = self._checked(
-                scenario, threshold, faults, seed, link, status_regex, overrides
+            chosen, fault_items, options, request = self._checked(
+                scenario, threshold, faults, seed, link, status_regex, overrides, rule
             )
         except ConfigError as err:
-            problem: str | None = str(err)  # failed outside the handler: no chained traceback
+            problem = str(err)  # failed outside the handler: no chained traceback
         else:
-            problem = _rule_problem(rule)
+            problem = None
         if problem is not None:
             _fail(problem)
         settings = RunSettings(
-            seed=seed,
-            threshold=threshold,
+            seed=request.seed,
+            threshold=request.threshold,
             faults=fault_items,
             status_pattern=status_regex,
-            warning_when_clear=rule,
+            warning_when_clear=request.warning_when_clear,
         )
         result = self._run(chosen, link, options, settings)
         self.results.append(result)

@@ -1,9 +1,11 @@
 """The pytest plugin's options: command line first, then the ini file, then the default.
 
-Each ``--hil-*`` option has an ini twin (``hil_node`` for ``--hil-node``)
+Each ``--hil-*`` option is a row of the run request's table
+(harness.run_request) and has an ini twin (``hil_node`` for ``--hil-node``)
 except the port and the domain id, which belong to one machine and one
-board. Values go through the same argument types as the ``fossbot-hil``
-command, so a bad value is one usage line. Nothing here imports numpy,
+board. Values go through the same readers as the ``fossbot-hil`` command,
+and the session's `RunRequest` checks them, so a bad value is one usage
+line naming the option as the user gave it. Nothing here imports numpy,
 rclpy or pybullet until an option is actually given: the plugin is loaded
 into every pytest session of whoever installed the package.
 """
@@ -23,117 +25,82 @@ from harness.links.kinds import (
     default_link,
     default_serial_link,
     either,
-    link_kind,
     link_names,
     serial_links,
 )
+from harness.run_request import OPTIONS as TABLE
+from harness.run_request import OptionError, RunOption, RunRequest, table
+from harness.run_request.table import names as option_names
 
-DEFAULT_TIMEOUT_S = 1.0
-DEFAULT_READY_TIMEOUT_S = 20.0
-DEFAULT_PORT_WAIT_S = 300.0  # a whole board run, in real time, may be ahead in the queue
+DEFAULT_TIMEOUT_S = table.DEFAULT_TIMEOUT_S
+DEFAULT_READY_TIMEOUT_S = table.DEFAULT_READY_TIMEOUT_S
+DEFAULT_PORT_WAIT_S = table.DEFAULT_PORT_WAIT_S
 
 
-def _lazy(name: str, *args: str) -> Callable[[str], Any]:
-    """An argument type from harness.commands.arguments, imported on first use."""
+def _typed(row: RunOption) -> Callable[[str], Any] | None:
+    """The row's reader as an argparse type: its problem in one line after pytest's
+    "argument --hil-seed:" (or "hil_seed in tox.ini:")."""
+    if row.read is None:
+        return None
+    read = row.read
 
     def parse(text: str) -> Any:
-        from harness.commands import arguments
+        try:
+            return read(text)
+        except OptionError as err:
+            raise argparse.ArgumentTypeError(err.render(option_names("noun"))) from None
 
-        fn = getattr(arguments, name)
-        return (fn(*args) if args else fn)(text)
-
-    parse.__name__ = name  # argparse names the type in its own messages
+    parse.__name__ = row.key  # argparse names the type in its own messages
     return parse
-
-
-def _link(text: str) -> str:
-    if text not in link_names():
-        raise argparse.ArgumentTypeError(
-            f"unknown link {text!r} (known: {', '.join(link_names())})"
-        )
-    return text
 
 
 @dataclass(frozen=True)
 class _Option:
-    """One ``--hil-*`` option and its ini twin (None: command line only)."""
+    """One ``--hil-*`` option and its ini twin (None: command line only), from its row."""
 
-    name: str  # the HilConfig field
-    metavar: str
+    row: RunOption
     help: str
-    parse: Callable[[str], Any] | None = None
-    ini: bool = True
-    repeat: bool = False
+
+    @property
+    def name(self) -> str:  # the HilConfig field
+        assert self.row.hil is not None
+        return self.row.hil
+
+    @property
+    def metavar(self) -> str | None:
+        return self.row.hil_metavar or self.row.metavar
+
+    @property
+    def parse(self) -> Callable[[str], Any] | None:
+        return _typed(self.row)
+
+    @property
+    def ini(self) -> bool:
+        return self.row.ini
+
+    @property
+    def repeat(self) -> bool:
+        return self.row.repeat
 
     @property
     def flag(self) -> str:
-        return "--hil-" + self.name.replace("_", "-")
+        return self.row.hil_flag
 
     @property
     def ini_name(self) -> str:
-        return "hil_" + self.name
+        return self.row.ini_key
 
 
-OPTIONS = (
-    _Option(
-        "link",
-        "NAME",
-        f"link to the software under test: {default_link()} (default), "
-        f"{', '.join(n for n in link_names() if n != default_link())}; hil tests on a board "
-        f"use {default_serial_link()} unless this names "
-        f"{either([n for n in serial_links() if n != default_serial_link()])}",
-        _link,
-    ),
-    _Option("node", "CMD", 'node under test as a shell command, e.g. "python3 my_node.py"'),
-    _Option("package", "PKG", "node under test: a package in a colcon workspace"),
-    _Option("executable", "EXE", "executable of --hil-package"),
-    _Option("workspace", "DIR", "colcon workspace of --hil-package (has install/)"),
-    _Option(
-        "param",
-        "NAME:=VALUE",
-        "node parameter, passed verbatim (repeatable; ini: hil_param, one per line)",
-        _lazy("param"),
-        repeat=True,
-    ),
-    _Option(
-        "port",
-        "DEV",
-        "USB-UART wired to the board's LIDAR input (enables hil tests)",
-        ini=False,
-    ),
-    _Option(
-        "domain_id",
-        "N",
-        "ROS_DOMAIN_ID (default: a free one reserved per run; a board's: 0)",
-        _lazy("domain_id"),
-        ini=False,
-    ),
-    _Option("seed", "N", "seed for every run (default: each scenario's)", _lazy("seed")),
-    _Option(
-        "warning_when_clear",
-        "RULE",
-        "must the node publish warning False when nothing is within the threshold: "
-        "optional (the lab's rule) or required (default: each scenario's, optional)",
-        _lazy("warning_rule"),
-    ),
-    _Option(
-        "timeout",
-        "S",
-        f"seconds to wait for the answers to one scan (default {DEFAULT_TIMEOUT_S:g})",
-        _lazy("duration", "timeout"),
-    ),
-    _Option(
-        "ready_timeout",
-        "S",
-        f"seconds for the node to come up (default {DEFAULT_READY_TIMEOUT_S:g})",
-        _lazy("duration", "ready timeout"),
-    ),
-    _Option(
-        "port_wait",
-        "S",
-        f"seconds to wait while another run uses --hil-port (default {DEFAULT_PORT_WAIT_S:g})",
-        _lazy("duration", "port wait"),
-    ),
+LINK_HELP = (
+    f"link to the software under test: {default_link()} (default), "
+    f"{', '.join(n for n in link_names() if n != default_link())}; hil tests on a board "
+    f"use {default_serial_link()} unless this names "
+    f"{either([n for n in serial_links() if n != default_serial_link()])}"
+)
+OPTIONS = tuple(
+    _Option(row, LINK_HELP if row.key == "link" else row.hil_help or row.help)
+    for row in TABLE
+    if row.hil is not None
 )
 
 
@@ -257,20 +224,26 @@ def _workers(config: pytest.Config) -> int:
     return int(os.environ.get("PYTEST_XDIST_WORKER_COUNT", "1") or 1)
 
 
+#: The request's keys for the HilConfig fields (the rest are named alike).
+_KEYS = {"param": "params", "timeout": "scan_timeout"}
+
+
+def request_of(cfg: HilConfig) -> RunRequest:
+    """The session's run request, checked once; a usage error naming each option as the
+    user gave it ("--hil-node", "hil_node in pytest.ini")."""
+    values = {_KEYS.get(opt.name, opt.name): getattr(cfg, opt.name) for opt in OPTIONS}
+    try:
+        return RunRequest.of(values)
+    except OptionError as err:
+        names = {_KEYS.get(opt.name, opt.name): cfg.source(opt.name) for opt in OPTIONS}
+        problem = err.render(names)  # failed outside the handler: no chained traceback
+    raise pytest.UsageError(problem)
+
+
 def check_config(cfg: HilConfig, config: pytest.Config) -> None:
     """Combinations that cannot work are usage errors now, not a failure in every test."""
     src = cfg.source
-    if cfg.node and (cfg.package or cfg.executable):
-        other = "package" if cfg.package else "executable"
-        raise pytest.UsageError(f"{src('node')} and {src(other)}: give one or the other")
-    if bool(cfg.package) != bool(cfg.executable):
-        raise pytest.UsageError(f"{src('package')} and {src('executable')} go together")
-    if cfg.link is not None and not link_kind(cfg.link).runs_node:
-        for name in ("node", "package", "param"):
-            if getattr(cfg, name):
-                raise pytest.UsageError(
-                    f"{src(name)} needs a link that runs a node, not --hil-link {cfg.link}"
-                )
+    request_of(cfg)
     if cfg.param:
         from harness.commands.node_names import check_parameters
         from harness.errors import ConfigError
@@ -279,19 +252,6 @@ def check_config(cfg: HilConfig, config: pytest.Config) -> None:
             check_parameters(cfg.param, None, {"params": f"{src('param')} "})
         except ConfigError as err:
             raise pytest.UsageError(str(err)) from None
-    if cfg.port is not None:
-        from harness.commands.arguments import check_port
-        from harness.errors import ConfigError
-
-        try:
-            check_port("--hil-port", cfg.port)  # a typo is a usage error, not N failed tests
-        except ConfigError as err:
-            raise pytest.UsageError(str(err)) from None
-    if cfg.port is not None and cfg.link is not None and not link_kind(cfg.link).serial_line:
-        raise pytest.UsageError(
-            f"--hil-port drives a board through its LIDAR line: --hil-link must be "
-            f"{either(serial_links())}, not {cfg.link}"
-        )
     if cfg.domain_id is not None and cfg.port is None and _workers(config) > 1:
         raise pytest.UsageError(
             f"--hil-domain-id {cfg.domain_id} with {_workers(config)} xdist workers: every "

@@ -19,6 +19,10 @@ if TYPE_CHECKING:
 
 #: The options that choose the node under test (a link that runs none refuses them).
 NODE_KEYS = ("node", "package", "executable", "workspace", "params")
+#: The options that are not the link's: which link, how the scenarios are judged, and
+#: the plugin's wait for a port; every other option is a LinkOptions field of its name.
+RUN_KEYS = ("link", "seed", "faults", "threshold", "status_regex", "warning_when_clear")
+OWN_KEYS = ("port_wait", "given")
 
 
 @dataclass(frozen=True)
@@ -57,17 +61,24 @@ class RunRequest:
 
     @classmethod
     def of(
-        cls, values: Mapping[str, object], given: Collection[str] = (), *, check: bool = True
+        cls,
+        values: Mapping[str, object],
+        given: Collection[str] = (),
+        *,
+        check: bool = True,
+        typed: bool = False,
     ) -> RunRequest:
-        """A request from `values` (keys of the table; text or typed), each read by its
-        row and (`check`) the whole checked; OptionError (keys as ``{key}``) for the first
-        problem."""
+        """A request from `values` (keys of the table; text, or with `typed` only values
+        of the option's type), each read by its row and (`check`) the whole checked;
+        OptionError (keys as ``{key}``) for the first problem."""
         known = {f.name for f in fields(cls)} - {"given"}
         read: dict[str, Any] = {}
         for key, value in values.items():
             if key not in known:
                 raise OptionError(key, f"unknown option {literal(key)}")
             row = option(key)
+            if typed and row.number and isinstance(value, str):
+                raise OptionError(key, f"{{{key}}} must be a number, got {literal(value)}")
             if row.repeat and value is not None:
                 items = [value] if isinstance(value, str) else list(value)  # type: ignore[call-overload]
                 read[key] = tuple(row.value(item) for item in items)
@@ -140,27 +151,8 @@ class RunRequest:
         """The link's settings (the runner fills in the threshold and the scan rate)."""
         from harness.links.base import LinkOptions
 
-        return LinkOptions(
-            scan_timeout=self.scan_timeout,
-            ready_timeout=self.ready_timeout,
-            processor=self.processor,
-            node=self.node,
-            package=self.package,
-            executable=self.executable,
-            workspace=self.workspace,
-            launch=self.launch,
-            params=self.params,
-            threshold_param=self.threshold_param or None,
-            scan_topic=self.scan_topic,
-            status_topic=self.status_topic,
-            warning_topic=self.warning_topic,
-            domain_id=self.domain_id,
-            ros_network=self.ros_network,
-            realtime=self.realtime,
-            port=self.port,
-            board_commands=self.board_commands,
-            lidar_mount=self.lidar_mount,
-        )
+        link = {key: getattr(self, key) for key in link_keys()}
+        return LinkOptions(**{**link, "threshold_param": self.threshold_param or None})
 
     def run_settings(self) -> RunSettings:
         """The run's overrides of the scenarios' seed, threshold, faults and judging."""
@@ -204,3 +196,10 @@ def check_port(path: str, key: str = "port") -> None:
         raise OptionError(key, f"{{{key}}} {shown}: a folder, not a serial port")
     if not stat.S_ISCHR(mode):
         raise OptionError(key, f"{{{key}}} {shown}: not a serial port (not a character device)")
+
+
+def link_keys() -> tuple[str, ...]:
+    """The request's keys that are LinkOptions fields, in the table's order."""
+    return tuple(
+        f.name for f in fields(RunRequest) if f.name not in RUN_KEYS and f.name not in OWN_KEYS
+    )

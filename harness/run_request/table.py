@@ -31,11 +31,13 @@ class RunOption:
     hil: str | None = None  # the plugin's "--hil-<hil>" option ...
     ini: bool = True  # ... and its "hil_<hil>" ini key (False: a machine's, not a project's)
     hil_help: str | None = None  # the plugin's help, where it differs from the CLI's
+    hil_metavar: str | None = None  # the plugin's metavar, where it differs from the CLI's
     grading: str | None = None  # the grading file's field
     run: str | None = None  # hil.run's keyword (and HilConfig's ...)
     repeat: bool = False  # given again, adds an item
     switch: bool = False  # a flag without a value
     choices: tuple[str, ...] | None = None
+    number: bool = False  # a number: typed callers (hil.run, a YAML file) may not give text
 
     @property
     def dest(self) -> str:
@@ -61,7 +63,16 @@ class RunOption:
 _TOPIC_HELP = "; relative names resolve to /NAME, ~ and {} names are refused"
 
 OPTIONS: tuple[RunOption, ...] = (
-    RunOption("link", "link", values.link, cli="--link", hil="link", grading="link", run="link"),
+    RunOption(
+        "link",
+        "link",
+        values.link,
+        cli="--link",
+        hil="link",
+        hil_metavar="NAME",
+        grading="link",
+        run="link",
+    ),
     RunOption(
         "node",
         "node",
@@ -169,6 +180,7 @@ OPTIONS: tuple[RunOption, ...] = (
         hil="ready_timeout",
         grading="ready_timeout",
         run="ready_timeout",
+        number=True,
     ),
     RunOption(
         "domain_id",
@@ -180,6 +192,7 @@ OPTIONS: tuple[RunOption, ...] = (
         ini=False,
         hil_help="ROS_DOMAIN_ID (default: a free one reserved per run; a board's: 0)",
         run="domain_id",
+        number=True,
     ),
     RunOption(
         "ros_network",
@@ -254,8 +267,10 @@ OPTIONS: tuple[RunOption, ...] = (
         help="override the scenarios' seed",
         hil="seed",
         hil_help="seed for every run (default: each scenario's)",
+        hil_metavar="N",
         grading="seed",
         run="seed",
+        number=True,
     ),
     RunOption(
         "faults",
@@ -275,6 +290,7 @@ OPTIONS: tuple[RunOption, ...] = (
         metavar="M",
         grading="threshold",
         run="threshold",
+        number=True,
     ),
     RunOption(
         "status_regex",
@@ -290,8 +306,8 @@ OPTIONS: tuple[RunOption, ...] = (
         "warning rule",
         values.choice("warning_when_clear", WARNING_RULES),
         cli="--warning-when-clear",
-        metavar="RULE",
         hil="warning_when_clear",
+        hil_metavar="RULE",
         hil_help="must the node publish warning False when nothing is within the threshold: "
         "optional (the lab's rule) or required (default: each scenario's, optional)",
         grading="warning_when_clear",
@@ -309,6 +325,7 @@ OPTIONS: tuple[RunOption, ...] = (
         hil="timeout",
         grading="timeout",
         run="scan_timeout",
+        number=True,
     ),
     RunOption(
         "port_wait",
@@ -318,6 +335,7 @@ OPTIONS: tuple[RunOption, ...] = (
         hil="port_wait",
         hil_help="seconds to wait while another run uses --hil-port "
         f"(default {DEFAULT_PORT_WAIT_S:g})",
+        number=True,
     ),
 )
 _BY_KEY = {row.key: row for row in OPTIONS}

@@ -48,7 +48,7 @@ def test_options_and_ini_keys_are_listed_in_help(pytester: pytest.Pytester) -> N
             "--hil-workspace /nonexistent: no such folder",
         ),
         (["--hil-link", "inprocess", "--hil-param", "a:=1"], "--hil-param needs a link that"),
-        (["--hil-port=/dev/null", "--hil-link", "ros2"], "--hil-link must be rplidar or"),
+        (["--hil-port=/dev/null", "--hil-link", "ros2"], "--hil-port needs --hil-link rplidar or"),
         (["--hil-port=/nonexistent/ttyUSB9"], "--hil-port /nonexistent/ttyUSB9: no such device"),
         (["-n", "2", "--hil-domain-id", "3"], "--hil-domain-id 3 with 2 xdist workers"),
     ],

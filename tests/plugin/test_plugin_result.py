@@ -111,7 +111,7 @@ def test_a_scenario_file_next_to_the_test(pytester: pytest.Pytester) -> None:
         ('"approach_wall", scan_timeout=1e9', "hil.run: scan_timeout must be at most 86400"),
         ('"approach_wall", scan_timeout="1"', "hil.run: scan_timeout must be a number, got '1'"),
         ('"approach_wall", ready_timeout=0', "hil.run: ready_timeout must be a positive number"),
-        ('"approach_wall", domain_id=1.5', "hil.run: domain id must be a whole number 0..232"),
+        ('"approach_wall", domain_id=1.5', "hil.run: domain_id must be a whole number 0..232"),
         (
             '"approach_wall", threshold=99',
             "hil.run: threshold for scenario approach_wall: 99 m",
