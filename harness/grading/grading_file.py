@@ -31,9 +31,19 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal
 
 import yaml
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
+from pydantic import (
+    BaseModel,
+    ConfigDict,
+    Field,
+    ValidationError,
+    ValidationInfo,
+    create_model,
+    field_validator,
+)
 
 from harness.errors import ConfigError
+from harness.run_request import OPTIONS, OptionError, RunOption
+from harness.run_request.table import names
 from harness.scenario.files import SCENARIO_SUFFIXES
 from harness.scenario.yaml_loader import load_yaml, yaml_problem
 from harness.text_file import read_text_file
@@ -77,24 +87,43 @@ class GradebookSettings(_Strict):
             raise ValueError(str(error)) from None
 
 
-class GradingFile(_Strict):
+#: The run options a grading file may set, by field name: the run request's table's rows
+#: with a grading-file field (a new one there is a new field here).
+RUN_FIELDS: dict[str, RunOption] = {row.grading: row for row in OPTIONS if row.grading}
+_RunOptions = create_model(  # type: ignore[call-overload]
+    "_RunOptions", __base__=_Strict, **{name: (Any, None) for name in RUN_FIELDS}
+)
+
+
+class GradingFile(_RunOptions):  # type: ignore[valid-type, misc]
     """What grade and run take from the grading file; None leaves an option as given."""
 
     scenarios: list[PlannedScenario] = Field(min_length=1, max_length=500)
     points: float | None = Field(default=None, gt=0.0, le=1e6)
     partial_credit: bool = False
-    threshold: float | None = Field(default=None, gt=0.0)
-    timeout: float | None = Field(default=None, gt=0.0)
-    ready_timeout: float | None = Field(default=None, gt=0.0)
-    seed: int | None = Field(default=None, ge=0, le=2**32 - 1)
-    faults: str | list[str] | None = None
-    warning_when_clear: Literal["optional", "required"] | None = None
-    status_regex: str | None = None
-    link: str | None = None
-    package: str | None = None
-    executable: str | None = None
     gradebook: GradebookSettings = GradebookSettings()
     source: str = Field(default="", exclude=True)
+
+    @field_validator(*RUN_FIELDS)
+    @classmethod
+    def _a_run_option(cls, value: Any, info: ValidationInfo) -> Any:
+        """Each run option read by its row, as the command line's is; a problem names the
+        field ("seed must be a whole number ...")."""
+        if value is None:
+            return None
+        name = info.field_name or ""
+        row = RUN_FIELDS[name]
+        if row.number and isinstance(value, str):
+            raise ValueError(f"{name} must be a number, got {value[:40]!r}")
+        texts = [value] if isinstance(value, str) else value
+        if row.key == "faults" and not (
+            isinstance(texts, list) and all(isinstance(f, str) for f in texts)
+        ):
+            raise ValueError("faults: give a profile name, 'a,b' or a list of names")
+        try:
+            return row.value(value)
+        except OptionError as err:
+            raise ValueError(err.render(names("grading"), subject=True)) from None
 
     @field_validator("scenarios", mode="before")
     @classmethod
@@ -135,6 +164,14 @@ class GradingFile(_Strict):
             partial_credit=self.partial_credit,
         )
 
+    def request_values(self) -> dict[str, Any]:
+        """The run options the file sets, by the run request's keys (faults as a list)."""
+        return {
+            row.key: getattr(self, name)
+            for name, row in RUN_FIELDS.items()
+            if getattr(self, name) is not None
+        }
+
     def apply_to(self, args: Any, *, typed: Collection[str], skip: Collection[str] = ()) -> None:
         """Set the file's options on an argparse namespace, except those the user typed
         (the command line wins) and those in `skip`."""
@@ -143,18 +180,15 @@ class GradingFile(_Strict):
                 setattr(args, name, value)
 
     def judging_options(self) -> dict[str, Any]:
-        """The options the file sets, by their argparse names (faults as --faults text)."""
-        names = ("threshold", "timeout", "ready_timeout", "seed", "warning_when_clear")
-        options = {n: getattr(self, n) for n in names if getattr(self, n) is not None}
-        if self.status_regex is not None:
-            options["status_regex"] = self.status_regex
-        if self.faults is not None:
-            options["faults"] = (
-                self.faults if isinstance(self.faults, str) else ",".join(self.faults)
-            )
-        for name in ("link", "package", "executable"):
-            if getattr(self, name) is not None:
-                options[name] = getattr(self, name)
+        """The options the file sets, by their command-line names (faults as --faults
+        text), from the run request's table."""
+        from harness.run_request import option
+
+        options = {}
+        for key, value in self.request_values().items():
+            if key == "faults" and not isinstance(value, str):
+                value = ",".join(value)
+            options[option(key).dest] = value
         return options
 
 
@@ -207,4 +241,6 @@ def _first_error(err: ValidationError) -> str:
     first = err.errors()[0]
     where = ".".join(str(p) for p in first["loc"])
     message = str(first["msg"]).removeprefix("Value error, ")
-    return f"{where}: {message}" if where else message
+    if not where or message.startswith(f"{where} ") or message.startswith(f"{where}:"):
+        return message or where  # the message names the field itself
+    return f"{where}: {message}"
