@@ -21,18 +21,15 @@ from harness.ros.names import (
     resolve_topic,
     shown_name,
 )
+from harness.run_request.table import names as option_names
 
-#: How the command line names each LinkOptions field in a message (with the
-#: separator before the value); the plugin passes its own (``scan_topic=``).
-CLI_NAMES: Mapping[str, str] = {
-    "scan_topic": "--scan-topic ",
-    "status_topic": "--status-topic ",
-    "warning_topic": "--warning-topic ",
-    "params": "--param ",
-    "threshold_param": "--threshold-param ",
-    "threshold": "--threshold ",
-}
 TOPIC_FIELDS = ("scan_topic", "status_topic", "warning_topic")
+#: How the command line names each option these checks name (the run request's table's
+#: flags, with the separator before the value); the plugin passes its own (``scan_topic=``).
+CLI_NAMES: Mapping[str, str] = {
+    key: f"{option_names('cli')[key]} "
+    for key in (*TOPIC_FIELDS, "params", "threshold_param", "threshold")
+}
 
 
 def topic_option(label: str, value: object) -> str:
