@@ -146,7 +146,7 @@ def run(args: argparse.Namespace, console: Console) -> int:
         raise ConfigError(f"--link {args.link}: hunt runs nodes over {over}")
     options, judged = checked_runs_options(args, "hunt")
     if kind.runs_node:
-        from harness.links.ros2 import node_command
+        from harness.links.node_start import node_command
 
         node_command(options)  # a missing node program is exit 2 now, not a failed run
     optuna_module()  # exit 2 now if it is missing, not after the cluster started

@@ -46,13 +46,8 @@ from harness.links.board_idle import (
 )
 from harness.links.board_pairing import pair_with_driver_scans
 from harness.links.board_session import BoardSession, remappable, takes_remaps
-from harness.links.ros2 import (
-    POLL_S,
-    Ros2Link,
-    harness_observer,
-    node_command,
-    node_parameters,
-)
+from harness.links.node_start import harness_observer, node_command, node_parameters
+from harness.links.ros2 import POLL_S, Ros2Link
 from harness.nodes.command import node_arguments
 from harness.nodes.process import NodeProcess
 from harness.ros.observer import Heard, Observer

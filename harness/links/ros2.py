@@ -32,7 +32,6 @@ from __future__ import annotations
 import contextlib
 import time
 from collections.abc import Callable, Iterable
-from pathlib import Path
 from typing import TYPE_CHECKING
 
 from harness.errors import ConfigError, LinkError, NeverReady
@@ -40,6 +39,7 @@ from harness.judge.answers import Answers, Received
 from harness.links import start_explanations
 from harness.links.base import Link, LinkOptions, register
 from harness.links.node_notes import WiringNotes, output_notes
+from harness.links.node_start import harness_observer, launch_check, node_command, node_parameters
 from harness.links.topic_advice import (
     BOOL_TYPE,
     ElsewhereWatch,
@@ -47,11 +47,7 @@ from harness.links.topic_advice import (
 )
 from harness.links.watchdogs import FloodWatch, SilenceWatch, Topics, strangers_problem
 from harness.nodes.command import (
-    NodeCommand,
     node_arguments,
-    package_node,
-    reference_node,
-    shell_node,
 )
 from harness.nodes.process import NodeProcess, prepare_start, start_would_wait
 from harness.ros.domain import (
@@ -76,64 +72,6 @@ FIRST_RETRY_MAX_S = 2.0  # the first scan's resends back off up to this interval
 # a participant that never names itself (no ROS node) is sent its first scan after this.
 NAMED_WAIT_S = 0.5
 CATCH_UP_S = 2.0  # after a missed deadline, wait this long (at least) for the late answer
-
-
-def node_command(options: LinkOptions) -> NodeCommand:
-    """The node the options name: a command, a package in a workspace, or the reference."""
-    if options.node and options.package:
-        raise ConfigError("give either --node or --package/--executable, not both")
-    if options.launch:
-        if options.node or options.package or options.executable:
-            raise ConfigError("--launch starts the node itself: drop --node/--package/--executable")
-        from harness.launch_files.launch_command import launch_node
-
-        return launch_node(*options.launch, options.workspace)
-    if options.node:
-        return shell_node(options.node)
-    if options.package or options.executable:
-        if not (options.package and options.executable):
-            raise ConfigError("--package and --executable go together")
-        return package_node(options.package, options.executable, options.workspace)
-    return reference_node()
-
-
-def node_parameters(options: LinkOptions) -> tuple[str, ...]:
-    """The user's --param items, plus the threshold unless the user set it."""
-    params = tuple(options.params)
-    name = options.threshold_param
-    if name and not any(p.split(":=", 1)[0] == name for p in params):
-        params = (f"{name}:={options.threshold!r}", *params)
-    return params
-
-
-def launch_check(options: LinkOptions) -> LaunchCheck | None:
-    """The run's launch files (read, not run), when a package or `--launch` names them."""
-    by_package = bool(options.package and options.executable and not options.node)
-    if not (options.launch or by_package):
-        return None
-    from harness.launch_files.run_check import LaunchCheck  # the file readers: only for these
-
-    if options.launch:
-        package, file = options.launch
-        passed = ["use_sim_time", *(p.split(":=", 1)[0] for p in node_parameters(options))]
-        return LaunchCheck.for_run(
-            package, None, options.workspace, launched=Path(file).name, passed=passed
-        )
-    return LaunchCheck.for_run(options.package, options.executable, options.workspace)
-
-
-def harness_observer(options: LinkOptions, domain_id: int, *, publish_scans: bool) -> Observer:
-    """The harness's own ROS node in `domain_id`, on the topics and graph the options name."""
-    from harness.ros.observer import Observer  # imports rclpy
-
-    return Observer(
-        domain_id,
-        scan_topic=options.scan_topic,
-        status_topic=options.status_topic,
-        warning_topic=options.warning_topic,
-        network=options.ros_network,
-        publish_scans=publish_scans,
-    )
 
 
 @register("ros2")

@@ -26,7 +26,7 @@ from harness.judge.records import RunResult, TickRecord
 from harness.lidar.scan import Scan
 from harness.links.base import LinkOptions, create_link
 from harness.links.kinds import ROS2
-from harness.links.ros2 import harness_observer
+from harness.links.node_start import harness_observer
 from harness.live.drive import CommandWatchdog
 from harness.live.judge import LiveJudge
 from harness.live.world import LiveWorld
