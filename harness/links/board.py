@@ -44,7 +44,7 @@ from harness.links.board_idle import (
     IdleStreamEnd,
     set_aside_answers_to_the_idle_stream,
 )
-from harness.links.board_pairing import pair_with_driver_scans
+from harness.links.board_pairing import AnswerWindow, owed_answers, pair_with_driver_scans
 from harness.links.board_session import BoardSession, remappable, takes_remaps
 from harness.links.node_start import harness_observer, node_command, node_parameters
 from harness.links.ros2 import POLL_S, Ros2Link
@@ -111,6 +111,8 @@ class BoardLink(IdleStreamEnd, Ros2Link):
         self._lost_in_a_row = 0
         self._heard_scans: list[Heard] = []
         self._repeat_at: int | None = None  # the first repeat's scan in this exchange, if any
+        self._window: AnswerWindow | None = None  # the last tick's scans and answers
+        self._owed = 0  # statuses after this tick's scan that answer earlier scans
         self._line_damage: LineDamage | None = None
         self._first_damage: LineDamage | None = None  # as it was before the first scan's copy
         self._after_first: LineDamage | None = None  # as it was after it (copies were sent)
@@ -295,6 +297,7 @@ class BoardLink(IdleStreamEnd, Ros2Link):
         samples = self.profile.revolution(self.device, scan, rate, scan.range_max, mount=self.mount)
         returns = sum(1 for sample in samples if sample.distance_mm > 0)
         self._seen, self._delivery_problem, self._lost = None, None, None
+        window, self._window, self._owed = self._window, None, 0
         if not self._pushed:  # this scenario's first revolution: the idle stream ends
             self._idle_over(rate)
         written_ns = self._push(samples, tick, rate)
@@ -331,7 +334,10 @@ class BoardLink(IdleStreamEnd, Ros2Link):
             obs.spin(min(POLL_S, deadline - time.perf_counter()))
         if sparse:
             self.session.skips_sparse = False
-        self._not_this_revolution(written_ns)
+        repeats = self._not_this_revolution(written_ns)
+        if self._line_damage is None and tick > 0:
+            late = sum(1 for h in obs.inbox if h.kind == "status" and h.source_ns < heard.source_ns)
+            self._owed = owed_answers(window, repeats, late)
         self._seen = heard.value
         self._scans_from = heard.source_ns
         if self._lost_in_a_row:
@@ -448,9 +454,10 @@ class BoardLink(IdleStreamEnd, Ros2Link):
         self._delivery_problem = gone or missing
         return time.time_ns()
 
-    def _not_this_revolution(self, written_ns: int) -> None:
+    def _not_this_revolution(self, written_ns: int) -> int:
         """Driver scans of revolutions the device sent on its own (a repeat while the
-        harness was late) came before this one's: answers to them answer no tick."""
+        harness was late) came before this one's: answers to them answer no tick. How
+        many came."""
         assert self.observer is not None
         others = sorted(
             h.source_ns
@@ -458,6 +465,7 @@ class BoardLink(IdleStreamEnd, Ros2Link):
             if h.kind == "scan" and self._scans_from < h.source_ns < written_ns
         )
         self._sends = [*self._sends, *((None, ns) for ns in others)]
+        return len(others)
 
     def _driver_scans(self) -> list[Heard]:
         """The driver's scans of this exchange, oldest first: its revolution's, and on a
@@ -491,7 +499,7 @@ class BoardLink(IdleStreamEnd, Ros2Link):
 
     def _answered(self) -> bool:
         """One status for each driver scan this exchange brought (usually one)."""
-        return self._statuses() >= max(len(self._driver_scans()), 1)
+        return self._statuses() >= max(len(self._driver_scans()), 1) + self._owed
 
     def _settle_answers(self) -> None:
         """The first tick, when the node may still owe answers to idle revolutions: wait
@@ -565,6 +573,14 @@ class BoardLink(IdleStreamEnd, Ros2Link):
         self._heard_scans = self._driver_scans()  # `heard` is the inbox they are read from
         self._repeat_at = self._repeat_from()
         super()._sort(answers, heard, mine)
+        if self._owed:  # the first statuses answer scans before this tick's (owed_answers)
+            answers.keep_only(sorted(answers.statuses, key=lambda r: r.source_ns)[self._owed :])
+        statuses = sum(1 for h in heard if h.kind == "status" and h.source_ns >= self._sent_ns)
+        after = sum(1 for h in heard if h.kind == "scan" and h.source_ns > self._scans_from)
+        # Owed answers that never came (a node that skips a repeat) are not carried on.
+        plain = self._line_damage is None and self._copies == 1
+        plain = plain and not (self._owed and answers.timed_out)
+        self._window = AnswerWindow(1 + after, max(0, statuses - self._owed)) if plain else None
 
     # -- reporting and teardown ---------------------------------------------
     def diagnostics(self) -> str:

@@ -6,6 +6,7 @@ next one's) or split it in two; the node answers scans in order.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 from harness.judge.answers import Answers
@@ -14,7 +15,7 @@ from harness.lidar.scan import Scan
 if TYPE_CHECKING:
     from harness.ros.observer import Heard
 
-__all__ = ["pair_with_driver_scans"]
+__all__ = ["AnswerWindow", "owed_answers", "pair_with_driver_scans"]
 
 
 def pair_with_driver_scans(answers: Answers, scans: list[Heard]) -> None:
@@ -53,3 +54,31 @@ def pair_with_driver_scans(answers: Answers, scans: list[Heard]) -> None:
     answers.statuses, answers.warnings = groups[-1].statuses, groups[-1].warnings
     answers.seen = seen[-1]
     answers.earlier = list(zip(seen[:-1], groups[:-1], strict=True))
+
+
+@dataclass(frozen=True)
+class AnswerWindow:
+    """What one tick's exchange leaves the next to account for: the driver scans from the
+    tick's own on (its own and the device's repeats of it) and the statuses heard for them."""
+
+    scans: int
+    statuses: int
+
+
+def owed_answers(window: AnswerWindow | None, repeats_before: int, late_before: int) -> int:
+    """How many statuses published after this tick's driver scan still answer earlier ones.
+
+    In real time the device repeats a revolution while the harness is late (a
+    node slow on one scan); a node answering in order may answer such a repeat
+    only after the next tick's scan was published, and that answer, newer than
+    the tick's scan, is not the tick's. The scans since the last tick's own
+    (`window`, plus `repeats_before`: repeats heard since) less the statuses
+    heard for them (`late_before`: those published before this tick's scan)
+    is what the node still owes them, at most one a repeat (a tick's own scan
+    left unanswered is the silence watch's, not this); None (no window: the
+    first tick, a lost revolution, a damaged line, copies of the first scan)
+    owes nothing."""
+    if window is None:
+        return 0
+    repeats = window.scans - 1 + repeats_before
+    return min(repeats, max(0, window.scans + repeats_before - window.statuses - late_before))

@@ -53,9 +53,11 @@ class LidarNode(Node):
         self.declare_parameter(warning_param, "/obstacle_warning")
         self.declare_parameter("threshold", 0.5)
         # Seconds a scan's callback takes before it answers (a slow but right node): every
-        # scan's, or with slow_scan N only the N-th scan's (1 = the first it receives).
+        # scan's, or with slow_scan N only the N-th scan's (1 = the first it receives), and
+        # with slow_count C the C scans from the N-th on.
         self.delay_s = self.declare_parameter("delay_s", 0.0).value
         self.slow_scan = self.declare_parameter("slow_scan", 0).value
+        self.slow_count = self.declare_parameter("slow_count", 1).value
         scan_topic = self.get_parameter("lidar_topic").value
         if variant == "topic_parameter_ignored":
             scan_topic = "/scan"
@@ -85,7 +87,7 @@ class LidarNode(Node):
             return
         if self.variant == "slow_callback":
             time.sleep(1.5)
-        if self.slow_scan in (0, self.scans):
+        if self.slow_scan == 0 or 0 <= self.scans - self.slow_scan < self.slow_count:
             time.sleep(self.delay_s)
         if self.variant == "crash_when_nothing_in_range":
             valid = [r for r in msg.ranges if msg.range_min <= r <= msg.range_max]
