@@ -27,7 +27,6 @@ when the harness was late) are told apart the same way and not judged.
 from __future__ import annotations
 
 import copy
-import os
 import time
 from dataclasses import replace
 from typing import TYPE_CHECKING, Any, ClassVar
@@ -45,7 +44,7 @@ from harness.links.board_idle import (
     set_aside_answers_to_the_idle_stream,
 )
 from harness.links.board_pairing import AnswerWindow, owed_answers, pair_with_driver_scans
-from harness.links.board_session import BoardSession, remappable, takes_remaps
+from harness.links.board_session import BoardSession, board_options, remappable, takes_remaps
 from harness.links.node_start import harness_observer, node_command, node_parameters
 from harness.links.ros2 import POLL_S, Ros2Link
 from harness.nodes.command import node_arguments
@@ -62,20 +61,6 @@ LOST_IN_A_ROW = 5  # line faults: this many revolutions without a driver scan is
 # (the FOSSBot v2's agent) yields none of 5 or fewer.
 SPARSE_RETURNS = 5
 SPARSE_WAIT_S = 0.25  # at least this long for the board's scan of such a revolution
-
-
-def board_options(options: LinkOptions) -> LinkOptions:
-    """Options for a board: a physical board's own nodes, in its own domain."""
-    physical = options.port is not None
-    if physical and (options.node or options.package):
-        raise ConfigError(
-            "--port drives a physical board, which runs its own nodes: drop --node/--package"
-        )
-    if physical and options.domain_id is None:
-        # Joining a board's graph: its domain, not a reserved private one.
-        env_id = os.environ.get("ROS_DOMAIN_ID", "0")
-        options = replace(options, domain_id=int(env_id) if env_id.isdigit() else 0)
-    return options
 
 
 class BoardLink(IdleStreamEnd, Ros2Link):

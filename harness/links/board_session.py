@@ -20,8 +20,10 @@ domain; on the virtual board it still starts a fresh node under test.
 
 from __future__ import annotations
 
+import os
 import shlex
 import sys
+from dataclasses import replace
 from typing import TYPE_CHECKING
 
 from harness.devices.profiles import DeviceProfile
@@ -70,6 +72,20 @@ def check_board_commands(texts: tuple[str, ...]) -> None:
     """Every `--board-command` can start (checked before anything runs: exit 2 now)."""
     for text in texts:
         board_command(text)
+
+
+def board_options(options: LinkOptions) -> LinkOptions:
+    """Options for a board: a physical board's own nodes, in its own domain."""
+    physical = options.port is not None
+    if physical and (options.node or options.package):
+        raise ConfigError(
+            "--port drives a physical board, which runs its own nodes: drop --node/--package"
+        )
+    if physical and options.domain_id is None:
+        # Joining a board's graph: its domain, not a reserved private one.
+        env_id = os.environ.get("ROS_DOMAIN_ID", "0")
+        options = replace(options, domain_id=int(env_id) if env_id.isdigit() else 0)
+    return options
 
 
 class BoardSession:
