@@ -45,10 +45,8 @@ from harness.links.board_idle import (
 )
 from harness.links.board_pairing import AnswerWindow, owed_answers, pair_with_driver_scans
 from harness.links.board_session import BoardSession, board_options, remappable, takes_remaps
-from harness.links.node_start import harness_observer, node_command, node_parameters
+from harness.links.node_start import harness_observer, node_command
 from harness.links.ros2 import POLL_S, Ros2Link
-from harness.nodes.command import node_arguments
-from harness.nodes.process import NodeProcess
 from harness.ros.observer import Heard, Observer
 
 if TYPE_CHECKING:
@@ -171,19 +169,15 @@ class BoardLink(IdleStreamEnd, Ros2Link):
         super().start()
 
     def _start_processes(self, env: dict[str, str]) -> None:
-        if self.physical:
-            return  # the board's software runs its nodes
+        if not self.physical:  # a physical board's software runs its nodes
+            super()._start_processes(env)
+
+    def _remaps(self) -> list[str]:
+        """The node answers on its own topics where it has them (`links_ahead`)."""
         if self._own_topics is None:
-            super()._start_processes(env)  # the node under test, on the options' topics
-            return
-        opts = self.options
-        args = node_arguments(self.command, node_parameters(opts))
-        status, warning = self._own_topics
-        args += ["-r", f"{opts.status_topic}:={status}", "-r", f"{opts.warning_topic}:={warning}"]
-        held = None if self.domain is None else self.domain.fileno()
-        self.process = NodeProcess(self.command, args, env, held=held)
-        self.process.start(wait=False)  # open() waits: the next link starts meanwhile
-        self.node_start = f"{self.command.description}, {self.process.how}"
+            return []
+        opts, (status, warning) = self.options, self._own_topics
+        return ["-r", f"{opts.status_topic}:={status}", "-r", f"{opts.warning_topic}:={warning}"]
 
     def _make_observer(self, domain_id: int) -> Observer:
         """The harness's node in the run's domain, hearing this link's node only: on its

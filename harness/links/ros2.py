@@ -263,11 +263,15 @@ class Ros2Link(Link):
     # overrides; the lockstep machinery below stays the same.
     def _start_processes(self, env: dict[str, str]) -> None:
         """Start the node under test."""
-        args = node_arguments(self.command, node_parameters(self.options))
+        args = node_arguments(self.command, node_parameters(self.options)) + self._remaps()
         held = None if self.domain is None else self.domain.fileno()
         self.process = NodeProcess(self.command, args, env, held=held)
         self.process.start(wait=False)  # open() waits: the next links start meanwhile
         self.node_start = f"{self.command.description}, {self.process.how}"
+
+    def _remaps(self) -> list[str]:
+        """Hook: ROS remapping arguments the node is started with (none: its own topics)."""
+        return []
 
     def _make_observer(self, domain_id: int) -> Observer:
         return harness_observer(self.options, domain_id, publish_scans=self.publishes_scans)
