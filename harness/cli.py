@@ -18,6 +18,8 @@ from harness.commands import command_modules
 from harness.commands.arguments import expand_arguments
 from harness.errors import ConfigError, HarnessError, Interrupted
 from harness.nodes.quick_exit import exit_now
+from harness.option_names import speaking
+from harness.run_request.table import names
 
 EXIT_OK, EXIT_FAILED, EXIT_USAGE = 0, 1, 2
 
@@ -64,14 +66,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         console = Console(highlight=False, width=200)  # files and pipes: no wrapping
     try:
         parser = build_parser()
-        args = parser.parse_args(argv)
-        if args.command is None:
-            parser.print_help()
-            return EXIT_USAGE
-        expand_arguments(args)  # ~ and $VAR in paths and commands, as a shell would
-        args.given = getattr(args, "given", frozenset())  # noted as parsed (arguments.add_row)
-        handlers = {m.NAME: m.run for m in command_modules()}
-        return handlers[args.command](args, console)
+        with speaking(flag_names(parser)):  # lower layers' messages name options as flags
+            return _run(parser, argv, console)
     except ConfigError as err:
         _print_error(str(err))
         return EXIT_USAGE
@@ -83,6 +79,31 @@ def main(argv: Sequence[str] | None = None) -> int:
     except HarnessError as err:
         _print_error(str(err))
         return EXIT_FAILED
+
+
+def flag_names(parser: argparse.ArgumentParser) -> dict[str, str]:
+    """Each option key as the CLI spells it: the run options' flags (the table's), and
+    every other flag of every command by its argparse name."""
+    found: dict[str, str] = {}
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction):
+            for sub in action.choices.values():
+                found.update(flag_names(sub))
+        flags = [s for s in action.option_strings if s.startswith("--")]
+        if flags and action.dest not in found:
+            found[action.dest] = max(flags, key=len)
+    return {**found, **names("cli")}
+
+
+def _run(parser: argparse.ArgumentParser, argv: Sequence[str] | None, console: Console) -> int:
+    args = parser.parse_args(argv)
+    if args.command is None:
+        parser.print_help()
+        return EXIT_USAGE
+    expand_arguments(args)  # ~ and $VAR in paths and commands, as a shell would
+    args.given = getattr(args, "given", frozenset())  # noted as parsed (arguments.add_row)
+    handlers = {m.NAME: m.run for m in command_modules()}
+    return handlers[args.command](args, console)
 
 
 def entry() -> None:

@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import signal
 
+from harness.option_names import Names, worded
+
 
 def one_line(err: BaseException, limit: int = 200) -> str:
     """Another library's error as one short line for a message (its type when it says
@@ -22,6 +24,32 @@ class HarnessError(Exception):
 
 class ConfigError(HarnessError):
     """Bad input from the user; the message is one line naming what is wrong."""
+
+
+class OptionError(ConfigError):
+    """A bad option value or combination; `template` names options as ``{key}``.
+
+    ``str(err)`` words the keys as `names` do, by default as this process's
+    caller names them (`harness.option_names.speak`); `render` words them
+    for another caller.
+    """
+
+    def __init__(self, key: str, template: str, names: Names | None = None) -> None:
+        self.key = key
+        self.template = template
+        super().__init__(self.render(names))
+
+    def render(self, names: Names | None = None, *, subject: bool = False) -> str:
+        """The message with `names`; `subject`: a value's problem that does not say
+        whose it is starts with the option's name ("threshold_param: ...")."""
+        text = worded(self.template, names)
+        if subject and "{" + self.key + "}" not in self.template:
+            return f"{worded('{' + self.key + '}', names)}: {text}"
+        return text
+
+    def named(self, names: Names) -> OptionError:
+        """The same error worded with `names` (a caller's names for the keys)."""
+        return OptionError(self.key, self.template, names)
 
 
 class LinkError(HarnessError):

@@ -31,6 +31,7 @@ GROUND = {
     "text_file",
     "ctrl_c",
     "shell_words",
+    "option_names",
 }
 
 # Bottom to top; a package imports only from layers below its own.

@@ -9,7 +9,8 @@ caller renders with its own names for the keys. Pure: no rclpy, no pybullet.
 
 from __future__ import annotations
 
-from harness.run_request.errors import Names, OptionError
+from harness.errors import OptionError
+from harness.option_names import Names
 from harness.run_request.request import RunRequest
 from harness.run_request.table import OPTIONS, RunOption, option
 

@@ -8,7 +8,7 @@ from collections.abc import Collection, Mapping
 from dataclasses import dataclass, field, fields
 from typing import TYPE_CHECKING, Any
 
-from harness.run_request.errors import OptionError
+from harness.errors import OptionError
 from harness.run_request.table import option
 from harness.run_request.values import literal
 

@@ -7,8 +7,8 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
+from harness.option_names import Names
 from harness.run_request import values
-from harness.run_request.errors import Names
 from harness.run_request.values import Reader
 
 WARNING_RULES = ("optional", "required")

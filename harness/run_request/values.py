@@ -8,7 +8,7 @@ import math
 from collections.abc import Callable, Sequence
 from typing import Any
 
-from harness.run_request.errors import OptionError
+from harness.errors import OptionError
 
 Reader = Callable[[object], Any]
 MAX_WAIT_S = 86400.0  # the OS's timed waits overflow past 24 days; no wait needs a day
