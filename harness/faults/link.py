@@ -36,6 +36,7 @@ __all__ = [
     "NO_LINK_FAULTS",
     "ON_TIME",
     "RateDrift",
+    "RateFault",
     "Reorder",
     "StaleStamps",
     "damage_bytes",
@@ -89,48 +90,44 @@ class Delay:
 
 
 @dataclass(frozen=True)
-class Drop:
+class RateFault:
+    """A fault that strikes a fraction `rate` (at most `top`) of scans, beams or bytes."""
+
+    rate: float
+    kind: ClassVar[str]
+    says: ClassVar[str]  # describe()'s words, formatted with the rate
+    top: ClassVar[float] = 1.0
+    params: ClassVar[tuple[str, ...]] = ("rate",)
+
+    def __post_init__(self) -> None:
+        _rate(self.rate, f"{self.kind} rate", self.top)
+
+    def describe(self) -> str:
+        return self.says.format(self.rate)
+
+
+@dataclass(frozen=True)
+class Drop(RateFault):
     """A fraction of the scans never reaches the node."""
 
-    rate: float
     kind: ClassVar[str] = "drop"
-    params: ClassVar[tuple[str, ...]] = ("rate",)
-
-    def __post_init__(self) -> None:
-        _rate(self.rate, "drop rate")
-
-    def describe(self) -> str:
-        return f"{self.rate:.0%} of scans dropped"
+    says: ClassVar[str] = "{:.0%} of scans dropped"
 
 
 @dataclass(frozen=True)
-class Duplicate:
+class Duplicate(RateFault):
     """A fraction of the scans reaches the node twice."""
 
-    rate: float
     kind: ClassVar[str] = "duplicate"
-    params: ClassVar[tuple[str, ...]] = ("rate",)
-
-    def __post_init__(self) -> None:
-        _rate(self.rate, "duplicate rate")
-
-    def describe(self) -> str:
-        return f"{self.rate:.0%} of scans delivered twice"
+    says: ClassVar[str] = "{:.0%} of scans delivered twice"
 
 
 @dataclass(frozen=True)
-class Reorder:
+class Reorder(RateFault):
     """A fraction of the scans is held back and arrives after the next one."""
 
-    rate: float
     kind: ClassVar[str] = "reorder"
-    params: ClassVar[tuple[str, ...]] = ("rate",)
-
-    def __post_init__(self) -> None:
-        _rate(self.rate, "reorder rate")
-
-    def describe(self) -> str:
-        return f"{self.rate:.0%} of scans swapped with the next"
+    says: ClassVar[str] = "{:.0%} of scans swapped with the next"
 
 
 @dataclass(frozen=True)
@@ -178,33 +175,21 @@ class StaleStamps:
 
 
 @dataclass(frozen=True)
-class LineCorruption:
+class LineCorruption(RateFault):
     """Serial links: each byte has one bit flipped with probability `rate`."""
 
-    rate: float
     kind: ClassVar[str] = "line_corruption"
-    params: ClassVar[tuple[str, ...]] = ("rate",)
-
-    def __post_init__(self) -> None:
-        _rate(self.rate, "line_corruption rate", MAX_BYTE_RATE)
-
-    def describe(self) -> str:
-        return f"{self.rate:.2%} of line bytes with a flipped bit"
+    says: ClassVar[str] = "{:.2%} of line bytes with a flipped bit"
+    top: ClassVar[float] = MAX_BYTE_RATE
 
 
 @dataclass(frozen=True)
-class LineDrops:
+class LineDrops(RateFault):
     """Serial links: each byte is lost with probability `rate`."""
 
-    rate: float
     kind: ClassVar[str] = "line_drops"
-    params: ClassVar[tuple[str, ...]] = ("rate",)
-
-    def __post_init__(self) -> None:
-        _rate(self.rate, "line_drops rate", MAX_BYTE_RATE)
-
-    def describe(self) -> str:
-        return f"{self.rate:.2%} of line bytes lost"
+    says: ClassVar[str] = "{:.2%} of line bytes lost"
+    top: ClassVar[float] = MAX_BYTE_RATE
 
 
 @dataclass(frozen=True)

@@ -36,6 +36,7 @@ from harness.faults.link import (
     LinkFault,
     LinkFaults,
     RateDrift,
+    RateFault,
     Reorder,
     StaleStamps,
 )
@@ -107,16 +108,15 @@ class Noise:
 
 
 @dataclass(frozen=True)
-class Dropouts:
+class Dropouts(RateFault):
     """A fraction of the valid returns is lost and reads as ``value``."""
 
-    rate: float
     value: str = "nan"
     kind: ClassVar[str] = "dropouts"
     params: ClassVar[tuple[str, ...]] = ("rate", "value")
 
     def __post_init__(self) -> None:
-        _check_rate(self.rate, "dropouts rate")
+        super().__post_init__()
         if self.value not in DROPOUT_VALUES:
             known = ", ".join(DROPOUT_VALUES)
             raise ConfigError(f"dropouts value must be one of {known}, got {self.value!r}")
@@ -126,7 +126,7 @@ class Dropouts:
 
 
 @dataclass(frozen=True)
-class Spurious:
+class Spurious(RateFault):
     """Ghost returns closer than range_min on a fraction of all beams.
 
     Values are drawn from [0.05, 0.95) * range_min, so they stay strictly
@@ -134,19 +134,12 @@ class Spurious:
     a trap for nodes that take ``min(ranges)`` without checking range_min.
     """
 
-    rate: float
     kind: ClassVar[str] = "spurious"
-    params: ClassVar[tuple[str, ...]] = ("rate",)
-
-    def __post_init__(self) -> None:
-        _check_rate(self.rate, "spurious rate")
-
-    def describe(self) -> str:
-        return f"{self.rate:.0%} of beams read a ghost below range_min"
+    says: ClassVar[str] = "{:.0%} of beams read a ghost below range_min"
 
 
 @dataclass(frozen=True)
-class FarReturns:
+class FarReturns(RateFault):
     """Finite readings beyond range_max on a fraction of the no-return beams.
 
     A device measures past the range_max its driver publishes (the
@@ -155,15 +148,8 @@ class FarReturns:
     trap for nodes that do not check range_max.
     """
 
-    rate: float
     kind: ClassVar[str] = "far_returns"
-    params: ClassVar[tuple[str, ...]] = ("rate",)
-
-    def __post_init__(self) -> None:
-        _check_rate(self.rate, "far_returns rate")
-
-    def describe(self) -> str:
-        return f"{self.rate:.0%} of no-return beams read a raw distance beyond range_max"
+    says: ClassVar[str] = "{:.0%} of no-return beams read a raw distance beyond range_max"
 
 
 @dataclass(frozen=True)
@@ -186,18 +172,8 @@ Fault = Noise | Dropouts | Spurious | FarReturns
 _Item = Noise | Dropouts | Spurious | FarReturns | Convention | LinkFault
 _FAULT_ORDER: tuple[str, ...] = ("noise", "dropouts", "spurious", "far_returns")
 _KINDS: dict[str, type[Any]] = {
-    "convention": Convention,
-    "dropouts": Dropouts,
-    "far_returns": FarReturns,
-    "noise": Noise,
-    "spurious": Spurious,
-    **LINK_KINDS,
-}
-
-
-def _check_rate(rate: float, what: str) -> None:
-    if not (isinstance(rate, (int, float)) and 0.0 <= rate <= 1.0):
-        raise ConfigError(f"{what} must be in [0, 1], got {rate!r}")
+    cls.kind: cls for cls in (Convention, Dropouts, FarReturns, Noise, Spurious)
+} | LINK_KINDS
 
 
 def _check_convention(name: str) -> None:
@@ -360,11 +336,8 @@ def _compose(items: Sequence[_Item], name: str) -> FaultProfile:
         by_kind[item.kind] = item
     convention = by_kind.pop("convention", Convention("rep117"))
     assert isinstance(convention, Convention)
-    link_types = (Delay, Drop, Duplicate, Reorder, RateDrift, StaleStamps)
-    line_types = (LineCorruption, LineDrops, LineNoise)
-    link = tuple(f for f in by_kind.values() if isinstance(f, link_types + line_types))
-    scan_types = (Noise, Dropouts, Spurious, FarReturns)
-    faults = tuple(f for f in by_kind.values() if isinstance(f, scan_types))
+    link = tuple(f for f in by_kind.values() if f.kind in LINK_KINDS)
+    faults = tuple(f for f in by_kind.values() if f.kind in _FAULT_ORDER)
     return FaultProfile(faults=faults, convention=convention.name, name=name, link=LinkFaults(link))
 
 
