@@ -31,7 +31,7 @@ import time
 import weakref
 from collections.abc import Iterable
 from dataclasses import dataclass
-from types import SimpleNamespace, TracebackType
+from types import SimpleNamespace
 from typing import TYPE_CHECKING, Any
 
 from harness.errors import ConfigError
@@ -374,10 +374,5 @@ class FoxgloveView:
     def __enter__(self) -> FoxgloveView:
         return self
 
-    def __exit__(
-        self,
-        kind: type[BaseException] | None,
-        error: BaseException | None,
-        traceback: TracebackType | None,
-    ) -> None:
+    def __exit__(self, *exc: object) -> None:
         self.close()

@@ -30,7 +30,6 @@ import sys
 import termios
 import time
 from collections.abc import Callable
-from types import TracebackType
 
 from harness.errors import ConfigError
 
@@ -174,12 +173,7 @@ class KeyReader:
         self._saved = saved
         return self
 
-    def __exit__(
-        self,
-        kind: type[BaseException] | None,
-        error: BaseException | None,
-        traceback: TracebackType | None,
-    ) -> None:
+    def __exit__(self, *exc: object) -> None:
         saved, self._saved = self._saved, None
         try:
             termios.tcsetattr(self.fd, termios.TCSADRAIN, saved)

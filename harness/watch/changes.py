@@ -18,7 +18,6 @@ import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from types import TracebackType
 
 from harness.errors import HarnessError, one_line
 from harness.watch.sources import Watched
@@ -82,12 +81,7 @@ class ChangeFeed:
         self._raise_failure()
         return self
 
-    def __exit__(
-        self,
-        exc_type: type[BaseException] | None,
-        exc: BaseException | None,
-        tb: TracebackType | None,
-    ) -> None:
+    def __exit__(self, *exc: object) -> None:
         self._stop.set()
         deadline = time.monotonic() + STOP_WAIT_S
         for thread in self._threads:
