@@ -12,6 +12,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from harness.option_names import worded
 from harness.serial_line.stats import ServerStats
 
 SCAN_REQUESTS = ("SCAN", "FORCE_SCAN", "EXPRESS_SCAN")
@@ -19,8 +20,8 @@ SCAN_REQUESTS = ("SCAN", "FORCE_SCAN", "EXPRESS_SCAN")
 _LACKS = ("unknown_command", "unknown_conf", "unsupported_mode")
 # A client at the other emulated LIDAR's rate most likely is that LIDAR's driver.
 _OTHER_DEVICE_AT: dict[int | None, tuple[str, str]] = {
-    230400: ("an LD06/LD19", "emulate ldlidar, --link ldlidar"),
-    115200: ("an RPLIDAR A1", "emulate rplidar, --link rplidar"),
+    230400: ("an LD06/LD19", "emulate ldlidar, {link} ldlidar"),
+    115200: ("an RPLIDAR A1", "emulate rplidar, {link} rplidar"),
 }
 
 
@@ -74,7 +75,7 @@ def _likely(stats: ServerStats, port: str, baudrate: int, streams_unasked: bool)
             return (
                 f"the client's line is at {rate} baud, the device's at {baudrate}; {rate} is "
                 f"{other[0]}'s rate: a driver for {other[0]}? use its own device type "
-                f"({other[1]}), or set the driver's baud rate to {baudrate}"
+                f"({worded(other[1])}), or set the driver's baud rate to {baudrate}"
             )
         return (
             f"the client's line is at {rate or 'another'} baud, the device's at "

@@ -21,6 +21,7 @@ from dataclasses import dataclass
 from typing import Literal
 
 from harness.errors import ConfigError, LinkError, one_line
+from harness.option_names import named
 from harness.serial_line.modem_lines import ModemLines, client_environment, shell_exports
 from harness.serial_line.port_lock import DEFAULT_WAIT_S, PortLock, hold_port
 
@@ -295,13 +296,12 @@ class SerialPort(DevicePort):
         *,
         dtr_input: Literal["dsr", "cts"] = "dsr",
         write_timeout: float = 0.5,
-        option: str = "--port",
         lock_wait: float = DEFAULT_WAIT_S,
     ) -> None:
         import serial  # the optional part: only a named port needs pyserial
 
         self.name = path
-        self._label = f"{option} {path}"
+        self._label = f"{named('port')} {path}"  # "--port /dev/ttyUSB0" in the CLI
         self._serial_exc: tuple[type[BaseException], ...] = (serial.SerialException, OSError)
         self._timeout_exc = serial.SerialTimeoutException
         if dtr_input not in ("dsr", "cts"):
