@@ -38,6 +38,7 @@ from harness.safe_text import clip, shown, visible
 from harness.scenario.footprint import Outline, disc, robot_outlines
 from harness.scenario.model_files import find_model_file, parse_xml, robot_models_dir
 from harness.scenario.schema import Model, Scenario
+from harness.scenario.urdf_chain import chain_to_root, joint_origin, joints_by_child
 
 if TYPE_CHECKING:
     from matplotlib.animation import AbstractMovieWriter
@@ -83,36 +84,15 @@ def frame_indices(count: int, failed: Sequence[int] = (), limit: int = MAX_FRAME
     return sorted(picks)
 
 
-def _planar_origin(joint: ET.Element) -> tuple[float, float, float]:
-    """A URDF joint's origin seen from above: x, y and yaw."""
-    origin = joint.find("origin")
-    xyz = (origin.get("xyz") if origin is not None else None) or "0 0 0"
-    rpy = (origin.get("rpy") if origin is not None else None) or "0 0 0"
-    (x, y, _), (_, _, yaw) = (tuple(float(v) for v in text.split()) for text in (xyz, rpy))
-    return x, y, yaw
-
-
 def _mount(root: ET.Element, link: str) -> tuple[float, float, float]:
-    """Where `link` sits in the URDF's root frame, seen from above (x, y, yaw).
-
-    Composes the joints on the way up to the root (roll and pitch left out:
-    a scanning LIDAR stands upright; a moving joint at its zero position).
-    """
-    joint_of = {}
-    for joint in root.findall("joint"):
-        child = joint.find("child")
-        if child is not None:
-            joint_of[child.get("link", "")] = joint
+    """Where `link` sits in the URDF's root frame, seen from above (x, y, yaw): roll and
+    pitch left out, as a scanning LIDAR stands upright; moving joints at zero."""
+    joints = joints_by_child(root)
     x = y = yaw = 0.0
-    for _ in range(len(joint_of)):  # a tree: one joint per link on the way up
-        joint = joint_of.get(link)
-        if joint is None:
-            break
-        ox, oy, oyaw = _planar_origin(joint)
+    for child in chain_to_root(joints, link)[:-1]:
+        (ox, oy, _), (_, _, oyaw) = joint_origin(joints[child])
         c, s = math.cos(oyaw), math.sin(oyaw)
         x, y, yaw = ox + c * x - s * y, oy + s * x + c * y, oyaw + yaw
-        parent = joint.find("parent")
-        link = parent.get("link", "") if parent is not None else ""
     return x, y, yaw
 
 
@@ -425,7 +405,7 @@ def _gif_writer(fps: float) -> AbstractMovieWriter:
             self.palette.putpalette(_palette())
             self.images: list[Any] = []
 
-        def grab_frame(self, **savefig_kwargs: Any) -> None:
+        def grab_frame(self, **_: Any) -> None:
             rgba = self.fig.canvas.buffer_rgba()
             frame = Image.frombuffer("RGBA", self.frame_size, rgba, "raw", "RGBA", 0, 1)
             rgb = frame.convert("RGB")

@@ -163,9 +163,6 @@ class Comparison:
     notes: tuple[str, ...]
     changes: tuple[Change, ...]
 
-    def of_kind(self, kind: str) -> list[Change]:
-        return [c for c in self.changes if c.kind == kind]
-
     @property
     def counts(self) -> dict[str, int]:
         tally = Counter(c.kind for c in self.changes)
