@@ -3,7 +3,7 @@
 pybullet's C code prints "pybullet build time: ..." through C stdio when it
 loads and again on every connect; it sits in C's buffer and surfaces at exit,
 in the middle of a report or of a tool reading our stdout. Both are swallowed
-here by pointing file descriptor 1 at /dev/null and flushing C stdio.
+here by pointing file descriptors 1 and 2 at a temporary file and flushing C stdio.
 """
 
 from __future__ import annotations
@@ -16,27 +16,6 @@ import tempfile
 from collections.abc import Iterator
 
 _LIBC = ctypes.CDLL(None)
-
-
-@contextlib.contextmanager
-def _stdout_silenced() -> Iterator[None]:
-    """Point fds 1 and 2 at /dev/null (the banner's stream varies with buffering)."""
-    sys.stdout.flush()
-    sys.stderr.flush()
-    _LIBC.fflush(None)
-    saved = {fd: os.dup(fd) for fd in (1, 2)}
-    try:
-        with open(os.devnull, "wb") as devnull:
-            for fd in saved:
-                os.dup2(devnull.fileno(), fd)
-            try:
-                yield
-            finally:
-                _LIBC.fflush(None)
-    finally:
-        for fd, copy in saved.items():
-            os.dup2(copy, fd)
-            os.close(copy)
 
 
 @contextlib.contextmanager
@@ -78,7 +57,7 @@ def last_complaint(lines: list[str]) -> str:
     return ""
 
 
-with _stdout_silenced():
+with captured_output():  # the banner, thrown away
     import pybullet as pb
 
 
@@ -94,7 +73,7 @@ def connect(gui: bool = False) -> int:
     """
     if not gui and _SPARE:
         return _SPARE.pop()
-    with _stdout_silenced():
+    with captured_output():
         return pb.connect(pb.GUI if gui else pb.DIRECT)
 
 
