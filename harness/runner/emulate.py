@@ -26,9 +26,11 @@ import numpy as np
 
 from harness.devices.profiles import DeviceProfile
 from harness.errors import ConfigError, Interrupted
-from harness.faults.link import LINE_KINDS, LinkFaults, scan_periods
+from harness.faults.link import LINE_KINDS, LineDamage, LinkFaults
 from harness.lidar.mount import FORWARD, LidarMount
-from harness.runner.settings import RunSettings, effective_seed, fault_profile
+from harness.links.base import LinkOptions
+from harness.runner.plan import plan_one
+from harness.runner.settings import RunSettings
 from harness.scenario.schema import Scenario
 
 IDLE_WAIT_S = 5.0  # after the last revolution: let the line drain
@@ -213,17 +215,11 @@ def emulate(
     from harness.sim.simulation import Simulation
 
     spec = scenario.lidar_spec
-    faults = fault_profile(scenario, settings)  # a mistake here opens nothing
-    seed = effective_seed(scenario, settings)
-    check_device_faults(faults.link)
-    drift = faults.link.get("rate_drift")
+    plan = plan_one(scenario, profile.name, LinkOptions(), settings)  # a mistake opens nothing
+    check_device_faults(plan.profile.link)
     started = time.monotonic()
     log = _Log(announce, started, verbose)
-    damage = None
-    if faults.link.on_line:
-        from harness.faults.link import LineDamage
-
-        damage = LineDamage(faults.link, seed)
+    damage = LineDamage(plan.profile.link, plan.seed) if plan.profile.link.on_line else None
     device = profile.make_device(spec.rate_hz)
     device_line = open_device_line(
         device,
@@ -235,10 +231,9 @@ def emulate(
         damage=damage,
     )
     line, server, name = device_line.port, device_line.server, device_line.name
-    rng = np.random.default_rng(seed)
+    rng = np.random.default_rng(plan.seed)
     revolutions = 0
     stopped_by: str | None = None
-    periods = scan_periods(drift, spec.rate_hz, seed) if drift is not None else None
     try:
         announce(f"port: {name}")  # from here on, a stop is a normal end
         if isinstance(line, PtyPort):
@@ -248,7 +243,7 @@ def emulate(
         # which would swallow what the server thread logs meanwhile.
         with Simulation(scenario) as sim, server:
             status_due = started + status_every_s
-            for tick in sim.ticks(periods):
+            for tick in sim.ticks(plan.periods()):
                 due = started + tick.t
                 while (left := due - time.monotonic()) > 0:
                     time.sleep(min(left, 0.05))  # pacing the scenario clock, not syncing
@@ -256,7 +251,7 @@ def emulate(
                     if time.monotonic() >= status_due:
                         log.line(status_line(server.stats()))
                         status_due += status_every_s
-                scan = faults.emit(tick.truth, spec, rng, stamp=tick.t)
+                scan = plan.profile.emit(tick.truth, spec, rng, stamp=tick.t)
                 samples = profile.revolution(
                     device, scan, 1.0 / tick.period, spec.range_max, mount=mount
                 )

@@ -11,10 +11,11 @@ step reads the same values.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, replace
 
 from harness.errors import ConfigError
+from harness.faults.link import scan_periods
 from harness.faults.sensor import FaultProfile
 from harness.judge.oracle import Oracle
 from harness.judge.records import RunResult
@@ -44,6 +45,11 @@ class RunPlan:
     @property
     def threshold(self) -> float:
         return self.options.threshold
+
+    def periods(self) -> Iterator[float] | None:
+        """Seconds between scans where the fault profile drifts the rate, else None."""
+        drift = self.profile.link.get("rate_drift")
+        return scan_periods(drift, self.scenario.lidar_spec.rate_hz, self.seed) if drift else None
 
     def oracle(self) -> Oracle:
         """The oracle this run's ticks are judged by."""

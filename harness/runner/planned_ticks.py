@@ -9,8 +9,9 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
-from harness.faults.link import scan_periods
-from harness.runner.settings import RunSettings, effective_seed, fault_profile
+from harness.links.base import LinkOptions
+from harness.runner.plan import plan_one
+from harness.runner.settings import RunSettings
 from harness.scenario.schema import Scenario
 
 __all__ = ["planned_ticks"]
@@ -22,9 +23,7 @@ def planned_ticks(scenarios: Sequence[Scenario], settings: RunSettings) -> dict[
 
     counts: dict[str, int] = {}
     for scenario in scenarios:
-        drift = fault_profile(scenario, settings).link.get("rate_drift")
-        seed = effective_seed(scenario, settings)
-        periods = scan_periods(drift, scenario.lidar_spec.rate_hz, seed) if drift else None
+        plan = plan_one(scenario, "", LinkOptions(), settings)  # no link: the ticks are its own
         with Simulation(scenario) as sim:
-            counts[scenario.name] = sum(1 for _ in sim.ticks(periods))
+            counts[scenario.name] = sum(1 for _ in sim.ticks(plan.periods()))
     return counts

@@ -14,7 +14,6 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from harness.errors import ConfigError, LinkError, NeverReady
-from harness.faults.link import scan_periods
 from harness.faults.sensor import FaultProfile
 from harness.judge.records import RunResult, TickRecord
 from harness.lidar.mount import FORWARD
@@ -52,15 +51,14 @@ def run_scenario(
         check_link_faults(profile.link, link)
     except ConfigError as err:
         raise ConfigError(f"{faults_origin(scenario, settings)}: {err}") from None
-    drift = profile.link.get("rate_drift")
-    periods = scan_periods(drift, scenario.lidar_spec.rate_hz, plan.seed) if drift else None
+    periods = plan.periods()
     try:
         with Simulation(scenario, gui=settings.gui) as sim:
             opening = time.perf_counter()
             link.open()
             result.startup_s = time.perf_counter() - opening
             frames = (
-                Frame(s.tick, s.t, s.x, s.y, s.yaw, _emit(profile, s, sim.spec, rng, bool(drift)))
+                Frame(s.tick, s.t, s.x, s.y, s.yaw, _emit(profile, s, sim.spec, rng))
                 for s in sim.ticks(periods)
             )
             judge_frames(
@@ -82,11 +80,10 @@ def _emit(
     tick: SimTick,
     spec: LidarSpec,
     rng: np.random.Generator,
-    drifting: bool,
 ) -> Scan:
     """The scan a driver publishes for one tick; a drifting rate also sets its timing fields."""
     scan = profile.emit(tick.truth, spec, rng, stamp=tick.t)
-    if drifting:
+    if profile.link.get("rate_drift") is not None:
         scan = replace(scan, scan_time=tick.period, time_increment=tick.period / spec.samples)
     return scan
 
