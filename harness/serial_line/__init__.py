@@ -1,15 +1,9 @@
 """The serial line to the board: ports, real-time pacing, and the device server.
 
 ``ports`` gives a pty pair (the virtual board) or a named USB-UART (real
-HIL), which ``port_lock`` lets one run use at a time; ``modem_lines``
-carries a pyserial client's DTR and RTS to a pty, which has none (its
-``modem_shim`` folder goes on the client's PYTHONPATH); ``server`` runs an
-emulated LIDAR from ``harness.devices`` on a port in one thread, composed
-of one part per role: ``stream_policy`` (what goes out next; pure),
-``line_watch`` (DTR, the client, its baud), ``host_bytes`` (requests in),
-``line_writer`` with ``pacing`` (bytes out at the line rate that ptys
-ignore), ``pushes`` (the harness's side) and ``stats`` (the counts, read by
-``diagnosis``). ``device_line`` opens a device's whole line at once.
+HIL), one run at a time (``port_lock``); ``server`` runs an emulated LIDAR
+on it in one thread, one module per role (docs/architecture.md lists them);
+``device_line`` opens a device's whole line at once.
 """
 
 from harness import lazy_exports

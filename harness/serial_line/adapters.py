@@ -1,10 +1,8 @@
 """What a serial port likely is, and whether this user may open it.
 
-`fossbot-hil ports` lists adapters by device path, which says little on a
-bench with two of them plugged in. The USB vendor:product id tells the
-chip (the A1M8's own adapter board is a Silicon Labs CP2102), and a port
-this user may not open is the first hour's most common failure: both are
-said per port, with the fix.
+A device path says little on a bench with two adapters plugged in: the USB
+id tells the chip (the A1M8's board is a CP2102), and a port this user may
+not open is the first hour's most common failure; both are said with the fix.
 """
 
 from __future__ import annotations

@@ -1,11 +1,9 @@
 """Open an emulated LIDAR's whole line at once: its port and the server that runs it.
 
-`fossbot-hil emulate` and the serial links' board session both put a device
-on a line: a named USB-UART (opened only when named) or a pty pair standing
-in for the cable, and one ``DeviceServer`` on it. ``open_device_line`` is
-that one step for both, so they cannot drift apart; the server is returned
-unstarted (``emulate`` builds its simulation before the server thread may
-log) and each caller closes the server, then the port, in its own order.
+`emulate` and the board session both put a device on a USB-UART (only when
+named) or a pty pair: one function, so they cannot drift apart. The server
+comes back unstarted (``emulate`` builds its simulation first) and each
+caller closes the server, then the port.
 """
 
 from __future__ import annotations

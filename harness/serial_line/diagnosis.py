@@ -1,11 +1,9 @@
 """Why a serial line did not work: what was sent, what came back, the likely cause.
 
-On a bench the usual failures look alike from the far end ("the board
-publishes no /scan"), but the line tells them apart: nothing opened the
-port, the board never asked, it asked at the wrong baud, it asked for
-what the device lacks, the motor line is off, or the bytes go the wrong
-way. ``diagnose`` reads a server's counters and says which; `emulate`'s
-summary and the HIL link's errors both print it. Pure: counters in, text out.
+From the far end the usual failures look alike ("the board publishes no
+/scan"); the line's counters tell them apart (nothing opened the port, no
+request, wrong baud, a request the device lacks, motor off, crossed wires).
+Pure: counters in, text out.
 """
 
 from __future__ import annotations

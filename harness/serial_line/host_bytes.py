@@ -1,10 +1,8 @@
 """The host's bytes into the device, and the device's timed events that follow them.
 
-A request may arrive in pieces: the line quiet for ``request_gap_s`` in
-the middle of one ends it (``drop_partial_request``). A RESET reboots the
-core, which prints its banner ``reset_s`` later (``finish_reset``). The
-device's immediate replies go to the writer; a scan that started or ended
-makes the queued stream stale (``StreamPolicy.device_changed``).
+A request cut by ``request_gap_s`` of quiet is dropped; a RESET's banner
+comes ``reset_s`` later; a scan that started or ended makes the queued
+stream stale (``StreamPolicy.device_changed``).
 """
 
 from __future__ import annotations

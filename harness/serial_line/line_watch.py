@@ -1,12 +1,9 @@
 """The line around the bytes: the board's DTR (the motor), the client, its baud rate.
 
-A pty tells whether a client has it open and, through the termios it
-shares, the baud rate the client set; a USB-UART tells neither, but carries
-the board's DTR on DSR or CTS. ``LineWatch`` polls the port for those (the
-server thread calls it every few milliseconds and before handing host bytes
-to the device, so a DTR set before a request is seen first, as on a wire),
-turns a DTR change into the device's motor, and tells each change as a
-``LineEvent``: what `emulate -v` prints and ``diagnosis`` counts.
+A pty shows whether a client has it open and the baud it set (shared
+termios); a USB-UART shows neither but carries DTR on DSR or CTS. Polled
+before host bytes reach the device, so a DTR set before a request is seen
+first, as on a wire; each change is a ``LineEvent`` (`emulate -v`, ``diagnosis``).
 """
 
 from __future__ import annotations

@@ -1,11 +1,7 @@
 """Put the device's bytes on the port: its replies first, then the stream.
 
-In lockstep the bytes go as fast as the board takes them (a few large
-writes between looks at the host); in realtime a ``LinePacer`` says how
-many may go now, and line time passes whether the port took them or not:
-what it did not take is lost, as on a UART whose receiver is not reading
-(``overrun_bytes``). Each stream write tells the ``StreamPolicy`` what left,
-which says when a revolution went out whole.
+In realtime line time passes whether the port took the bytes or not: what
+it did not take is lost, as on a UART nobody reads (``overrun_bytes``).
 """
 
 from __future__ import annotations
@@ -22,11 +18,7 @@ __all__ = ["LineWriter"]
 
 
 class LineWriter:
-    """Writes `policy`'s stream and the device's replies to `port` (one thread calls it).
-
-    `lock` guards the pacer and the finished revolutions, which the harness
-    thread reads.
-    """
+    """Writes `policy`'s stream and the device's replies; `lock` guards what the harness reads."""
 
     def __init__(
         self,

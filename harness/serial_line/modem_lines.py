@@ -1,16 +1,11 @@
 """A pty's modem lines, as the client's pyserial sets them through the modem shim.
 
-A pty has no DTR or RTS, yet the RPLIDAR clients drive the A1's motor with
-DTR. ``modem_shim/sitecustomize.py``, on the client's PYTHONPATH, makes
-pyserial's DTR/RTS calls on a listed port succeed and sends each change
-here as one datagram (b"DTR 1"); ``ModemLines`` receives them.
-``client_environment`` is what a client process needs for that, and
-``shell_exports`` the same as a line to paste into a shell. Pure stdlib:
-no pyserial here (the client's pyserial is patched, not ours).
+A pty has no DTR or RTS, yet RPLIDAR clients drive the A1's motor with DTR:
+``modem_shim/sitecustomize.py`` on the client's PYTHONPATH makes those
+calls succeed and sends each change here as a datagram (b"DTR 1").
 
-The variable, ``FOSSBOT_HIL_MODEM_LINES``: ``PORT=SOCKET`` items separated
-by ``os.pathsep`` (":"), e.g. ``/dev/pts/3=/tmp/fossbot-hil-modem-x/lines``;
-``PORT`` is the port's real path; ``PORT`` alone (no socket) lets the calls
+``FOSSBOT_HIL_MODEM_LINES``: ``PORT=SOCKET`` items separated by
+``os.pathsep``, ``PORT`` the port's real path; ``PORT`` alone lets the calls
 succeed and go nowhere. The first item naming a port counts.
 """
 
@@ -59,10 +54,8 @@ def _remove_folder(folder: str, owner: int) -> None:
 class ModemLines:
     """The client's DTR and RTS: each None until the client first set it.
 
-    A bound, non-blocking datagram socket in a private (0700) temporary
-    folder: only this user's processes can reach it, and ``poll`` never
-    waits. Datagrams queue in the kernel (a few, `net.unix.max_dgram_qlen`)
-    until ``poll`` drains them; one sent to a full queue is lost.
+    A non-blocking datagram socket in a private (0700) folder: only this user
+    can reach it and ``poll`` never waits; a datagram sent to a full queue is lost.
     """
 
     def __init__(self) -> None:
@@ -143,11 +136,9 @@ def _first(item: str, existing: str | None) -> str:
 def client_environment(
     port_path: str, channel: str | None, environ: Mapping[str, str] | None = None
 ) -> dict[str, str]:
-    """The variables a client process needs so that its pyserial's modem-line calls
-    on `port_path` succeed and reach `channel`: merge them into its environment.
+    """The variables a client needs for its modem-line calls on `port_path` to reach `channel`.
 
-    The shim's folder goes first on PYTHONPATH, the existing path kept; the
-    port's item goes first in the listing, other ports' items kept.
+    The shim's folder and the port's item go first; what was there is kept.
     """
     environ = os.environ if environ is None else environ
     return {

@@ -1,11 +1,8 @@
 """Pace bytes at a serial line's real rate, and measure how well that went.
 
-Linux ptys ignore the baud rate (tens of MB/s at "115200"), so a real-time
-emulation has to pace itself: a byte takes ``bits_per_byte / baudrate``
-seconds (10 bits for 8N1). Due times come from the start of a burst plus
-the bytes sent since, never from "now + chunk time", so sleep overshoot does
-not accumulate into a slower line. The class is pure timing: the caller
-passes ``now`` in, which is how the tests drive it with a fake clock.
+Linux ptys ignore the baud rate, so real-time emulation paces itself. Due
+times count from the burst's start, never from "now", so sleep overshoot
+does not add up into a slower line. Pure timing: the caller passes ``now``.
 """
 
 from __future__ import annotations
@@ -37,12 +34,10 @@ def p99(values: list[float]) -> float:
 class LinePacer:
     """When the next bytes may go out on a line of `baudrate`, and how it went.
 
-    A burst is a stretch of back-to-back bytes. It starts when bytes are sent
-    with the line idle (or when the sender fell more than `max_lag_s` behind,
-    after which catching up would exceed the line rate); byte i of a burst is
-    due at ``start + i * byte_time``. Chunks are at most `chunk_s` of line
-    time (about 11 bytes at 115200), so the stream looks continuous to a
-    reader while the writer wakes about once a millisecond.
+    Byte i of a burst is due at ``start + i * byte_time``; a new burst starts on
+    an idle line or `max_lag_s` behind (catching up would beat the line rate).
+    Chunks of `chunk_s` keep the stream continuous while the writer wakes about
+    once a millisecond.
     """
 
     def __init__(
@@ -120,12 +115,7 @@ class LinePacer:
         self._burst_start = None
 
     def report(self, period_s: float | None = None) -> PacingReport:
-        """Achieved rate over busy stretches, and revolution-start jitter against `period_s`.
-
-        A burst's rate is the bytes before its last chunk over the time from
-        its first write to its last (the last chunk's own line time has not
-        passed when it is written).
-        """
+        """Achieved rate over busy stretches (up to each burst's last chunk), and start jitter."""
         busy_bytes = self._busy_bytes
         busy_time = self._busy_time
         if self._burst_start is not None:
@@ -158,11 +148,10 @@ HARDWARE_CHUNK_S = 0.02  # a real UART: offer 20 ms of line time per write
 def unpaced_chunks(
     baudrate: int, bits_per_byte: int = 10, *, paced_by_hardware: bool = False
 ) -> tuple[int, int]:
-    """Lockstep (no pacer): bytes per write, and bytes written before the host is read again.
+    """Lockstep: bytes per write, and per look at the host.
 
-    A pty takes what it is offered at once, so large chunks; a real UART
-    drains at its baud rate, so about 20 ms of line time a write, one write
-    between looks at the host (a request is answered within that).
+    A pty takes everything at once; a UART drains at its baud, so about 20 ms
+    of line time a write, so a request is answered within that.
     """
     if paced_by_hardware:
         chunk = max(16, int(baudrate / bits_per_byte * HARDWARE_CHUNK_S))

@@ -1,19 +1,10 @@
 """One run at a time per serial port, across threads, processes and pytest workers.
 
-Two runs driving one USB-UART would interleave their bytes and each judge
-the other's revolutions. So whoever opens a physical port first takes a
-lock named after it, and later runs wait their turn (bounded) or give up
-with a line saying who holds it.
-
-The lock is an exclusive ``flock`` on a file in the temp folder, not on the
-device: opening a tty has side effects (DTR toggles, some boards reset).
-The file is named after the device's real path, so ``/dev/serial/by-id/...``
-and ``/dev/ttyUSB0`` are one port. The kernel frees the lock when its holder
-dies, so a crashed run never leaves a port locked. Within one process the
-lock is re-entrant: the pytest plugin holds the port for a whole test and
-the link it runs takes it again when it opens the port. The lock and the
-record naming its holder are ``harness.holder_lock``'s, as for ROS domains
-and report folders.
+Two runs on one USB-UART would judge each other's revolutions. The lock is
+an exclusive ``flock`` on a temp file named after the device's real path
+(by-id and ttyUSB0 are one port), not on the device (opening a tty toggles
+DTR); the kernel frees it when its holder dies. Re-entrant within a process:
+the plugin holds the port for a test and its link takes it again.
 """
 
 from __future__ import annotations
@@ -57,11 +48,7 @@ class PortLock:
 
 
 def hold_port(device: str, wait: float = DEFAULT_WAIT_S, *, label: str | None = None) -> PortLock:
-    """Take `device`'s lock, waiting at most `wait` seconds for the run that holds it.
-
-    ConfigError after the wait names the holder; `label` (e.g. "--port
-    /dev/ttyUSB0") starts the message. Re-entrant within a process.
-    """
+    """Take `device`'s lock, waiting at most `wait` s; then a ConfigError naming the holder."""
     label = label or device
     path = _lock_file(device)
     try:

@@ -1,9 +1,8 @@
 """Byte pipes the emulated LIDAR talks through: a pty pair or a real USB-UART.
 
-Every read and write is bounded, so the server thread that owns a port can
-always notice its stop event. A port that breaks under us raises
-``LinkError`` with one line naming the port; a port that cannot be opened
-raises ``ConfigError`` (the user named it, the user must fix it).
+Every read and write is bounded, so the server thread always notices its
+stop; a port that breaks is a ``LinkError``, one that cannot be opened a
+``ConfigError`` (the user named it).
 """
 
 from __future__ import annotations
@@ -43,11 +42,7 @@ def _one_line(err: BaseException) -> str:
 
 
 class DevicePort(ABC):
-    """The device side of a serial line: what the emulated LIDAR reads and writes.
-
-    ``read`` and ``write`` never block longer than their timeout; ``wake``
-    (the read end of a pipe) lets another thread cut a read short.
-    """
+    """The device side of a serial line; `wake` (a pipe's read end) cuts a read short."""
 
     name: str
     #: True where the hardware sends at the baud rate (a write then takes line time).
@@ -87,22 +82,15 @@ class DevicePort(ABC):
 class PtyPort(DevicePort):
     """A pseudo-terminal: the harness holds the master, the board opens ``slave_path``.
 
-    The slave is set raw (8-bit clean, no echo, no CR/LF translation) before
-    its descriptor is closed; Linux keeps those settings for later openers
-    while the master lives. Nobody having the slave open shows as POLLHUP on
-    the master (reads give EIO): that is "no reader yet", not an error, and
-    bytes written then would only greet the next opener as stale input, so
-    ``write`` accepts nothing while there is no reader. Ptys ignore the baud
-    rate entirely.
+    The slave is set raw before it is closed (Linux keeps that for later
+    openers). No reader shows as POLLHUP (reads give EIO): not an error, and
+    ``write`` takes nothing then, or the bytes would greet the next opener as
+    stale input. Ptys ignore the baud rate.
 
-    A pty has no modem lines; a client's pyserial run with
-    ``client_environment()`` (the modem shim, see ``modem_lines``) sends its
-    DTR and RTS changes to this port's ``modem`` instead. ``dtr_asserted``
-    is the DTR it last set: None until a client set it (a client without
-    the shim, e.g. a C++ driver: the emulated motor simply runs), and
-    deasserted once that client closed the port, as a tty drops DTR on
-    close. ``on_modem_change(line, asserted)``, if set, is told each change
-    ("dtr" or "rts") on the thread that asks for ``dtr_asserted``.
+    A pty has no modem lines: a client run with ``client_environment()`` sends
+    its DTR and RTS to ``modem``. ``dtr_asserted`` is None until a client set
+    it (one without the shim: the motor simply runs) and deasserted once it
+    closed the port, as a tty does; ``on_modem_change(line, asserted)`` hears each.
     """
 
     def __init__(self, *, symlink: str | None = None) -> None:
@@ -213,11 +201,6 @@ class PtyPort(DevicePort):
         self._poll_modem()
         return self.modem.dtr if self.modem is not None else None
 
-    def rts_asserted(self) -> bool | None:
-        """The RTS the client last set through the modem shim; None until one did."""
-        self._poll_modem()
-        return self.modem.rts if self.modem is not None else None
-
     def _poll_modem(self) -> None:
         modem = self.modem
         if modem is None:
@@ -244,11 +227,9 @@ class PtyPort(DevicePort):
         return self.modem.path
 
     def host_baud(self) -> int | None:
-        """The rate the board's driver set on the slave (Linux shares a pty's termios).
+        """The baud the board's driver set (a pty shares its termios); None if not a standard one.
 
-        A pty carries bytes whatever the rate, so a driver set to the wrong
-        baud works here and fails on a real cable: this is how the emulator
-        can still tell. None for a rate outside the standard table.
+        A wrong baud works on a pty and fails on a cable: this is how the emulator tells.
         """
         try:
             speed = termios.tcgetattr(self.fileno())[5]
@@ -274,17 +255,11 @@ class PtyPort(DevicePort):
 class SerialPort(DevicePort):
     """A real USB-UART opened with pyserial, only because the user named it.
 
-    Wiring for HIL: board TX -> adapter RX, adapter TX -> board RX, GND, and
-    the board's DTR -> this adapter's DSR (or CTS, ``dtr_input="cts"``). The
-    A1's motor follows the board's DTR, which we can only see through one of
-    our inputs. The adapter itself transmits at the baud rate, so its bytes
-    are paced by hardware; a vanished adapter (read or write fails) becomes
-    ``LinkError`` at the next operation, which the server runs every few ms.
-
-    One run at a time: the port's lock (``port_lock``) is taken first,
-    waiting at most `lock_wait` s for a run that holds it, and the device is
-    opened exclusively, so a program outside the harness that holds it
-    (with an exclusive open) is refused too.
+    Wiring: board TX -> adapter RX, adapter TX -> board RX, GND, and the
+    board's DTR -> DSR (or CTS, ``dtr_input="cts"``): the A1's motor follows it.
+    The hardware paces the bytes; a vanished adapter is a ``LinkError`` at the
+    next operation. The port's lock is taken first (at most `lock_wait` s) and
+    the device opened exclusively, so an exclusive holder outside is refused too.
     """
 
     paced_by_hardware = True
@@ -390,11 +365,7 @@ class PortInfo:
     manufacturer: str | None = None
 
     def line(self) -> str:
-        """One row for the terminal: device, USB ids, description.
-
-        The serial number and description are the adapter's own strings:
-        shown through the sanitiser, like any text a device sends.
-        """
+        """One row for the terminal; the adapter's own strings go through the sanitiser."""
         from harness.safe_text import for_terminal
 
         ids = self.vid_pid or "-"

@@ -1,11 +1,8 @@
 """What the harness thread hands the server thread: pushed revolutions and idle requests.
 
-The harness pushes revolutions and, in a continuous run, asks for the idle
-stream between scenarios and for a whole start marker before the next
-push; the server thread takes them when its stream is empty. Both sides
-hold one lock while they touch this (the same lock guards the pacer and the
-revolutions sent). In realtime a push still waiting for its slot is replaced
-by a newer one: a real sensor reports the present.
+Both sides hold one lock here (it also guards the pacer and the revolutions
+sent). In realtime a push still waiting for its slot is replaced by a newer
+one: a real sensor reports the present.
 """
 
 from __future__ import annotations

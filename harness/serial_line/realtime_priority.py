@@ -1,16 +1,10 @@
 """Ask Linux to run the calling thread under SCHED_FIFO, where it is allowed.
 
-Real-time serial emulation paces each revolution to within a fraction of a
-millisecond, but an ordinary thread on a busy two-core machine can wait
-several milliseconds for a core: with two CPU hogs beside it, revolution
-starts came up to 10 ms late. A SCHED_FIFO thread runs as soon as it is
-woken. The priority is low among real-time ones (above every ordinary
-thread, below the kernel's real-time threads such as migration and the
-watchdog), and the threads that ask for it spend their time blocked in
-select, so they cannot starve the machine (Linux also caps real-time
-threads at 95 % of a core by default).
-
-Standard library only: the bench's line reader imports it at start.
+With two CPU hogs beside it an ordinary thread started revolutions up to
+10 ms late. The priority is the lowest real-time one and the threads that
+ask for it sit in select, so they cannot starve the machine (Linux also
+caps real-time threads at 95 % of a core). Standard library only: the
+bench's line reader imports it at start.
 """
 
 from __future__ import annotations

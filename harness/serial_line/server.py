@@ -1,18 +1,9 @@
 """Run an emulated LIDAR on a serial line, in one background thread.
 
-The harness thread hands over revolutions (``send_revolution``); the server
-thread answers host requests, follows DTR, encodes revolutions with the
-device and writes them, either as fast as the board takes them (lockstep)
-or at the line's real rate with revolutions on the sensor's period
-(realtime). The thread owns the device: nothing else may touch it while the
-server runs.
-
-One part per role: ``stream_policy`` (what goes out next; the marker and
-``continuous`` rules are told there), ``line_watch`` (DTR, the client, its
-baud), ``host_bytes`` (requests in), ``line_writer`` with ``pacing``,
-``pushes`` (the harness's side) and ``stats``. The device is any
-``harness.devices.protocol.LineDevice``. What stays here is the thread,
-the bounded waits, and errors carried from the thread to the caller.
+The thread owns the device: nothing else may touch it while the server
+runs. The roles are parts (``stream_policy``, ``line_watch``, ``host_bytes``,
+``line_writer``, ``pushes``); what stays here is the thread, the bounded
+waits, and errors carried from the thread to the caller.
 """
 
 from __future__ import annotations
@@ -53,8 +44,7 @@ def _drain(fd: int) -> None:
 class DeviceServer:
     """An emulated LIDAR `device` served on `port` by one background thread.
 
-    Call ``start()`` (or use ``with``). Errors in the thread (a vanished
-    port, a device bug) stop it; they are kept in ``error`` and raised as
+    An error in the thread stops it; it is kept in ``error`` and raised as
     ``LinkError`` by the next ``send_revolution``/``wait_idle``/``close``.
     """
 
@@ -200,12 +190,10 @@ class DeviceServer:
     def send_revolution(
         self, samples: Sequence[Any], tick: int, period_s: float | None = None
     ) -> int:
-        """Queue one revolution; it goes out on the server thread. Returns its id
-        (``delivery_of``).
+        """Queue one revolution; returns its id (``delivery_of``).
 
-        `period_s`: in real time, how long this revolution lasts before the
-        next is due (a drifting rate); default the server's period. In
-        continuous lockstep a push also ends the idle stream.
+        `period_s`: in real time, how long it lasts (a drifting rate); default the
+        server's. In continuous lockstep a push also ends the idle stream.
         """
         self._check()
         push_id = self.pushes.push(samples, tick, period_s or self.period_s)
@@ -215,12 +203,7 @@ class DeviceServer:
     def stream_idle(
         self, samples: Sequence[Any] | None = None, period_s: float | None = None
     ) -> None:
-        """Continuous: between scenarios, keep the device streaming until the next push.
-
-        `samples` replaces the revolution to stream (default: the last one
-        sent); in realtime it streams anyway once nothing new comes, in
-        lockstep it goes out every `period_s` (default: the last period).
-        """
+        """Continuous: keep streaming `samples` (default the last sent) until the next push."""
         if not self.continuous:
             raise RuntimeError("stream_idle needs a continuous server")
         self._check()
@@ -228,15 +211,11 @@ class DeviceServer:
         self._wake()
 
     def end_idle(self, timeout: float) -> RevolutionSent | None:
-        """Continuous lockstep: stop the idle stream before the next push; wait (at most
-        `timeout` s) until the revolution it was writing is out. Returns the last
-        repeat written since the last push (its driver scan comes before the
-        push's), or None.
+        """Continuous lockstep: stop the idle stream, wait (at most `timeout` s) for its
+        revolution to be out; returns the last repeat since the last push, or None.
 
-        The stream then ends on a whole start marker (one packet of an LD06's,
-        one node of an A1's), however many idle revolutions went out, so the
-        bytes of the pushes that follow do not depend on how long the idle
-        stream ran (same seed, same bytes, line damage included).
+        The stream ends on a whole start marker however many idle revolutions went
+        out, so the pushes that follow are the same bytes (same seed, same bytes).
         """
         self._check()
         if not self.pushes.end_idle():
@@ -278,9 +257,8 @@ class DeviceServer:
     def wait_until(self, predicate: Callable[[LineDevice], bool], timeout: float) -> bool:
         """Wait (at most `timeout` s) until `predicate(device)` holds, e.g. "scanning".
 
-        Re-checked whenever the server thread has handled host bytes or a
-        DTR change, and every 50 ms; reading device state from here is safe
-        for simple attributes (``mode``, ``motor_on``).
+        Re-checked after host bytes or a DTR change, and every 50 ms; simple
+        attributes (``mode``, ``motor_on``) are safe to read from here.
         """
         self._check()
         deadline = time.monotonic() + max(0.0, timeout)

@@ -1,10 +1,8 @@
 """What a device server counted: the running counts, and the snapshot callers read.
 
-The stream policy, the line watch and the writer each count their own part
-of a run into one ``ServerCounts``; ``snapshot`` joins those with the
-device's own counters into the ``ServerStats`` that `emulate`'s summary,
-the HIL link's errors and ``diagnosis`` read. ``RevolutionSent`` is when
-one revolution went out. Pure: no I/O, no threads.
+Each part counts into one ``ServerCounts``; ``snapshot`` joins them with the
+device's own counters into the ``ServerStats`` that `emulate`, the HIL link
+and ``diagnosis`` read. Pure.
 """
 
 from __future__ import annotations

@@ -1,66 +1,26 @@
 """What a LIDAR streams next, tick by tick: revolutions, start markers, repeats, idle.
 
-Pure: the server thread calls ``StreamPolicy`` with the time (``now``) and
-what the harness pushed, and takes the bytes it queued (``stream``); no
-thread, no port, no clock of its own, so the tests drive it with a fake
-clock and a real device codec. It owns the stream's bytes until they are
-written (``consumed``) and says when it next needs the thread
-(``next_action_at``).
+Pure: the server thread calls ``StreamPolicy`` with the time and what the
+harness pushed, and takes the bytes it queued (``stream``); no thread, port
+or clock of its own, so tests drive it with a fake clock and a real codec.
 
-The start of the next revolution (lockstep)
--------------------------------------------
-A LIDAR driver publishes revolution k only when the start of revolution k+1
-arrives (the RPLIDAR start flag; the LD06 angle wrap). In lockstep the
-harness sends k+1 only after the answers to k, so without help the run
-would deadlock. After every revolution the server therefore also writes a
-*start marker*: the start of a sweep, encoded by the device like the start
-of any revolution, at the first angles of the revolution just sent, every
-reading "no return" (distance 0, quality 0). Its size: one node for an
-RPLIDAR standard scan; for the LD06 the samples that complete the packet
-the encoder holds open (12 - N mod 12 for N-sample revolutions, or 12), so
-that the next revolution starts on a packet boundary and no packet mixes
-the marker's angles with the next sweep's (a host would interpolate such a
-packet across the whole circle; the vendor driver drops it). What happens
-when k+1 arrives is the ``next_start`` policy:
+Start markers: a driver publishes revolution k only when k+1 starts, and in
+lockstep the harness sends k+1 only after k's answers; so after every
+revolution a start marker (the sweep's first angles, no return, one RPLIDAR
+node or the rest of an LD06 packet) goes out, and ``next_start`` says whether
+k+1 is then sent whole (``"extra"``) or without the ``marker_samples`` the
+marker stood in for (``"replace"``): docs/serial.md, "The start of the next
+revolution", says which drivers need which. The bytes stay a pure function
+of the pushes. In realtime the marker goes out only on an underrun; express
+scans get none (no start flag).
 
-``"extra"`` (default): k+1 is sent whole; the marker is extra.
-    The `rplidar` package (the FOSSBot driver) yields k at the marker, keeps
-    no reading with quality 0 or distance 0, and drops the marker-only
-    "revolution" that k+1's start flag closes (it has no more than
-    ``min_len`` readings): it sees every revolution exactly as sent. A
-    driver that publishes every start-to-start stretch, however short (the
-    Slamtec SDK behind ``rplidar_ros``), would publish one extra near-empty
-    scan per revolution: use "replace" there. An LD06 driver's frame k+1
-    starts with the marker's no-return points, at the same angles as
-    k+1's first readings.
-``"replace"``: the marker stands in for the first ``marker_samples`` of
-    k+1, which are not sent. No extra revolutions in any driver, but those
-    readings are "no return": the link must apply the same change to the
-    scan it judges.
-
-Either way the byte stream is a pure function of the revolutions pushed:
-the marker goes out after every revolution whatever the timing. In
-realtime mode the next revolution normally follows on its own; the marker is
-sent only when the next revolution is late at its due time (an underrun),
-and the same policy applies when it comes. Express scans get no marker:
-their capsules carry no start flag and the encoder holds back a capsule
-until the next one starts, so in lockstep the end of each express
-revolution waits for the next push (use standard scans, or realtime).
-
-A device that never falls silent (``continuous``)
--------------------------------------------------
-A real device streams from its SCAN request until its STOP, whatever the
-host does; a driver may wait for bytes with no timeout (rplidar-roboticia
-does). With ``continuous`` the server does the same for a whole run of
-scenarios: in realtime, when the next revolution is late at its slot, the
-start marker goes out as above and, if nothing came within half a period,
-the last revolution goes out again (a *repeat*), and so on each period; in
-lockstep, revolutions go out as pushed while a scenario runs, and between
-scenarios (``stream_idle``, until the next push or ``end_idle``) the last
-revolution goes out again every period. ``stream_idle(samples)`` also sets
-what to stream before anything was pushed (an empty room, say). Repeats
-are marked in ``deliveries()``; a pushed revolution's delivery is found by
-the id ``send_revolution`` returned (``delivery_of``).
+``continuous``: a real device streams from SCAN to STOP whatever the host
+does, and a driver may wait for bytes with no timeout (rplidar-roboticia).
+So in realtime a late slot gets the marker and, if nothing came within half
+a period, the last revolution again (a *repeat*), each period; in lockstep,
+between scenarios (``stream_idle``, until the next push or ``end_idle``),
+the last revolution goes out every period. ``stream_idle(samples)`` sets
+what to stream before any push. Repeats are marked in ``deliveries()``.
 """
 
 from __future__ import annotations
