@@ -1,21 +1,15 @@
 """Is the board's /scan the robot's view, or that view turned and/or mirrored? (pure)
 
-On the serial links the board's own driver makes the scan the node reads.
-A driver set up for another mounting (``invert``, ``angle_offset_deg``), or
-a harness emulating the device with the wrong mount, shows every obstacle
-at another angle; the verdicts stay self-consistent, since the oracle judges
-the board's scan. The harness knows the truth of every revolution, so it
-fits the turn (and mirror) that carries the truth onto the board's scan over
-the whole run, and says what to change.
+On the serial links the board's own driver makes the scan, and a driver
+set up for another mounting shows every obstacle at another angle while
+the verdicts stay self-consistent (the oracle judges the board's scan).
+The harness knows each revolution's truth, so it fits the turn and mirror
+that carry the truth onto the board's scan over the run (docs/hil.md).
 
-Both scans go onto one grid of 1-degree bins by angle (the nearest valid
-reading per bin; valid = finite and within both scans' limits), and every
-turn x mirror is scored by the share of bins, valid in either scan, where
-both are valid and agree within 5 cm + 3 %. Bins where neither scan sees
-anything say nothing either way and are not counted.
-
-The board shows what the robot sees at scan angle ``phi`` at
-``(-phi if mirrored else phi) + rotation_deg``.
+Both scans go onto 1-degree bins (the nearest valid reading each); a turn x
+mirror scores the share of bins valid in either scan where both are valid
+and agree within 5 cm + 3 % (bins empty in both say nothing). The board
+shows the robot's view at ``phi`` at ``(-phi if mirrored else phi) + rotation_deg``.
 """
 
 from __future__ import annotations
@@ -167,12 +161,7 @@ def _grid(scan: Scan, lo: float, hi: float) -> np.ndarray:
 
 
 def _fill_holes(grid: np.ndarray) -> np.ndarray:
-    """A lone empty bin between two that agree takes their mean.
-
-    A board bins by floor on its own angles, so a beam near a bin's edge
-    lands in the next bin: one bin gets two beams and its neighbour none.
-    Such a hole is an artefact, not a gap in the world.
-    """
+    """A lone empty bin between two that agree takes their mean (floor binning's artefact)."""
     before, after = np.roll(grid, 1), np.roll(grid, -1)
     with np.errstate(invalid="ignore"):
         alike = np.abs(before - after) <= ABS_TOLERANCE_M + REL_TOLERANCE * np.fmin(before, after)
@@ -220,13 +209,11 @@ def _rotation(index: int) -> float:
 
 
 def _refined(row: np.ndarray, turn: int) -> float:
-    """The turn in degrees, to a whole degree, from the peak of one mirror's scores.
+    """The turn in degrees, from the peak of one mirror's scores.
 
-    A board that bins by floor shows every beam up to a bin early, so the
-    peak falls between two turns: its vertex (a parabola through the peak
-    and its neighbours) is the better estimate. A turn within a degree of a
-    round value (a multiple of 5 degrees, what a setting is made of) is that
-    value.
+    A board binning by floor shows each beam up to a bin early, so the peak
+    falls between two turns: a parabola's vertex is the better estimate, and a
+    turn within a degree of a multiple of 5 (what a setting is made of) is that.
     """
     before, peak, after = (float(row[(turn + d) % GRID]) for d in (-1, 0, 1))
     curve = before - 2.0 * peak + after
@@ -325,9 +312,8 @@ def run_pairs(results: Sequence[RunResult]) -> list[tuple[Scan, Scan]]:
 def run_alignment(results: Sequence[RunResult]) -> Alignment | None:
     """The fit over a whole run; None when no tick has a board scan (ros2, inprocess).
 
-    A revolution the board published late or split (``answers.earlier``) is
-    left out: which truth it showed is not known for sure. The mount is the
-    first one a result names (one device per run).
+    A revolution published late or split (``answers.earlier``) is left out: its
+    truth is not known for sure. One device per run: the first mount named.
     """
     mount = next((r.lidar_mount for r in results if r.lidar_mount is not None), None)
     return fit_alignment(run_pairs(results), mount=mount)

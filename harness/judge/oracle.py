@@ -1,19 +1,8 @@
 """Per-tick judgement of a node's answers against the scan it was sent (pure).
 
-The oracle looks only at the *emitted* scan, the one the node received, so
-the truth behind faults never leaks into a verdict. Rules (docs/oracle.md):
-
-* valid reading = finite and range_min <= r <= range_max (REP-117, compared
-  in float32 like ``Scan.valid_mask``); obstacle iff any valid reading;
-  distance = min valid; angle = angle_min + index * angle_increment of that
-  minimum (any beam holding exactly that minimum is right).
-* If the only valid readings sit exactly at range_max, a driver may mean
-  "no return" by them: "no obstacle" and "obstacle at range_max" both pass.
-* Warning True expected iff min valid < threshold; within ``band`` of the
-  threshold either answer passes.
-* Distance tolerance: half a unit in the last printed digit + float32
-  rounding. Angle tolerance: one angle_increment + half a printed unit, in
-  any wrap within [-2*pi, 2*pi] (degrees fail, with a hint).
+Only the *emitted* scan counts, the one the node received, so the truth
+behind faults never leaks into a verdict. The rules and tolerances are
+docs/oracle.md's ("What a correct node says", "Tolerances").
 """
 
 from __future__ import annotations
@@ -202,11 +191,9 @@ class Oracle:
     def angle_matches(claimed: float, truth: float, tol: float, decimals: int | None) -> bool:
         """Is `claimed` the angle `truth` (radians), in this or another standard wrap?
 
-        Accepted: within `tol` of truth, or of truth +- 2*pi as long as the
-        claim stays within [-2*pi, 2*pi] (covers [-pi, pi), [0, 2*pi),
-        [-2*pi, 0)). Arbitrary multiples of 2*pi are not accepted, and a claim
-        that matches truth in degrees fails before the other wraps are
-        tried: otherwise a node printing degrees would pass now and then.
+        Within `tol` of truth, or of truth +- 2*pi while the claim stays within
+        [-2*pi, 2*pi]. A claim matching truth in degrees fails first: otherwise a
+        node printing degrees would pass now and then.
         """
         if not math.isfinite(claimed):
             return False
@@ -223,9 +210,8 @@ class Oracle:
     ) -> Verdict:
         """Judge one tick; failures accumulate so one verdict names every problem.
 
-        `delivery` says how the link carried the scan: a dropped scan (or one
-        the line lost) expects no answer, and a duplicate, an out-of-order or
-        a stale one may go unanswered; an answer that does come must be right.
+        A dropped scan expects no answer; a duplicate, reordered or stale one
+        (`delivery`) may go unanswered; an answer that comes must be right.
         """
         exp = self.expect(scan)
         failures: list[str] = []

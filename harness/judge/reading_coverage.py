@@ -1,41 +1,21 @@
 """Reading coverage: which kinds of readings a suite's delivered scans carry (pure).
 
-Counted from the scans the node actually received (a TickRecord's ``scan``;
-a scan the link dropped or the serial line lost is not counted), not from
-what the scenario files describe, so an instructor sees what the suite
-really exercises. Validity is the oracle's (REP-117, float32 like
-``Scan.valid_mask``): finite and range_min <= r <= range_max.
+Counted from the scans the node received (a dropped or lost scan is not
+one), never from the scenario files, so an instructor sees what the suite
+really exercises; validity is the oracle's. Per scan:
 
-Per scan:
+* ``cases``: a reading of the case (``CASES``: nan, +-inf, zero where
+  invalid, below range_min, above range_max), ``beside_valid`` or
+  ``without_valid`` a valid reading in the same scan;
+* ``near_threshold``: its nearest valid return outside the oracle's band but
+  within ``NEAR_THRESHOLD_M`` of its edge, where a node that rounds before
+  comparing, or a threshold a few centimetres off, warns wrong;
+* ``angle_near_pi``: that return's angle within ``ANGLE_MARGIN_RAD`` of +-pi
+  in the scan's own wrap (the seam of the angle range);
+* ``angle_min_zero`` / ``angle_min_minus_pi``: the scan's angle_min.
 
-* ``cases``: the scan holds at least one reading of the case, counted
-  ``beside_valid`` when the scan also has a valid reading, ``without_valid``
-  when it has none. ``nan``; ``pos_inf``; ``neg_inf``; ``zero`` (exactly 0.0,
-  and invalid, i.e. range_min > 0); ``below_range_min`` (finite,
-  0 < r < range_min); ``above_range_max`` (finite, r > range_max).
-* ``near_threshold``: its nearest valid return lies outside the band in
-  which the oracle accepts either warning (``Oracle.band``: at least 5 mm,
-  three noise sigmas with noise), but no more than ``NEAR_THRESHOLD_M``
-  (0.1 m) beyond the band's edge, on either side: band < |d - threshold|
-  <= band + 0.1 m. There a node that rounds before comparing, or uses a
-  threshold a few centimetres off, gives the wrong warning.
-* ``angle_near_pi``: the angle of its nearest valid return (angle_min +
-  i * angle_increment, the first beam holding the minimum) lies within
-  ``ANGLE_MARGIN_RAD`` (0.2 rad) of +pi or -pi, in whatever wrap the scan
-  counts (3.1 in a 0..2pi scan counts): the seam of the angle range.
-* ``angle_min_zero`` / ``angle_min_minus_pi``: its angle_min is 0 / -pi
-  (within 1e-6 rad).
-
-Per run, in the order the node received the scans:
-
-* ``warning_clears``: how often a warning that was due (nearest valid
-  return below the threshold, outside the band) becomes not due (nearest
-  valid return at or beyond the threshold outside the band, or no valid
-  return) on a later scan; scans inside the band are skipped. This is the
-  event that shows a latched warning.
-
-``coverage_of`` sums a suite, ``coverage_by_scenario`` each scenario, and
-``gaps`` says, one line per missing item, what the suite never delivers.
+Per run, in order: ``warning_clears``, how often a due warning (outside the
+band) becomes not due on a later scan: what shows a latched warning.
 """
 
 from __future__ import annotations

@@ -75,10 +75,9 @@ class RunResult:
     def broken(self) -> bool:
         """The run ended early and no answer was judged wrong before it (a verdict of ERROR).
 
-        The tick at which a node died, a processing function raised or the
-        link broke fails for that reason alone; it is the break, not a wrong
-        answer. A node that runs but answers too late or not at all is judged
-        on that (FAIL): its speed decides its verdict, it does not break the run.
+        A node that died, a processing function that raised or a broken link is
+        the break, not a wrong answer; a node that answers too late or not at all
+        is judged on that (FAIL): its speed decides its verdict, not the run's.
         """
         return self.error is not None and all(
             r.answers.problem is not None and not r.answers.silent for r in self.failed_ticks

@@ -1,23 +1,9 @@
 """Hints drawn from a whole run, for mistakes no single tick reveals (pure).
 
-One tick says what was wrong ("expected warning False; got True"), not
-why; the run often can. Each hint below looks at every judged tick and
-names a mistake only when the whole run fits it:
-
-* one scan late: the failed ticks' answers are right for the scan before;
-* a status only when it changes: silent where its last status still held;
-* silent when nothing is in range: no status for any scan without a
-  valid return, though the others were answered;
-* a latched warning: True since tick N, never False again, after the
-  obstacle had gone;
-* a rounded distance: it warns as if its threshold were where a distance
-  rounded to 1 or 2 decimals crosses the threshold;
-* a hard-coded threshold: the distances at which it warned and did not
-  warn bracket another threshold than the one the harness passed;
-* only the first answer wrong.
-
-`run_hint` gives them in that order, joined; a node one scan late gets no
-threshold hint (its Bools are the scan before's, so they bracket nothing).
+One tick says what was wrong, not why; the run often can. Each hint names a
+mistake only when the whole run fits it (the table in docs/oracle.md, "Hints
+from the whole run"); `run_hint` gives them in that order, and a node one
+scan late gets no threshold hint (its Bools are the scan before's).
 """
 
 from __future__ import annotations

@@ -1,41 +1,12 @@
 """Read the free-text status a student node publishes (pure).
 
 Students word their status however they like ("Obstacle at 0.84 m, angle
-1.57 rad", "d=0.84,a=1.57", "No obstacle"). The oracle needs three things
-from it: is an obstacle claimed, at what distance (metres), at what angle
-(radians), and how many decimals were printed (for tolerances).
-
-Default rules, in order:
-
-0. A status printed as a structure -- JSON (``Infinity`` and ``NaN``
-   included), a Python dict or tuple (``inf``, ``nan``, ``np.float32(...)``),
-   ``key: value`` lines or pairs -- is read by its keys
-   (``structured_status``); the rules below read the rest, and a structure
-   none of whose keys say anything.
-1. A negative phrase ("no obstacle", "nothing", "clear", "free", "none
-   detected", "out of range", "obstacle: false", ...) means no obstacle is
-   claimed, whatever numbers follow. A negated negative ("not clear") is
-   not one.
-2. Numbers are read as written: ``1.2e-1``, ``-0.52``, ``.5``, ``0.842m``,
-   ``1.57rad``, Python float reprs, and ``inf``/``nan`` (any case, signed).
-   Digits glued to a word or path are not numbers (``LIDAR2``, ``/scan2``,
-   ``float32``, ``A1M8``), nor are version-like runs (``1.2.3``).
-   Units are never converted: the lab asks for metres and radians.
-3. No number at all means no obstacle claimed. ``inf`` and ``nan`` are
-   numbers: "Min distance: inf" claims an obstacle at inf m (the lab's own
-   pitfall, and wrong).
-4. Otherwise the distance is the first number and the angle the second --
-   unless labels say otherwise: a unit right after a number (``m``, ``cm``,
-   ``mm`` -> distance; ``rad``, ``deg``, ``°`` -> angle; ``s``, ``ms``,
-   ``Hz`` -> ignored) or a keyword just before it, since the previous
-   number (``distance``/``dist``/``range``/``d=``/``r=`` -> distance;
-   ``angle``/``theta``/``bearing``/``heading``/``a=`` -> angle;
-   ``index``/``beam``/``i=``/``time``/``t=`` -> ignored). A labelled
-   distance or angle wins over position; unlabelled numbers fill the rest
-   in order. A gap naming both a distance and an angle word labels nothing.
-
-A user regex with named groups ``distance`` and ``angle`` (and optionally
-``obstacle``) replaces all of this; see ``compile_status_pattern``.
+1.57 rad", "d=0.84,a=1.57", "No obstacle"); the oracle needs whether an
+obstacle is claimed, its distance and angle, and the printed precision (for
+tolerances). The default rules (a structure read by its keys first, then
+negative phrases, numbers as written, position unless labelled) are
+docs/oracle.md's "Reading the status"; a user regex with named groups
+replaces them (``compile_status_pattern``).
 """
 
 from __future__ import annotations

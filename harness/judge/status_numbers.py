@@ -1,11 +1,8 @@
 """Numbers in a student's status text, and what labels each (pure).
 
-A status says "Obstacle at 0.842m, angle -0.52rad", "d=1.2e-1", "min: inf".
-Reading it needs every number that stands on its own (not the "2" of
-"LIDAR2", nor "1.2.3"), how precisely it was printed (for tolerances), and
-whether a unit after it or a keyword before it says it is a distance, an
-angle, or something to ignore (an index, a time). ``status`` picks the
-claim from these; ``structured_status`` reads a key's number with them.
+Every number that stands on its own (not the "2" of "LIDAR2", nor "1.2.3"),
+its printed precision, and whether a unit after it or a keyword before it
+makes it a distance, an angle, or something to ignore.
 """
 
 from __future__ import annotations

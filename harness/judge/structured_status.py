@@ -1,21 +1,12 @@
 """What a status printed as JSON, a Python dict or ``key: value`` lines claims (pure).
 
-``structured_text`` takes such a status apart; here its keys say what each
-value is. A key names the obstacle flag (``obstacle``, ``detected``,
-``obstacle_detected``), the distance (``distance``, ``min``, ``range``,
-``min_distance``) or the angle (``angle``, ``bearing``, ``angle_rad``), in any
-case or spelling (``minDistance``); one naming an index, a time, a threshold
-or a maximum is not the claim (``range_max``, ``threshold``). Keys are
-explicit, so they beat position: ``obstacle: false`` claims no obstacle
-whatever distance follows (json's ``Infinity`` for "nothing in range"
-included), ``distance: null`` gives no distance though other numbers stand
-about, and numbers under keys that say nothing fill the distance and the
-angle in order, as unlabelled numbers do in free text. A structure none of
-whose keys mean anything here is left to the free-text rules.
-
-A flag that is neither true nor false ("obstacle: yes-ish"), or a distance
-or angle that is no number nor null, makes the status unreadable: the oracle
-says so, with a ``--status-regex`` that reads it the way its keys suggest.
+Keys are explicit, so they beat position: ``obstacle: false`` claims no
+obstacle whatever distance follows (json's ``Infinity`` included), and
+numbers under keys that say nothing fill the distance and angle in order.
+A structure none of whose keys mean anything is left to the free-text rules;
+a flag or value that cannot be read makes the status unreadable, with a
+``--status-regex`` that reads it the way its keys suggest. Which key means
+what: docs/oracle.md, "Structured statuses".
 """
 
 from __future__ import annotations

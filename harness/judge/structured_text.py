@@ -1,14 +1,9 @@
 """A status printed as a data structure, taken apart into keys and values (pure).
 
-Students print their status as JSON (``json.dumps``, whose "nothing in
-range" is ``Infinity``), as a Python dict (``str()`` of one gives
-``{'obstacle': False, 'distance': inf}``) or as ``key: value`` lines. The
-free-text rules misread these (the quotes around "obstacle" hide its
-"false"), so such a text is taken apart here by a real parser first:
-``json``; else Python's own parser (``ast``: the tree is walked, never
-evaluated, and ``inf``, ``nan``, ``true``, ``null``, ``np.float32(0.84)``
-are read as what they print); else ``key: value`` pairs, YAML-like. What
-the keys mean is ``structured_status``'s concern, not this module's.
+Free-text rules misread JSON and printed dicts (the quotes around
+"obstacle" hide its "false"), so a real parser goes first: ``json``; else
+Python's (``ast``: walked, never evaluated); else ``key: value`` pairs.
+What the keys mean is ``structured_status``'s concern.
 """
 
 from __future__ import annotations

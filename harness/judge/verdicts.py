@@ -1,9 +1,8 @@
 """A scenario run's one verdict, for every command and report (pure).
 
-`run`, `sweep`, `grade`, `audit`, `hunt`, the terminal table, JUnit, JSON
-and HTML all say PASS, FAIL, ERROR or NOT RUN of a run the same way: by
-``verdict_of`` (docs/contract.md says what each means). A verdict is a
-``str`` too, so tables and JSON written before read the same.
+Every command and report says PASS, FAIL, ERROR or NOT RUN by ``verdict_of``
+(docs/contract.md says what each means); a verdict is a ``str`` too, so
+tables and JSON written before read the same.
 """
 
 from __future__ import annotations
