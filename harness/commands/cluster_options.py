@@ -3,7 +3,11 @@
 from __future__ import annotations
 
 import argparse
-from typing import TYPE_CHECKING
+from collections.abc import Iterator
+from contextlib import contextmanager
+from typing import TYPE_CHECKING, Any
+
+from rich.console import Console
 
 from harness.cluster.client import WORKER_WAIT_S
 from harness.commands.arguments import (
@@ -13,7 +17,8 @@ from harness.commands.arguments import (
     positive,
     whole_number,
 )
-from harness.errors import ConfigError
+from harness.errors import ConfigError, HarnessError, one_line
+from harness.report.console_text import print_safe as say
 
 if TYPE_CHECKING:
     from harness.links.base import LinkOptions
@@ -22,6 +27,7 @@ if TYPE_CHECKING:
 workers = whole_number("workers", 1, 1_000)
 # What a worker that runs scenarios itself (sweep, hunt) imports before it is forked.
 WARM_WORKER = "harness.runner.warm_worker"
+KILLED = "the worker running it died every time it was tried"
 
 
 def add_cluster_options(parser: argparse.ArgumentParser, *, unit: str = "runs") -> None:
@@ -75,3 +81,37 @@ def checked_runs_options(args: argparse.Namespace, command: str) -> tuple[LinkOp
         status_pattern=args.status_regex, warning_when_clear=args.warning_when_clear
     )
     return options, judged
+
+
+@contextmanager
+def runs_client(args: argparse.Namespace, console: Console, task_module: str) -> Iterator[Any]:
+    """The Dask client a sweep's or hunt's runs go to (warm workers), its dashboard said."""
+    from harness.cluster.client import dashboard, open_client
+
+    with open_client(
+        args.scheduler,
+        args.workers,
+        worker_wait=args.worker_wait,
+        preload=(WARM_WORKER, task_module),
+    ) as client:
+        link = dashboard(client)
+        if link:
+            say(console, f"Dask dashboard: {link}")
+        yield client
+
+
+def run_result(future: Any, lost: str, then: str = "") -> Any | None:
+    """A run's result; None when Dask gave up on it (it killed its worker every time).
+
+    Any other loss (the scheduler went away) ends the command: the run is
+    not done, and the message says `lost` "was lost to the Dask cluster".
+    """
+    from distributed import KilledWorker
+
+    try:
+        return future.result()
+    except KilledWorker:
+        return None
+    except Exception as err:  # noqa: BLE001 - lost to the cluster, not to the node
+        why = f"{type(err).__name__}: {one_line(err)}"
+        raise HarnessError(f"{lost} was lost to the Dask cluster ({why}){then}") from None

@@ -25,10 +25,12 @@ from harness.commands.arguments import (
     whole_number,
 )
 from harness.commands.cluster_options import (
-    WARM_WORKER,
+    KILLED,
     add_cluster_options,
     checked_runs_options,
     describe_cluster,
+    run_result,
+    runs_client,
 )
 from harness.errors import ConfigError
 from harness.links.kinds import either, link_kind, link_names
@@ -183,7 +185,6 @@ def _search(
 ) -> Hunt:
     """The hunt on the cluster, with a progress bar of its search runs; runs.csv is
     rewritten after every batch, so an interrupted hunt keeps its runs."""
-    from harness.cluster.client import dashboard, open_client
     from harness.cluster.progress import add_task, task_progress
     from harness.hunt.search import hunt
     from harness.hunt.space import placed, robot_footprint
@@ -200,15 +201,7 @@ def _search(
             return None
         return candidate
 
-    with open_client(
-        args.scheduler,
-        args.workers,
-        worker_wait=args.worker_wait,
-        preload=(WARM_WORKER, "harness.hunt.task"),
-    ) as client:
-        link = dashboard(client)
-        if link:
-            say(console, f"Dask dashboard: {link}")
+    with runs_client(args, console, "harness.hunt.task") as client:
 
         def run_batch(candidates: list[Candidate]) -> list[Outcome]:
             return _run_on(client, candidates, plan.seed, args.link, options, judged)
@@ -233,9 +226,6 @@ def _run_on(
     judged: RunSettings,
 ) -> list[Outcome]:
     """Each candidate's outcome, in order; a run Dask gave up on is an outcome too."""
-    from distributed import KilledWorker
-
-    from harness.errors import HarnessError, one_line
     from harness.hunt.task import Outcome, run_candidate
 
     futures = [
@@ -244,16 +234,8 @@ def _run_on(
     ]
     outcomes = []
     for candidate, future in zip(candidates, futures, strict=True):
-        try:
-            outcomes.append(future.result())
-        except KilledWorker:
-            problem = "the worker running it died every time it was tried"
-            outcomes.append(Outcome(candidate, None, 0.0, problem))
-        except Exception as err:  # noqa: BLE001 - lost to the cluster, not to the node
-            raise HarnessError(
-                f"hunt stopped: a run was lost to the Dask cluster "
-                f"({type(err).__name__}: {one_line(err)})"
-            ) from None
+        outcome = run_result(future, "hunt stopped: a run")
+        outcomes.append(Outcome(candidate, None, 0.0, KILLED) if outcome is None else outcome)
     return outcomes
 
 
@@ -367,17 +349,11 @@ def _write_runs(out: Path, result: Hunt) -> None:
     if not rows:
         return
     buffer = io.StringIO()
-    writer = csv.DictWriter(buffer, fieldnames=_columns(rows), lineterminator="\n")
+    columns = list(dict.fromkeys(name for row in rows for name in row))
+    writer = csv.DictWriter(buffer, fieldnames=columns, lineterminator="\n")
     writer.writeheader()
     writer.writerows(rows)
     write_atomically(out / "runs.csv", buffer.getvalue().encode())
-
-
-def _columns(rows: list[dict[str, Any]]) -> list[str]:
-    names: dict[str, None] = {}
-    for row in rows:
-        names.update(dict.fromkeys(row))
-    return list(names)
 
 
 def _write_summary(

@@ -20,10 +20,12 @@ from harness.commands.arguments import (
     whole_number,
 )
 from harness.commands.cluster_options import (
-    WARM_WORKER,
+    KILLED,
     add_cluster_options,
     checked_runs_options,
     describe_cluster,
+    run_result,
+    runs_client,
 )
 from harness.errors import ConfigError
 from harness.judge.verdicts import RunVerdict
@@ -233,20 +235,11 @@ def _run_all(
     """
     from harness.campaign.results import ResultsTable
     from harness.campaign.task import run_one
-    from harness.cluster.client import dashboard, open_client
     from harness.cluster.progress import add_task, task_progress
     from harness.cluster.window import Window
 
-    with open_client(
-        args.scheduler,
-        args.workers,
-        worker_wait=args.worker_wait,
-        preload=(WARM_WORKER, "harness.campaign.task"),
-    ) as client:
+    with runs_client(args, console, "harness.campaign.task") as client:
         table = ResultsTable(path, resume=args.resume, columns=columns)
-        link = dashboard(client)
-        if link:
-            say(console, f"Dask dashboard: {link}")
 
         def submit(spec: RunSpec) -> Any:
             return client.submit(
@@ -266,31 +259,16 @@ def _run_all(
 
 
 def _row_of(future: Any, spec: RunSpec) -> dict[str, Any]:
-    """The run's row; a run Dask gave up on (it killed its worker every time) is a row too.
-
-    Any other loss (the scheduler went away) ends the sweep: the run is not
-    done, and --resume runs it.
-    """
-    from distributed import KilledWorker
-
-    from harness.errors import HarnessError, one_line
-
-    try:
-        return dict(future.result())
-    except KilledWorker:
-        failure = "could not run: the worker running it died every time it was tried"
-    except Exception as err:  # noqa: BLE001 - lost to the cluster, not to the node
-        raise HarnessError(
-            f"sweep stopped: run {spec.key} was lost to the Dask cluster "
-            f"({type(err).__name__}: {one_line(err)}); "
-            "--resume runs what is missing"
-        ) from None
+    """The run's row; a run Dask gave up on (it killed its worker every time) is a row too."""
+    done = run_result(future, f"sweep stopped: run {spec.key}", "; --resume runs what is missing")
+    if done is not None:
+        return dict(done)
     return {
         **spec.as_row(),
         "verdict": RunVerdict.ERROR.value,
         "ticks": 0,
         "failed_ticks": 0,
-        "first_failure": failure,
+        "first_failure": f"could not run: {KILLED}",
         "wall_s": 0.0,
         "worker": "",
     }
