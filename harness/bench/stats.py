@@ -6,9 +6,11 @@ place and testable in milliseconds.
 
 from __future__ import annotations
 
+import bisect
 import math
 from collections.abc import Sequence
-from itertools import pairwise
+from itertools import accumulate, pairwise
+from statistics import median
 
 __all__ = [
     "RPLIDAR_NODE_BYTES",
@@ -39,15 +41,6 @@ def percentile(values: Sequence[float], q: float) -> float:
         raise ValueError(f"q must be in (0, 100], got {q}")
     ordered = sorted(values)
     return ordered[max(0, math.ceil(q / 100.0 * len(ordered)) - 1)]
-
-
-def median(values: Sequence[float]) -> float:
-    """The middle value (the mean of the two middle ones for an even count)."""
-    if not values:
-        raise ValueError("median of no values")
-    ordered = sorted(values)
-    mid = len(ordered) // 2
-    return ordered[mid] if len(ordered) % 2 else (ordered[mid - 1] + ordered[mid]) / 2.0
 
 
 def overhead_ratio(scan_s: float, raycast_s: float, round_trip_s: float) -> float:
@@ -84,28 +77,19 @@ def rplidar_revolution_starts(data: bytes) -> list[int]:
     head = RPLIDAR_SCAN_DESCRIPTOR
     if not data.startswith(head):
         raise ValueError("the stream does not start with the RPLIDAR scan descriptor")
-    starts = []
-    for offset in range(len(head), len(data) - RPLIDAR_NODE_BYTES + 1, RPLIDAR_NODE_BYTES):
-        if data[offset] & 0b11 == 0b01:
-            starts.append(offset)
-    return starts
+    offsets = range(len(head), len(data) - RPLIDAR_NODE_BYTES + 1, RPLIDAR_NODE_BYTES)
+    return [offset for offset in offsets if data[offset] & 0b11 == 0b01]
 
 
 def read_times(reads: Sequence[tuple[float, int]], offsets: Sequence[int]) -> list[float]:
     """When the reader had each byte offset: the time of the read that brought it."""
+    totals = list(accumulate(n for _, n in reads))
     times = []
-    ends = []
-    total = 0
-    for t, n in reads:
-        total += n
-        ends.append((total, t))
-    k = 0
     for offset in offsets:
-        while k < len(ends) and ends[k][0] <= offset:
-            k += 1
-        if k == len(ends):
+        k = bisect.bisect_right(totals, offset)
+        if k == len(totals):
             break
-        times.append(ends[k][1])
+        times.append(reads[k][0])
     return times
 
 
@@ -120,11 +104,7 @@ def arrival_rate(
     over the time between those reads; idle gaps between stretches never
     count. None if no stretch had two reads.
     """
-    ends = []
-    total = 0
-    for t, n in reads:
-        total += n
-        ends.append((t, total))
+    ends = list(zip((t for t, _ in reads), accumulate(n for _, n in reads), strict=True))
     got_bytes = got_time = 0.0
     for lo, hi in segments:
         inside = [(t, e) for t, e in ends if lo < e < hi]
