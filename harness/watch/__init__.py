@@ -1,18 +1,8 @@
 """`fossbot-hil run --watch` and `--failed-first`: the edit-run loop.
 
-- ``order``: failed scenarios first, then the rest in their given order;
-- ``verdict_cache``: each run's verdicts per scenario, kept between
-  commands in the user's cache folder (what `--failed-first` reads);
-- ``changes``: the file watcher (watchfiles), in background threads, so a
-  change saved while a run goes is kept for the next;
-- ``rebuild``: ``colcon build`` of the package under test, bounded;
-- ``screen``: one compact screen that redraws on a terminal, plain lines
-  elsewhere;
-- ``loop``: run, wait for a change, (build,) run again, until Ctrl-C.
-
-- ``sources`` (pure): what to watch for a node (its script, a workspace
-  package's sources, a processor file, scenario files), and whether a change
-  needs a ``colcon build``.
+``sources`` (pure: what to watch, whether a change needs a build),
+``changes`` (the watcher), ``rebuild`` (colcon), ``verdict_cache`` and
+``order`` (failed first), ``screen``, and ``loop``, which joins them.
 """
 
 from harness import lazy_exports

@@ -1,16 +1,10 @@
 """The edit-run loop: run, wait for a change, build when needed, run again, until Ctrl-C.
 
-Each run puts the scenarios that failed in the run before first (the first
-run: those that failed when the command last ran, from the verdict cache),
-then the rest in their given order. A change saved during a run or a build
-is kept by the watcher and starts the next round as soon as this one ends.
-A build that fails skips the run: the next save builds again.
-
-A usage error in the first run ends the command (exit 2, as `run`); later
-ones (a scenario file saved half-edited, a script renamed away) are shown
-and the loop waits for the next save. Ctrl-C or SIGTERM ends the loop at
-any point: a run in progress reaps its nodes first (run_suite), a build is
-stopped (rebuild), the watchers stop, and the exit code is 130 or 143.
+What failed last runs first. A change saved during a run or a build starts
+the next round as soon as this one ends; a failed build skips the run. A
+usage error ends the first run (exit 2, as `run`); later ones (a scenario
+file saved half-edited) are shown and the loop waits for the next save.
+Ctrl-C or SIGTERM reaps a run's nodes or stops a build first (exit 130, 143).
 """
 
 from __future__ import annotations

@@ -1,17 +1,10 @@
 """What `run --watch` shows: one compact screen that redraws, or plain lines.
 
-On a terminal, a rich Live screen: what is watched, then one line per
-scenario (pending, running, PASS, FAIL with its first failure in one
-line), the footer ``N of M scenarios passed`` with the seconds since the
-change was seen, what the watch is doing (waiting, building), and the
-first failure in full. Each verdict is drawn as soon as it is judged.
-
-Anywhere else (a pipe, a file, a test) the same events as lines, each
-written and flushed when it happens, so a script reading the output sees
-``7 of 7 scenarios passed`` the moment it is known.
-
-Text from the node (its status, its stderr, a scenario's name) is shown as
-plain text, never markup, escaped and bounded (harness.safe_text).
+On a terminal, a rich Live screen: a row per scenario, drawn as soon as it
+is judged, the footer, what the watch does, the first failure in full.
+Anywhere else the same events as lines, each flushed when it happens, so a
+script sees ``7 of 7 scenarios passed`` the moment it is known. Text from
+the node is plain text, never markup, escaped and bounded (safe_text).
 """
 
 from __future__ import annotations
@@ -96,6 +89,9 @@ class WatchScreen:
         return self
 
     def __exit__(self, *exc: object) -> None:
+        self._stop_live()
+
+    def _stop_live(self) -> None:
         if self._live is not None:
             self._draw(force=True)
             self._live.stop()
@@ -203,10 +199,7 @@ class WatchScreen:
     def stopped(self, signal_name: str) -> None:
         """Ctrl-C or SIGTERM: the last line."""
         self._status = f"stopped by {signal_name}"
-        if self._live is not None:
-            self._draw(force=True)
-            self._live.stop()
-            self._live = None
+        self._stop_live()
         print_safe(self.console, self._status)
 
     # -- drawing --------------------------------------------------------------

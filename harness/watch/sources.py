@@ -1,25 +1,11 @@
 """Which files make up the node under test, and whether a change to them needs a build (pure).
 
-`run --watch` re-runs when these change. What the harness can know from the
-command line alone:
-
-- a Python script (``--node "python3 path/node.py ..."``, ``--node path/node.py``):
-  the script and the ``.py`` files beside it, which it may import (its folder
-  is watched, not the folders below it: a script in a home folder must not
-  cost a watch on every folder under it);
-- any other command whose program is a path to a file: that file;
-- ``--workspace W --package P``: the package's source folder (the folder under
-  W whose package.xml names P, as colcon finds it): its Python files,
-  setup.py, setup.cfg, package.xml and resource/. A workspace built with
-  ``--symlink-install`` runs its Python files where they are, so a change to
-  them needs no build; otherwise (and for setup.py, setup.cfg, package.xml
-  or resource/ in any case) ``colcon build --packages-select P`` must run
-  first, with the flags the workspace was built with;
-- ``--link inprocess --processor FILE.py:FUNCTION``: that file (it is loaded
-  anew for every scenario; a module it imports is not).
-
-Scenario files given by path are watched too. The bundled reference node is
-not the user's to edit: it brings nothing to watch. No rclpy here.
+Only what the command line tells: a script and the .py files beside it (not
+the folders below: a script in a home folder must not watch all of it), a
+program that is a file, a workspace package's sources (rebuilt with the
+workspace's own colcon flags unless ``--symlink-install`` runs them where
+they are), a processor file, scenario files given by path. The bundled
+node is not the user's to edit: nothing to watch.
 """
 
 from __future__ import annotations
@@ -53,12 +39,8 @@ def _hidden(name: str) -> bool:
 
 @dataclass(frozen=True)
 class Watched:
-    """A folder to watch and which of its files count.
-
-    Not `recursive`: the files directly in `folder` named in `names`, or
-    (when `suffixes` is given) any with one of those suffixes. `recursive`:
-    a package's source folder, under the package rules (`package_file`).
-    """
+    """A folder to watch and which of its files count: those directly in it named in
+    `names` or with one of `suffixes`, or, `recursive`, a package's (`package_file`)."""
 
     folder: Path
     recursive: bool = False

@@ -1,24 +1,12 @@
 """The last run's verdicts per scenario, for `run --failed-first` and `run --watch`.
 
-Every `run` leaves one small JSON file: scenario name -> "passed" or "failed".
-`--failed-first` (and the first run of `--watch`) reads it to put what
-failed first, as `pytest --ff` reads .pytest_cache.
-
-Where: in the user's cache folder (``$XDG_CACHE_HOME/fossbot-hil/last-run/``,
-by default ``~/.cache/fossbot-hil/last-run/``; ``$FOSSBOT_HIL_CACHE_DIR/last-run/``
-when that is set), one file per working folder
-and node under test, named by a hash of both. Not in the working folder as
-pytest does: the harness runs in a student's lab folder, often a git
-repository they hand in, or a folder they may not write; and not one file
-for all: the verdicts of another node (another ``--node``, package or
-workspace), or of the same command line run from another folder (whose
-relative paths name other files), say nothing of this one's. The newest
-files are kept (at most `KEPT_FILES`).
-
-The file only orders scenarios, never judges them: when it is missing,
-unreadable, of another format or written for another key, the scenarios
-run in their given order. It is written atomically (harness.atomic_write),
-so a run killed mid-write leaves the previous one.
+As `pytest --ff` reads .pytest_cache, but kept in the user's cache folder
+(harness.user_cache), not the working folder: that is often a student's
+repository they hand in, or not writable. One file per working folder and
+node under test (named by a hash of both): another node's verdicts, or the
+same command line's from another folder, say nothing of this one's. The
+file only orders scenarios, never judges them: a missing or unusable file
+means the given order.
 """
 
 from __future__ import annotations
