@@ -1,12 +1,8 @@
 """What a LIDAR is and what it emits (pure data).
 
-- ``spec``: geometry and timing (``LidarSpec``) and the presets of real
-  devices (``preset("rplidar_a1")``): add a new LIDAR here;
-- ``scan``: the emitted ``Scan``, exactly the fields of sensor_msgs/LaserScan;
-- ``mount``: where a device's own zero points on the robot (``LidarMount``).
-
-A LIDAR that also talks over a serial line needs its protocol in
-``harness.devices``.
+``spec`` (``LidarSpec`` and the real devices' presets: add a new LIDAR
+here), ``scan`` (the emitted ``Scan``), ``mount`` (where a device's zero
+points). A serial LIDAR also needs its protocol in ``harness.devices``.
 """
 
 from harness import lazy_exports

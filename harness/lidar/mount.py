@@ -1,17 +1,11 @@
 """How a LIDAR device sits on the robot: where its own zero points, which way it counts.
 
-A ``Scan`` is in the robot's scan frame (REP-103: radians, counter-clockwise,
-0 = straight ahead). A spinning LIDAR reports its own angles: degrees,
-clockwise seen from above (the RPLIDAR A1 and the LD06/LD19 both), from its
-own zero, which need not point forward. On the FOSSBot v2 the A1's zero
-points to the robot's right (``yaw_deg = -90``): the v2 bridge turns it back
-with ``invert: true, angle_offset_deg: -90``. A device mounted upside down
-counts the other way round seen from above (``mirrored``).
-
-A board driver that maps device angle ``theta`` to
-``a = (-theta if invert else theta) + angle_offset_deg`` (the v2 bridge, the
-bundled driver) shows the scan frame exactly when ``invert = not mirrored``
-and ``angle_offset_deg = yaw_deg`` (``driver_settings``).
+A ``Scan`` is in the scan frame (REP-103: counter-clockwise, 0 ahead); a
+spinning LIDAR counts degrees clockwise from its own zero (on the FOSSBot
+v2 the A1's points right: ``yaw_deg = -90``), the other way round when
+mounted upside down (``mirrored``). A board driver mapping ``theta`` to
+``(-theta if invert else theta) + angle_offset_deg`` shows the scan frame
+exactly when ``invert = not mirrored`` and ``angle_offset_deg = yaw_deg``.
 """
 
 from __future__ import annotations

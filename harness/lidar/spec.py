@@ -74,10 +74,9 @@ class LidarSpec:
     def check(self) -> None:
         """Refuse layouts no real sensor has.
 
-        The beams cover at most one turn ((samples - 1) x angle_increment
-        <= 2 pi: Gazebo's closed layout, first and last beam at the same
-        angle, is the most), and every beam angle lies within +-2 pi, where
-        the oracle's "any wrap" comparison of angles holds.
+        At most one turn ((samples - 1) x increment <= 2 pi: Gazebo's closed
+        layout is the most), every angle within +-2 pi, where the oracle's
+        "any wrap" comparison holds.
         """
         if not 1 <= self.samples <= 16383:
             raise ConfigError(f"lidar samples must be 1..16383, got {self.samples}")

@@ -87,9 +87,8 @@ def threshold_problem(threshold: float, scenario: Scenario) -> str | None:
 def check_lidar_fits(scenario: Scenario) -> None:
     """The threshold and the obstacle conditions ask what this LIDAR can answer.
 
-    The threshold must be within range (`threshold_problem`). An ``obstacle_ahead_*``
-    condition looks at the beams within +-10 deg of straight ahead; without
-    any, it could never hold (below) or would always hold (above).
+    An ``obstacle_ahead_*`` condition looks at the beams within +-10 deg ahead;
+    without any it could never hold (below) or would always hold (above).
     """
     spec = scenario.lidar_spec
     problem = threshold_problem(scenario.threshold, scenario)
@@ -134,11 +133,9 @@ def check_reachable(scenario: Scenario) -> None:
 def check_model_files(scenario: Scenario) -> Path:
     """The robot URDF and every model obstacle: found where allowed and loadable.
 
-    The same check ``harness.sim.world.World`` runs before PyBullet sees a
-    file; here it runs when the scenario file is loaded, before any node
-    or board is started. The robot's LIDAR mount must read too (an upright
-    device link, or none: ``harness.scenario.mount``). Returns the robot
-    URDF's resolved path.
+    ``World`` runs the same check before PyBullet sees a file; here it runs at
+    load, before any node or board starts, with the robot's LIDAR mount. Returns
+    the robot URDF's resolved path.
     """
     folders = [scenario.base_dir, robot_models_dir()]
     where = shown(scenario.source or "<scenario>")
@@ -177,11 +174,9 @@ def check_model_files(scenario: Scenario) -> Path:
 def check_start_clear(scenario: Scenario, robot_urdf: Path | None = None) -> None:
     """A robot that starts inside a wall, box or cylinder, or overlapping one, is refused.
 
-    The robot's origin (its root link, on the floor) must lie outside each
-    of them, and the collision shapes of its rigid body (read from
-    `robot_urdf`, a URDF already checked by ``check_model_files``; see
-    ``harness.scenario.footprint``) may overlap one by at most START_OVERLAP.
-    Model obstacles are not checked.
+    Its origin must lie outside each, and its rigid body's collision shapes
+    (``footprint``, from the checked `robot_urdf`) may overlap one by at most
+    START_OVERLAP. Model obstacles are not checked.
     """
     where = shown(scenario.source or "<scenario>")
     start = scenario.robot.start

@@ -31,11 +31,9 @@ SCENARIO_SUFFIXES = (".yaml", ".yml")
 
 
 def parse_scenario(data: Any, *, source: str = "<scenario>") -> Scenario:
-    """Validate already-loaded YAML data; ConfigError names the source and field.
+    """Validate loaded YAML data (schema, bounds, cost); ConfigError names the source and field.
 
-    Checks the schema, the bounds and the cost of the run; the model files
-    it names are checked by ``check_model_files`` (``load_scenario_file``
-    does both).
+    Its model files are ``check_model_files``'s (``load_scenario_file`` does both).
     """
     where = shown(source)
     if not isinstance(data, dict):

@@ -1,14 +1,10 @@
 """Shapes on the floor, as pure numbers (no pybullet): does the robot start inside an obstacle?
 
-Scenario validation refuses a robot that starts overlapping a wall, box or
-cylinder before any simulation exists, so the robot's outline is read from
-its URDF here and compared with the obstacles' outlines geometrically.
-
-An ``Outline`` is a convex polygon seen from above, rounded by a radius (a
-disc is one point rounded, a capsule two) and standing between two heights.
-The robot's outlines are the collision shapes of its rigid body: the root
-link and every link fixed to it. Links on moving joints (wheels, arms) are
-left out, and so are mesh and plane shapes, whose extent is not read here.
+Refused before any simulation exists: the robot's outline is read from its
+URDF and compared with the obstacles' geometrically. An ``Outline`` is a
+convex polygon seen from above, rounded by a radius (a disc is one point
+rounded), between two heights. The robot's are its rigid body's collision
+shapes (root link and links fixed to it); mesh and plane shapes are left out.
 """
 
 from __future__ import annotations

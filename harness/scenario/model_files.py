@@ -1,24 +1,15 @@
 """Model files a scenario names: where they may live, and whether PyBullet can take them.
 
-Pure (xml.etree, no pybullet), so a scenario file is checked when it is
-loaded, before any node or board is started, and so it unit-tests fast.
+Where: paths relative to the scenario's folder, else ``robot_models/``; the
+file (symlinks followed) and every mesh it uses must lie inside the folder
+it was found in, so a scenario from elsewhere cannot make the harness read
+``/etc/passwd``.
 
-Where: a scenario names its robot (``robot.urdf``) and model obstacles
-(``obstacles[i].path``) by paths relative to its own folder, else to the
-shipped ``robot_models/``. Whatever the path says, the file it resolves to
-(symlinks followed) must lie inside the folder it was found in, and so must
-every mesh the model uses: a scenario file from elsewhere cannot make the
-harness read ``/etc/passwd`` or a file beside the project.
-
-What: PyBullet's URDF/SDF parsers print their complaints on stdout and
-crash the whole process on some broken files (a URDF with two root links
-segfaults; a mesh path naming a folder aborts with ``std::bad_alloc``; an
-SDF model of two links without a joint segfaults). So each file is read
-here first, bounded in size, and checked for what PyBullet needs: well-formed
-XML without DTDs, the right root element, links with unique names joined
-into one tree by known joint types, one shape per geometry with finite,
-positive sizes, and mesh files that exist, are regular files of a kind
-PyBullet reads and look like that kind.
+What: PyBullet's parsers print on stdout and crash the process on some
+broken files (two root links, a mesh path naming a folder, an SDF of two
+links without a joint), so each file is read here first, bounded, and
+checked for what PyBullet needs. Pure (xml.etree): checked at load, before
+any node starts.
 """
 
 from __future__ import annotations

@@ -1,19 +1,13 @@
 """Where the LIDAR device's zero points on the robot, as the robot model says (pure).
 
-A robot URDF may carry a link for the device itself (``robot.lidar_device_link``,
-default ``lidar_device_frame``): its +x is the device's 0 degrees, its +z the
-device's top, so its angles run clockwise seen from that top. Its orientation
-relative to the scan link (``robot.lidar_link``), composed through the fixed
-joints between the two (rpy only; where the device sits does not matter),
-is the mount: the yaw of its x about the scan frame's z, mirrored when its z
-points down. A tilted device is refused: a spinning LIDAR's plane is the scan
-plane.
-
-A URDF without that link has the generic mount (``FORWARD``: zero straight
-ahead) while the field is its default; a scenario that names another link
-its URDF lacks is a ``ConfigError``. (The value decides, not whether the
-file wrote it: a varied scenario is rebuilt from its dumped fields.) Read with ``xml.etree``
-only (no pybullet), so a scenario file is checked when it is loaded.
+A URDF may carry a link for the device (``robot.lidar_device_link``): its
++x is the device's 0 degrees, its +z its top. Its orientation relative to
+the scan link, through fixed joints only, is the mount: the yaw of its x,
+mirrored when its z points down; a tilted device is refused (a spinning
+LIDAR's plane is the scan plane). Without that link the mount is
+``FORWARD`` while the field keeps its default (the value decides: a varied
+scenario is rebuilt from its dumped fields); another link the URDF lacks is
+a ``ConfigError``.
 """
 
 from __future__ import annotations
@@ -81,11 +75,10 @@ def _down_to(
 def urdf_mount(
     root: ET.Element, scan_link: str, device_link: str, *, model: str = "the URDF"
 ) -> LidarMount | None:
-    """The mount of `device_link` relative to `scan_link` in a URDF; None if it has no such link.
+    """The mount of `device_link` relative to `scan_link`; None if the URDF has no such link.
 
-    ConfigError naming the field and `model` (callers add the scenario file)
-    when the scan link is missing, the device is tilted, or the two are not
-    joined by fixed joints alone.
+    ConfigError naming the field and `model` when the scan link is missing, the
+    device is tilted, or the two are not joined by fixed joints alone.
     """
     links = {link.get("name", "") for link in root.findall("link")}
     if device_link not in links:

@@ -76,57 +76,46 @@ def _text_hint(text: str) -> str:
     return "not a number as YAML 1.2 writes one"
 
 
-def _number(value: Any) -> Any:
-    """A number as YAML 1.2 writes it: not true/false, not text however much it looks like one.
-
-    An int is a number (`threshold: 1`); a float field then takes it as 1.0.
-    """
+def _checked(value: Any, *, whole: bool) -> Any:
+    """A number as YAML 1.2 writes it: not true/false, not text however much it looks like
+    one; `whole`: `360`, not `360.0` or `3.6e2`. An int is a number (a float field takes
+    `threshold: 1` as 1.0)."""
+    what = "a whole number" if whole else "a number"
     if isinstance(value, bool):  # Python's bool is an int
-        raise ValueError(f"must be a number, got {str(value).lower()}")
-    if isinstance(value, str):
-        if _NUMERIC_TEXT.match(value):
-            raise ValueError(f"must be a number, got text {value[:40]!r} ({_text_hint(value)})")
-        raise ValueError("Input should be a valid number, unable to parse string as a number")
-    return value
-
-
-def _whole(value: Any) -> Any:
-    """A whole number written as one: `360`, not `360.0`, `3.6e2` or `"360"`."""
-    if isinstance(value, bool):
-        raise ValueError(f"must be a whole number, got {str(value).lower()}")
-    if isinstance(value, float):
+        raise ValueError(f"must be {what}, got {str(value).lower()}")
+    if whole and isinstance(value, float):
         raise ValueError(f"must be a whole number, got {value!r}")
     if isinstance(value, str):
         if _NUMERIC_TEXT.match(value):
-            hint = _text_hint(value)
-            raise ValueError(f"must be a whole number, got text {value[:40]!r} ({hint})")
-        raise ValueError("Input should be a valid integer, unable to parse string as an integer")
+            raise ValueError(f"must be {what}, got text {value[:40]!r} ({_text_hint(value)})")
+        noun = "integer" if whole else "number"
+        words = f"a valid {noun}, unable to parse string as {'an' if whole else 'a'} {noun}"
+        raise ValueError(f"Input should be {words}")
     return value
 
 
 # Strict: pydantic converts nothing (no text to number, no 360.0 to 360); the
 # validators before it say what is wrong in words.
-_Number = BeforeValidator(_number)
-_Whole = BeforeValidator(_whole)
-Finite = Annotated[float, _Number, Field(strict=True, allow_inf_nan=False)]
-Positive = Annotated[float, _Number, Field(strict=True, gt=0, allow_inf_nan=False)]
-Coordinate = Annotated[
-    float,
-    _Number,
-    Field(strict=True, ge=-MAX_COORDINATE, le=MAX_COORDINATE, allow_inf_nan=False),
-]
-Size = Annotated[float, _Number, Field(strict=True, ge=MIN_SIZE, le=MAX_SIZE, allow_inf_nan=False)]
-Range = Annotated[float, _Number, Field(strict=True, gt=0, le=MAX_RANGE, allow_inf_nan=False)]
-Angle = Annotated[
-    float, _Number, Field(strict=True, ge=-2 * math.pi, le=2 * math.pi, allow_inf_nan=False)
-]
-Increment = Annotated[float, _Number, Field(strict=True, gt=0, le=2 * math.pi, allow_inf_nan=False)]
-Rate = Annotated[float, _Number, Field(strict=True, ge=1, le=100, allow_inf_nan=False)]
-Timeout = Annotated[
-    float, _Number, Field(strict=True, gt=0, le=MAX_SEGMENT_SECONDS, allow_inf_nan=False)
-]
-Linear = Annotated[float, _Number, Field(strict=True, ge=-2.0, le=2.0, allow_inf_nan=False)]
-Angular = Annotated[float, _Number, Field(strict=True, ge=-10.0, le=10.0, allow_inf_nan=False)]
+_Whole = BeforeValidator(lambda value: _checked(value, whole=True))
+
+
+def _float(**bounds: float) -> Any:
+    """A finite float field within `bounds` (pydantic's gt, ge, le)."""
+    number = BeforeValidator(lambda value: _checked(value, whole=False))
+    return Annotated[float, number, Field(strict=True, allow_inf_nan=False, **bounds)]
+
+
+Finite = _float()
+Positive = _float(gt=0)
+Coordinate = _float(ge=-MAX_COORDINATE, le=MAX_COORDINATE)
+Size = _float(ge=MIN_SIZE, le=MAX_SIZE)
+Range = _float(gt=0, le=MAX_RANGE)
+Angle = _float(ge=-2 * math.pi, le=2 * math.pi)
+Increment = _float(gt=0, le=2 * math.pi)
+Rate = _float(ge=1, le=100)
+Timeout = _float(gt=0, le=MAX_SEGMENT_SECONDS)
+Linear = _float(ge=-2.0, le=2.0)
+Angular = _float(ge=-10.0, le=10.0)
 Samples = Annotated[int, _Whole, Field(strict=True, ge=1, le=16383)]
 Seed = Annotated[int, _Whole, Field(strict=True, ge=0, le=2**32 - 1)]
 Point2 = tuple[Coordinate, Coordinate]

@@ -1,10 +1,7 @@
-"""A URDF's joints as a tree: each link's joint to its parent, the way up to the root,
-and a joint's origin (pure).
+"""A URDF's joints as a tree: each link's joint to its parent, the way to the root (pure).
 
-The LIDAR's mount (``scenario.mount``) and the live view's placement of the
-LIDAR (``live.robot_mount``) walk the same chain, and refuse the same bad
-input: a joint origin that is not three numbers is a ConfigError naming the
-joint (``model_files.check_model_file`` refuses such files first).
+The LIDAR's mount and the live view's LIDAR placement walk the same chain
+and refuse the same bad input (a joint origin that is not three numbers).
 """
 
 from __future__ import annotations

@@ -1,11 +1,8 @@
-"""Generated variations of a scenario: the wall nearer or farther, the start moved, the
-robot faster or slower (pure).
+"""Generated variations of a scenario: the wall moved, the start moved, the speed scaled (pure).
 
-A campaign (``fossbot-hil sweep --vary``) takes each as a factor with levels,
-so a node is tried at distances, poses and speeds no shipped file has. A
-varied scenario is checked exactly as a file is (schema limits, run length,
-a start clear of obstacles), so a level that makes no sense is a usage error
-naming the scenario and the level, before anything runs.
+A campaign (``sweep --vary``) tries a node at distances, poses and speeds no
+shipped file has; each variation is checked as a file is, so a level that
+makes no sense is a usage error before anything runs.
 """
 
 from __future__ import annotations
