@@ -1,11 +1,7 @@
 """What a /cmd_vel command becomes on the FOSSBot's wheels (pure).
 
-A differential drive cannot do everything a Twist asks: each wheel has a
-top speed. A command beyond it is scaled down whole, so the robot still
-drives the arc it was asked for (the curvature), only slower. Sideways and
-vertical parts of a Twist are ignored, as the lab's Gazebo plugin does.
-A robot that stops hearing commands stops (``CommandWatchdog``), as the
-lab's teleop expects.
+Sideways and vertical parts of a Twist are ignored, as the lab's Gazebo
+plugin does; a robot that stops hearing commands stops, as its teleop expects.
 """
 
 from __future__ import annotations
@@ -19,9 +15,8 @@ COMMAND_TIMEOUT_S = 0.5  # no /cmd_vel for this long: the robot stops
 
 @dataclass(frozen=True)
 class DriveLimits:
-    """The robot's wheels: radius and track (m), each wheel's top rim speed (m/s)."""
+    """The robot's wheels: track (m), each wheel's top rim speed (m/s)."""
 
-    wheel_radius: float
     track: float
     top_speed: float = TOP_SPEED
 
@@ -31,11 +26,8 @@ class DriveLimits:
         return 2.0 * self.top_speed / self.track
 
     def limit(self, linear: float, angular: float) -> tuple[float, float]:
-        """The body velocity the wheels can give for a command: (m/s, rad/s).
-
-        Not finite parts count as 0 (a Twist can carry NaN); a command beyond a
-        wheel's top speed is scaled down as a whole, keeping its curvature.
-        """
+        """The body velocity (m/s, rad/s) the wheels can give: beyond a wheel's top speed
+        scaled down whole, so the robot drives the arc asked for, slower; NaN counts as 0."""
         linear = linear if math.isfinite(linear) else 0.0
         angular = angular if math.isfinite(angular) else 0.0
         left = linear - angular * self.track / 2.0

@@ -1,22 +1,12 @@
 """The live view: the world, the robot, its scan and the node's answers, in the Foxglove app.
 
-``fossbot-hil sim`` serves its world over the Foxglove WebSocket protocol
-with the official ``foxglove-sdk``, so a student watches it in the Foxglove
-app with no ROS install. The simulator calls ``publish_pose``,
-``publish_scan`` and ``publish_answer`` as it goes; this module only turns
-them into Foxglove messages. Nothing is encoded for a channel no client
-watches, so an unwatched view costs next to nothing.
-
-Frames: ``odom`` (the scenario's world coordinates) -> ``base_footprint``
-(the robot, from its pose) -> the LIDAR frame (fixed, where the robot's
-URDF mounts the scenario's ``robot.lidar_link``). The answer topics and the
-verdict carry the recordings' names and fields (JSON, ``{"data": ...}``),
-so a layout made for a recording works live. The SDK keeps no message for
-late clients, so the world's obstacles go out to each client as it
-subscribes and again every ``WORLD_EVERY_S``.
-
-``foxglove`` is imported when a view is made: the harness works without
-the ``live`` extra. No rclpy, no pybullet.
+Served with the official ``foxglove-sdk``, so a student watches with no ROS
+install. Nothing is encoded for a channel no client watches, so an
+unwatched view costs next to nothing. Frames: ``odom`` -> ``base_footprint``
+-> the LIDAR frame (where the URDF mounts it). Answers and verdicts carry
+the recordings' topics and fields, so a layout made for a recording works
+live. The SDK keeps nothing for late clients, so the world goes to each
+client as it subscribes and again every ``WORLD_EVERY_S``. No rclpy, no pybullet.
 """
 
 from __future__ import annotations

@@ -1,12 +1,10 @@
 """Judging a node while the robot drives: every scan, on what came back before the next.
 
-Live, nothing waits for the node: scans go out at the LIDAR's rate in
-wall-clock time. An answer belongs to the newest scan published before the
-node published it (DDS source timestamps, one clock on one machine), and a
-scan is judged once the next one has gone out and a short grace has passed
-for answers still on their way. The oracle and its explanations are the
-lockstep run's; only the timing is looser, so ``fossbot-hil run`` stays the
-strict judge. Pure: no rclpy, no pybullet.
+Live, nothing waits for the node. An answer belongs to the newest scan
+published before it (DDS source timestamps: one clock on one machine); a
+scan is judged once the next has gone out and a short grace has passed.
+The oracle is the lockstep run's, the timing looser: ``fossbot-hil run``
+stays the strict judge. Pure: no rclpy, no pybullet.
 """
 
 from __future__ import annotations

@@ -1,23 +1,11 @@
 """Keyboard teleoperation for ``fossbot-hil sim --teleop``, with the lab's key layout.
 
-The lab drives the robot with ``ros2 run teleop_twist_keyboard teleop_twist_keyboard``;
-``--teleop`` reads the same keys in the simulator's own terminal, so the lab's
-instructions hold as written. Three parts, so each can be tested alone:
-
-- ``TeleopState`` (pure): one key in, the commanded (m/s, rad/s) out, scaled as
-  teleop_twist_keyboard scales it, never beyond the robot's top speeds.
-- ``KeyReader``: the terminal in cbreak mode without echo, one key at a time,
-  its settings restored on the way out whatever happened.
-- ``KeyboardTeleop``: both for the simulator loop. A key is typed once, but the
-  robot stops when commands stop coming (``drive.COMMAND_TIMEOUT_S``), so the
-  command in force is handed out again at a steady rate (``REPEAT_RATE_HZ``),
-  as teleop_twist_keyboard's ``repeat_rate`` does.
-
-Shift keys move a holonomic robot sideways (teleop_twist_keyboard's linear y) and
-t/b move it up and down (z). The state keeps those parts as the real tool sends
-them (``TeleopState.ignored``), but a differential drive cannot follow them and
-the simulator drops them, as the lab's Gazebo plugin does: ``U`` drives straight
-on, ``J`` stands still. Pure but for termios and select: no rclpy, no pybullet.
+The lab drives with ``teleop_twist_keyboard``; ``--teleop`` reads the same
+keys in the simulator's terminal, so the lab's instructions hold as written.
+The key logic (``TeleopState``, pure), the terminal (``KeyReader``) and the
+repeat (``KeyboardTeleop``) are apart, so each is tested alone. Shift keys
+and t/b (a holonomic robot's y and z) are kept as the tool sends them but
+dropped, as the lab's Gazebo plugin does: ``U`` drives straight on.
 """
 
 from __future__ import annotations
@@ -251,8 +239,8 @@ class KeyReader:
 
 
 class KeyboardTeleop:
-    """The keyboard as the simulator's driver: keys in, the command in force out,
-    at once after a key and again every 1/`rate_hz` s while no key comes."""
+    """The keyboard as the simulator's driver: keys in, the command in force out, at once
+    and again every 1/`rate_hz` s, as the robot stops when commands stop coming."""
 
     def __init__(
         self,

@@ -65,7 +65,7 @@ class LiveWorld:
             self.world.close()
             raise
         wheels = self.driver.wheels
-        self.limits = DriveLimits(wheels.radius, wheels.track)
+        self.limits = DriveLimits(wheels.track)
         self.t = 0.0  # simulation time, s
         self._steps = 0
         self._velocity = (0.0, 0.0)

@@ -8,7 +8,7 @@ import pytest
 
 from harness.live.drive import CommandWatchdog, DriveLimits
 
-V2 = DriveLimits(wheel_radius=0.03524, track=0.1866, top_speed=0.4)
+V2 = DriveLimits(track=0.1866, top_speed=0.4)
 
 
 def test_a_command_within_the_wheels_passes_unchanged() -> None:
