@@ -112,21 +112,8 @@ def _condition(segment: Segment) -> tuple[str, float]:
     raise AssertionError("Until validates exactly one condition")  # pragma: no cover
 
 
-_UNITS = {
-    "duration": "s",
-    "distance": "m",
-    "turn": "rad",
-    "obstacle_ahead_below": "m",
-    "obstacle_ahead_above": "m",
-}
-
-
 class MotionScript:
-    """Segment bookkeeping: what the robot is told to do, and when each segment ends.
-
-    ``advance(dt)`` hands out the constant-velocity pieces covering the next
-    dt; ``observe(ahead)`` judges the obstacle conditions on a fresh scan.
-    """
+    """Segment bookkeeping: what the robot is told to do, and when each segment ends."""
 
     def __init__(self, motion: Motion, *, source: str = "") -> None:
         self.segments = list(motion.segments)
@@ -146,11 +133,10 @@ class MotionScript:
         speed = abs(segment.linear if name == "distance" else segment.angular)
         needed = value / speed if speed > 0 else math.inf
         if needed > segment.until.timeout:
-            what = "linear" if name == "distance" else "angular"
-            unit = "m/s" if name == "distance" else "rad/s"
+            what, unit = ("linear", "m") if name == "distance" else ("angular", "rad")
             raise ConfigError(
-                f"{self._field(index)}: {name} {value:g} {_UNITS[name]} not reached within "
-                f"{segment.until.timeout:g} s ({what} {getattr(segment, what):g} {unit})"
+                f"{self._field(index)}: {name} {value:g} {unit} not reached within "
+                f"{segment.until.timeout:g} s ({what} {getattr(segment, what):g} {unit}/s)"
             )
         return needed
 

@@ -197,11 +197,8 @@ class World:
 
     @contextlib.contextmanager
     def _loading(self, field: str, ref: str) -> Iterator[None]:
-        """Run a PyBullet loader with its chatter captured; its failures become ConfigErrors.
-
-        The file was checked (``harness.scenario.model_files``) before, so this only
-        catches what PyBullet still refuses: a mesh it cannot read, say.
-        """
+        """Run a PyBullet loader with its chatter captured; what it still refuses of a
+        checked file (a mesh it cannot read, say) becomes a ConfigError."""
         prefix = f"{self.where}: {field}: cannot load {ref!r}: PyBullet"
         with bullet.captured_output() as lines:
             try:
@@ -233,12 +230,8 @@ class World:
     # -- lookups ----------------------------------------------------------
 
     def resolve(self, ref: str, field: str) -> Path:
-        """A model file, checked: next to the scenario file, else in robot_models/.
-
-        The rules (relative paths that stay inside the folder they are found
-        in; files PyBullet can load without crashing) are
-        ``harness.scenario.model_files``'s.
-        """
+        """A model file, checked by ``scenario.model_files``' rules: next to the scenario
+        file, else in robot_models/."""
         what = f"{self.where}: {field}: cannot load {ref!r}"
         model = find_model_file(ref, [self.scenario.base_dir, robot_models_dir()], what=what)
         check_model_file(model, what=what)
@@ -261,21 +254,17 @@ class World:
 
     def link_index(self, name: str, field: str = "robot.lidar_link") -> int:
         """PyBullet index of the named robot link (-1 for the root link)."""
-        names = self.link_names()
-        if name not in names:
-            raise ConfigError(
-                f"{self.where}: {field}: no link named {name!r} in "
-                f"{self.scenario.robot.urdf!r} (links: {', '.join(names)})"
-            )
-        return names.index(name) - 1
+        return self._index("link", self.link_names(), name, field) - 1
 
     def joint_index(self, name: str, field: str) -> int:
         """PyBullet index of the named robot joint."""
-        names = self.joint_names()
+        return self._index("joint", self.joint_names(), name, field)
+
+    def _index(self, kind: str, names: list[str], name: str, field: str) -> int:
         if name not in names:
             raise ConfigError(
-                f"{self.where}: {field}: no joint named {name!r} in "
-                f"{self.scenario.robot.urdf!r} (joints: {', '.join(names) or 'none'})"
+                f"{self.where}: {field}: no {kind} named {name!r} in "
+                f"{self.scenario.robot.urdf!r} ({kind}s: {', '.join(names) or 'none'})"
             )
         return names.index(name)
 
