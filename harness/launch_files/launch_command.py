@@ -18,15 +18,16 @@ from harness.errors import ConfigError
 from harness.launch_files.entries import LaunchFile
 from harness.launch_files.finding import package_launch_files, workspace_of
 from harness.launch_files.reading import read_launch_file
-from harness.nodes.command import NodeCommand, workspace_environment
+from harness.nodes.command import NodeCommand, option_problem, workspace_environment
+from harness.option_names import named, worded
 
 __all__ = ["find_launch_file", "launch_node", "ros2_launch_missing"]
 
 ROS2_PROGRAM = "ros2"  # ros2cli, whose launch verb starts the node
 HELP_TIMEOUT_S = 30.0  # `ros2 launch --help` (ros2cli loads its verbs: a second or two)
-INSTEAD = (
+INSTEAD = (  # worded when shown, as the caller names the options
     "source a ROS 2 installation that has it (e.g. `. /opt/ros/jazzy/setup.bash`), or leave "
-    "--launch out: with --workspace DIR --package P --executable E the harness still reads "
+    "{launch} out: with {workspace} DIR {package} P {executable} E the harness still reads "
     "the package's launch files and checks them against the running node"
 )
 
@@ -52,25 +53,28 @@ def ros2_launch_missing() -> str | None:
 
 
 def missing_message(package: str, file: str, reason: str) -> str:
-    return f"--launch {package} {file}: `ros2 launch` is not installed here ({reason}); {INSTEAD}"
+    launch = f"{named('launch')} {package} {file}"
+    return f"{launch}: `ros2 launch` is not installed here ({reason}); {worded(INSTEAD)}"
 
 
 def find_launch_file(package: str, file: str, workspace: str | None) -> LaunchFile:
     """The launch file `ros2 launch PACKAGE FILE` starts, read (not run); ConfigError
     when the package has none of that name."""
-    option = f"--launch {package} {file}"
+    option = f"{package} {file}"
     found = package_launch_files(package, workspace_of(workspace))
     name = Path(file).name
     match = next((path for path, _ in found.files if path.name == name), None)
     if match is None:
         listed = ", ".join(path.name for path, _ in found.files) or "none found"
-        raise ConfigError(
-            f"{option}: {package} has no launch file {name} (its launch files: {listed})"
+        raise option_problem(
+            "launch", f"{option}: {package} has no launch file {name} (its launch files: {listed})"
         )
     shown = next(s for path, s in found.files if path == match)
     read = read_launch_file(match, shown)
     if read is None:
-        raise ConfigError(f"{option}: {shown} is not a launch file (no launch description in it)")
+        raise option_problem(
+            "launch", f"{option}: {shown} is not a launch file (no launch description in it)"
+        )
     return read
 
 

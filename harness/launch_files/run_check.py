@@ -16,6 +16,7 @@ from harness.launch_files.checks import build_problem, undeclared_parameters, un
 from harness.launch_files.entries import LaunchFile, NodeEntry
 from harness.launch_files.finding import install_note, package_launch_files, workspace_of
 from harness.launch_files.reading import read_launch_file
+from harness.option_names import named
 
 __all__ = ["Asked", "LaunchCheck"]
 
@@ -66,8 +67,8 @@ class LaunchCheck:
             )
             static += [note] if note else []
             static += [
-                f"--launch: {shown} declares no launch argument {name!r}, so the harness cannot "
-                f"pass {name} to the node through it (the node keeps the file's value)"
+                f"{named('launch')}: {shown} declares no launch argument {name!r}, so the harness "
+                f"cannot pass {name} to the node through it (the node keeps the file's value)"
                 for name in dict.fromkeys(passed if launched else ())
                 if name not in read.arguments
             ]

@@ -14,6 +14,7 @@ from typing import TYPE_CHECKING
 
 from harness.links.base import LinkOptions
 from harness.links.topic_advice import BOOL_TYPE, topics_elsewhere, untaken_topic_parameter
+from harness.option_names import named
 
 if TYPE_CHECKING:
     from harness.launch_files.run_check import Asked, LaunchCheck
@@ -101,12 +102,12 @@ class WiringNotes:
         elif len(elsewhere) == 1:
             notes.append(
                 f"the node publishes a Bool on {elsewhere[0]}, not {opts.warning_topic}: pass "
-                f"--warning-topic {elsewhere[0]} if that is the lab's name"
+                f"{named('warning_topic')} {elsewhere[0]} if that is the lab's name"
             )
         elif elsewhere:
             notes.append(
                 f"the node publishes Bools on {', '.join(elsewhere)}, not {opts.warning_topic}: "
-                "pass --warning-topic with the lab's name"
+                f"pass {named('warning_topic')} with the lab's name"
             )
         else:
             notes.append(

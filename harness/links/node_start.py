@@ -13,7 +13,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from harness.errors import ConfigError
+from harness.errors import OptionError
 from harness.links.base import LinkOptions
 from harness.nodes.command import NodeCommand, package_node, reference_node, shell_node
 
@@ -25,10 +25,12 @@ if TYPE_CHECKING:
 def node_command(options: LinkOptions) -> NodeCommand:
     """The node the options name: a command, a package in a workspace, or the reference."""
     if options.node and options.package:
-        raise ConfigError("give either --node or --package/--executable, not both")
+        raise OptionError("node", "give either {node} or {package}/{executable}, not both")
     if options.launch:
         if options.node or options.package or options.executable:
-            raise ConfigError("--launch starts the node itself: drop --node/--package/--executable")
+            raise OptionError(
+                "launch", "{launch} starts the node itself: drop {node}/{package}/{executable}"
+            )
         from harness.launch_files.launch_command import launch_node
 
         return launch_node(*options.launch, options.workspace)
@@ -36,7 +38,7 @@ def node_command(options: LinkOptions) -> NodeCommand:
         return shell_node(options.node)
     if options.package or options.executable:
         if not (options.package and options.executable):
-            raise ConfigError("--package and --executable go together")
+            raise OptionError("package", "{package} and {executable} go together")
         return package_node(options.package, options.executable, options.workspace)
     return reference_node()
 

@@ -12,6 +12,8 @@ import time
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
+from harness.option_names import named
+
 if TYPE_CHECKING:
     from harness.links.base import LinkOptions
 
@@ -48,8 +50,8 @@ def topic_hints(node: Any, options: LinkOptions, *, reads: bool, publishes: bool
     """For a node never ready: the scan or status topic it uses instead, and the option
     that names it ('' when there is none to name)."""
     hints = []
-    scan = (SCAN_TYPE, options.scan_topic, "--scan-topic", "subscribes to a LaserScan", False)
-    status = (STRING_TYPE, options.status_topic, "--status-topic", "publishes a String", True)
+    scan = (SCAN_TYPE, options.scan_topic, "scan_topic", "subscribes to a LaserScan", False)
+    status = (STRING_TYPE, options.status_topic, "status_topic", "publishes a String", True)
     for missing, (type_name, topic, option, what, publishers) in (
         (not reads, scan),
         (not publishes, status),
@@ -59,7 +61,7 @@ def topic_hints(node: Any, options: LinkOptions, *, reads: bool, publishes: bool
         others = topics_elsewhere(node, type_name, topic, publishers=publishers)
         if len(others) == 1:
             hints.append(
-                f"it {what} on {others[0]}, not {topic}: pass {option} {others[0]} "
+                f"it {what} on {others[0]}, not {topic}: pass {named(option)} {others[0]} "
                 "if that is the lab's name"
             )
     return "".join(f"; {h}" for h in hints)
@@ -92,7 +94,7 @@ def untaken_topic_parameter(
     )
     if len(own) == 1:
         return (
-            f"{said} (it declares {own[0]}): pass --param {own[0]}:={topic}, or name the "
+            f"{said} (it declares {own[0]}): pass {named('params')} {own[0]}:={topic}, or name the "
             f"parameter {parameter} as the lab does"
         )
     return f"{said}: declare {parameter} and publish on the topic it names"

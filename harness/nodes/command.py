@@ -17,7 +17,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from harness.errors import ConfigError
+from harness.errors import OptionError
 from harness.nodes.colcon_hooks import hook_environment
 from harness.nodes.setup_problems import is_python
 
@@ -48,21 +48,26 @@ def reference_node() -> NodeCommand:
     )
 
 
-def split_command(command: str, *, option: str = "--node") -> list[str]:
-    """A user's command line split like a shell does, never empty; ConfigError names
-    `option`, the option that gave it."""
+def option_problem(key: str, text: str) -> OptionError:
+    """`text` (values and all, braces kept) as option `key`'s problem: "{key} text"."""
+    return OptionError(key, f"{{{key}}} " + text.replace("{", "{{").replace("}", "}}"))
+
+
+def split_command(command: str, *, option: str = "node") -> list[str]:
+    """A user's command line split like a shell does, never empty; OptionError names
+    `option`, the key of the option that gave it."""
     try:
         argv = shlex.split(command)
     except ValueError as err:
-        raise ConfigError(f"{option} {command!r}: {err}") from None
+        raise option_problem(option, f"{command!r}: {err}") from None
     if not argv:
-        raise ConfigError(f"{option}: the command is empty")
+        raise OptionError(option, f"{{{option}}}: the command is empty")
     return argv
 
 
-def shell_node(command: str, *, option: str = "--node") -> NodeCommand:
+def shell_node(command: str, *, option: str = "node") -> NodeCommand:
     """A user's command line, e.g. ``python3 my_node.py``, split like a shell does;
-    errors name `option`, the option that gave it."""
+    errors name `option`, the key of the option that gave it."""
     argv = split_command(command, option=option)
     program = argv[0]
     if program.endswith(".py") and Path(program).is_file():  # as grade runs a script
@@ -70,14 +75,14 @@ def shell_node(command: str, *, option: str = "--node") -> NodeCommand:
         program = argv[0]
     if "/" in program:
         if not Path(program).is_file():
-            raise ConfigError(f"{option} {command!r}: no such file {program}")
+            raise option_problem(option, f"{command!r}: no such file {program}")
         if not os.access(program, os.X_OK):
-            raise ConfigError(f"{option} {command!r}: {program} is not executable")
+            raise option_problem(option, f"{command!r}: {program} is not executable")
     elif shutil.which(program) is None:
-        raise ConfigError(f"{option} {command!r}: {program!r} not found on PATH")
+        raise option_problem(option, f"{command!r}: {program!r} not found on PATH")
     script = python_script_of(argv)
     if script is not None and not Path(script).is_file():
-        raise ConfigError(f"{option} {command!r}: no such script {script}")
+        raise option_problem(option, f"{command!r}: no such script {script}")
     return NodeCommand(tuple(argv), description=command)
 
 
@@ -136,20 +141,23 @@ def package_node(package: str, executable: str, workspace: str | None) -> NodeCo
     if workspace is not None:
         root = Path(workspace)
         if not root.is_dir():
-            raise ConfigError(f"--workspace {workspace}: no such folder")
+            raise option_problem("workspace", f"{workspace}: no such folder")
         install = root / "install" if (root / "install").is_dir() else root
         prefixes = install_prefixes(install)
         where = f"workspace {install}"
         if not prefixes:
-            raise ConfigError(
-                f"--workspace {workspace}: no colcon install folder with packages "
-                f"(run 'colcon build' in {root} first)"
+            raise option_problem(
+                "workspace",
+                f"{workspace}: no colcon install folder with packages "
+                f"(run 'colcon build' in {root} first)",
             )
     else:
         prefixes = [Path(p) for p in os.environ.get("AMENT_PREFIX_PATH", "").split(os.pathsep) if p]
         where = "AMENT_PREFIX_PATH"
         if not prefixes:
-            raise ConfigError("--package needs --workspace DIR (or a sourced ROS 2 / workspace)")
+            raise OptionError(
+                "package", "{package} needs {workspace} DIR (or a sourced ROS 2 / workspace)"
+            )
     owner = next((p for p in prefixes if (p / AMENT_MARKERS / package).is_file()), None)
     if owner is None:
         found = sorted(
@@ -161,7 +169,7 @@ def package_node(package: str, executable: str, workspace: str | None) -> NodeCo
             }
         )
         listed = ", ".join(found[:20]) or "none"
-        raise ConfigError(f"--package {package}: not found in {where} (packages: {listed})")
+        raise option_problem("package", f"{package}: not found in {where} (packages: {listed})")
     program = owner / "lib" / package / executable
     if not program.is_file():
         there = (
@@ -169,9 +177,9 @@ def package_node(package: str, executable: str, workspace: str | None) -> NodeCo
             if (owner / "lib" / package).is_dir()
             else []
         )
-        raise ConfigError(
-            f"--executable {executable}: not in package {package} "
-            f"(executables: {', '.join(there) or 'none'})"
+        raise option_problem(
+            "executable",
+            f"{executable}: not in package {package} (executables: {', '.join(there) or 'none'})",
         )
     env = workspace_environment(prefixes) if workspace is not None else {}
     return NodeCommand((str(program),), env, f"{package}/{executable} from {where}")

@@ -22,9 +22,10 @@ import pytest
 
 from harness.errors import ConfigError, HarnessError
 from harness.links.kinds import link_kind
+from harness.option_names import speaking
 from harness.pytest_plugin.cases import HilCase, split_faults
-from harness.pytest_plugin.options import DEFAULT_PORT_WAIT_S
 from harness.pytest_plugin.result import HilResult
+from harness.run_request.table import DEFAULT_PORT_WAIT_S, names
 
 if TYPE_CHECKING:
     from harness.links.base import LinkOptions
@@ -51,7 +52,6 @@ def _request(options: LinkOptions, link: str, run: dict[str, Any]) -> RunRequest
     hil.run's keywords (``scan_timeout``, ``seed``)."""
     from harness.run_request import OptionError, RunRequest
     from harness.run_request.request import NODE_KEYS, link_keys
-    from harness.run_request.table import names
 
     # A link that runs no node ignores the session's node (hil.run's node keywords too).
     runs_node = link_kind(link).runs_node
@@ -199,6 +199,7 @@ class Hil:
         """
         from harness.runner.settings import RunSettings
 
+        given = [*overrides, *(["link"] if link is not None else [])]
         link = link if link is not None else self.link
         if isinstance(scenario, HilCase) and faults is None:
             faults = scenario.faults
@@ -221,7 +222,9 @@ class Hil:
             status_pattern=status_regex,
             warning_when_clear=request.warning_when_clear,
         )
-        result = self._run(chosen, link, options, settings)
+        # The link's messages name the session's options --hil-node, hil.run's as keys: node.
+        with speaking({k: name for k, name in names("hil").items() if k not in given}):
+            result = self._run(chosen, link, options, settings)
         self.results.append(result)
         if self._record is not None:
             from harness.judge.verdicts import verdict_of

@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import argparse
 import os
-import re
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
@@ -270,8 +269,8 @@ def resolve_node(
     *,
     src: Callable[[str], str],
 ) -> None:
-    """Find the node now (a missing file or package is a usage error), as the link will."""
-    from harness.errors import ConfigError
+    """Find the node now (a missing file or package is a usage error), as the link will;
+    the problem names each option as the user gave it ("--hil-node", "hil_node in tox.ini")."""
     from harness.nodes.command import package_node, shell_node
 
     try:
@@ -279,12 +278,6 @@ def resolve_node(
             shell_node(node)
         elif package and executable:
             package_node(package, executable, workspace)
-    except ConfigError as err:
-        raise pytest.UsageError(renamed(str(err), src)) from None
-
-
-def renamed(message: str, src: Callable[[str], str]) -> str:
-    """A node error worded for the CLI ("--node ...") worded for pytest ("--hil-node ...")."""
-    return re.sub(
-        r"(?<![\w-])--(node|package|executable|workspace)\b", lambda m: src(m[1]), message
-    )
+    except OptionError as err:
+        keys = ("node", "package", "executable", "workspace")
+        raise pytest.UsageError(err.render({key: src(key) for key in keys})) from None

@@ -128,6 +128,34 @@ def test_a_conftest_overrides_the_node_fixture(pytester: pytest.Pytester) -> Non
     pytester.runpytest().assert_outcomes(passed=1)
 
 
+def test_a_runs_problem_names_the_plugins_options(pytester: pytest.Pytester) -> None:
+    """The link's own messages name options as the plugin does (--hil-workspace), a
+    hil.run keyword by its name (node), never as the command line's flags."""
+    pytester.makeconftest(
+        """
+        import pytest
+        from harness.pytest_plugin.plugin import NodeUnderTest
+
+        @pytest.fixture
+        def hil_node():
+            return NodeUnderTest(package="my_pkg", executable="my_node", workspace="nowhere")
+        """
+    )
+    pytester.makepyfile(
+        """
+        def test_workspace(hil):
+            hil.run("approach_wall")
+
+        def test_node(hil):
+            hil.run("approach_wall", node="python3 gone.py", package=None, executable=None)
+        """
+    )
+    result = pytester.runpytest()
+    result.assert_outcomes(failed=2)
+    result.stdout.fnmatch_lines(["*hil.run: --hil-workspace nowhere: no such folder"])
+    result.stdout.fnmatch_lines(["*hil.run: node 'python3 gone.py': no such script gone.py"])
+
+
 def test_hil_tests_skip_without_a_board_and_say_why(pytester: pytest.Pytester) -> None:
     pytester.makepyfile(
         """

@@ -107,7 +107,7 @@ def test_a_scenario_file_next_to_the_test(pytester: pytest.Pytester) -> None:
         ('"approach_wall", seed=-1', "hil.run: seed must be a whole number in 0..2**32-1"),
         ('"approach_wall", timeout=2', "hil.run: unknown option 'timeout' (known: link, "),
         ('"approach_wall", link="serial"', "hil.run: unknown link 'serial' (known: inprocess"),
-        ('"approach_wall", processor="nope.py:f"', "hil.run: --processor 'nope.py:f': no such"),
+        ('"approach_wall", processor="nope.py:f"', "hil.run: processor 'nope.py:f': no such"),
         ('"approach_wall", scan_timeout=1e9', "hil.run: scan_timeout must be at most 86400"),
         ('"approach_wall", scan_timeout="1"', "hil.run: scan_timeout must be a number, got '1'"),
         ('"approach_wall", ready_timeout=0', "hil.run: ready_timeout must be a positive number"),
