@@ -1,10 +1,7 @@
 """Emulated LIDAR devices: pure protocol codecs, no serial I/O.
 
-``revolution`` turns an emitted Scan into device samples (clockwise degrees,
-millimetres); ``rplidar`` is the Slamtec RPLIDAR A1M8's request/response
-state machine, ``rplidar_scans`` its scan encoders and reference decoders;
-``ldlidar`` the LDROBOT LD06/LD19 packet stream. A serial front end paces
-their bytes onto a pty or a real port.
+``revolution`` turns a Scan into device samples; ``rplidar``, ``rplidar_scans``
+and ``ldlidar`` are the codecs; ``serial_line`` paces their bytes onto a port.
 """
 
 from harness.devices.ldlidar import LdlidarDevice, decode_packets

@@ -1,10 +1,8 @@
 """What an emulated device did with the host's bytes, one event each.
 
-A builder whose board driver fails to start a scan needs to see which
-request it sent, what the device answered and what it rejected. The
-devices report that to an optional listener as ``DeviceEvent``s; the front
-end (``fossbot-hil emulate -v``, the HIL link's error) turns them into
-text. Pure: no I/O, no clock.
+A builder whose board driver starts no scan needs to see what it sent and
+what the device answered or rejected: devices tell a listener ``DeviceEvent``s
+(``emulate -v``, the HIL link's error). Pure.
 """
 
 from __future__ import annotations

@@ -1,10 +1,8 @@
 """LDROBOT LD06 / LD19: the packet stream the device sends, as pure code.
 
-The device takes no commands: once its motor is stable it streams 47-byte
-packets at 230400 baud, 12 measurements each. ``LdlidarDevice`` turns one
-revolution of device samples into those packets; ``decode_packets`` is the
-slow, obvious reference decoder the tests check it against. Facts and their
-sources: docs/devices.md.
+It takes no commands: it streams 47-byte packets of 12 measurements at
+230400 baud; ``decode_packets`` is the slow, obvious reference the tests
+check the encoder against. Facts and sources: docs/devices.md.
 """
 
 from __future__ import annotations
@@ -120,11 +118,10 @@ def parse_packet(packet: bytes) -> LdPacket:
 
 
 def decode_packets(data: bytes) -> tuple[list[Sample], int]:
-    """Reference decoder: samples of every good packet, and how many failed the CRC.
+    """Reference decoder: every good packet's samples, and how many failed the CRC.
 
-    Scans for 0x54 0x2C; after a bad CRC it resumes one byte later, so
-    garbage and damaged packets cost only themselves. A trailing incomplete
-    packet is ignored.
+    After a bad CRC it resumes one byte later, so garbage costs only itself; a
+    trailing incomplete packet is ignored.
     """
     samples: list[Sample] = []
     bad = 0
@@ -196,10 +193,8 @@ class LdlidarDevice(DeviceDefaults):
     def encode_revolution(self, samples: Sequence[Sample], *, start_ms: float = 0.0) -> bytes:
         """Whole packets for one revolution whose first sample was taken at ``start_ms``.
 
-        Sample k is taken at start_ms + k / samples_per_s; a packet carries
-        the (wrapped) time of its first sample. A revolution is rarely a
-        multiple of 12 samples: the remainder waits for the next call, as the
-        real stream runs on across revolutions.
+        A packet carries its first sample's (wrapped) time; samples short of a
+        packet wait for the next call, as the real stream runs across revolutions.
         """
         period_ms = 1000.0 / self.samples_per_s
         self._pending.extend((s, start_ms + k * period_ms) for k, s in enumerate(samples))
@@ -215,13 +210,11 @@ class LdlidarDevice(DeviceDefaults):
         return bytes(out)
 
     def receive(self, data: bytes) -> bytes:
-        """Host bytes: an LD06/LD19 takes no commands, so it answers none.
+        """Host bytes: an LD06/LD19 answers none.
 
-        Whole LDROBOT command frames (an LD14P driver's start/stop/speed)
-        are logged as requests the sensor ignores: harmless, it streams on.
-        Any other bytes are counted (``ignored_host_bytes``) because they say
-        something on a bench: requests starting 0xA5 come from an RPLIDAR
-        driver pointed at the wrong device.
+        LDROBOT command frames (an LD14P driver's) are logged as ignored requests;
+        other bytes are counted (``ignored_host_bytes``): 0xA5 says an RPLIDAR
+        driver is pointed at the wrong device.
         """
         rx = self._rx
         rx += data
@@ -263,7 +256,3 @@ class LdlidarDevice(DeviceDefaults):
                 else ""
             )
             self.listener(DeviceEvent("ignored_host_bytes", data, note=note))
-
-    def reset(self) -> None:
-        """Forget samples waiting for a packet (the stream was interrupted)."""
-        self._pending = []

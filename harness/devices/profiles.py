@@ -45,12 +45,9 @@ class DeviceProfile:
     ) -> list[Sample]:
         """The samples `device` sends for one revolution of `scan` at `rate_hz`, on `mount`.
 
-        Where the device reports each sample's own angle (the A1's standard
-        nodes) every beam goes out at the angle it was cast, as many as the
-        line carries in one revolution (else the device's native count,
-        still at the beams' angles); otherwise the revolution is resampled
-        to the native count at evenly spaced angles. `mount` says where the
-        device's zero points on the robot (the FOSSBot v2: to the right).
+        A device that reports each sample's angle (the A1's standard nodes) sends
+        every beam at its own angle, as many as the line carries (else its native
+        count); otherwise the revolution is resampled to the native count.
         """
         native = self.samples_per_rev(device, rate_hz)
         if self.at_beam_angles(device):

@@ -1,12 +1,8 @@
 """What a serial front end may ask of an emulated LIDAR: one declared interface.
 
-The device server (``harness.serial_line.server``) drives any device that
-satisfies ``LineDevice``: it feeds host bytes in, encodes revolutions, reads
-the state that decides what goes on the line, and counts what the device
-counted. A device that lacks a capability (the LD06/LD19 has no requests to
-answer, no motor line, no reboot) says so through the defaults of
-``DeviceDefaults`` rather than by leaving the member out, so the server never
-probes. Pure: no I/O.
+A device lacking a capability (the LD06 has no requests, motor line or
+reboot) declares it absent through ``DeviceDefaults`` instead of leaving the
+member out, so the server never probes. Pure.
 """
 
 from __future__ import annotations
@@ -27,14 +23,11 @@ _NONE: Mapping[str, int] = MappingProxyType({})
 class LineDevice(Protocol):
     """An emulated LIDAR as its serial front end sees it.
 
-    ``mode`` is "idle" while nothing streams, else the scan kind ("scan",
-    "express"; "streaming" for a device that streams unasked). ``session``
-    changes whenever a scan starts or ends: revolution bytes queued before
-    the change are stale. ``packetized``: the encoder holds samples that do
-    not fill a packet for its next call (the LD06), so a start marker must
-    complete that packet and "replace" leaves samples out before encoding.
-    ``follows_motor_line``: the device's motor follows the board's DTR
-    (``set_motor``).
+    ``mode``: "idle", else the scan kind ("scan", "express"; "streaming" for a
+    device that streams unasked). ``session`` changes when a scan starts or
+    ends: bytes queued before are stale. ``packetized``: the encoder holds a
+    partial packet for its next call (the LD06), so a start marker completes
+    it. ``follows_motor_line``: the motor follows the board's DTR (``set_motor``).
     """
 
     listener: Listener | None
@@ -92,12 +85,8 @@ class LineDevice(Protocol):
 
 
 class DeviceDefaults:
-    """The capabilities a device may lack, declared absent: subclass and override.
-
-    A stream-only device with no motor line, no reboot and no requests gets
-    everything here; its own ``mode`` and ``encode_revolution`` make it a
-    ``LineDevice``.
-    """
+    """The capabilities a device may lack, declared absent (a stream-only device: ``mode``
+    and ``encode_revolution`` are its own)."""
 
     listener: Listener | None = None
     session: int = 0  # never changes: no scan starts or ends

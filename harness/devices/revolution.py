@@ -1,13 +1,9 @@
 """Turning an emitted Scan into the measurements a spinning LIDAR would send.
 
-Both emulated devices (RPLIDAR A1, LD06/LD19) turn clockwise seen from above
-and report angles in degrees clockwise from their own zero, while a ``Scan``
-follows REP-103 (radians, counter-clockwise, 0 straight ahead). Where the
-device's zero points on the robot, and which way it counts, is its mount
-(``harness.lidar.mount``; the FOSSBot v2's A1 points its zero to the right).
-This module is the one place that turns scan angles into device angles, so
-the codecs only ever see device samples. See docs/devices.md for the
-conventions and their sources.
+The devices count degrees clockwise from their own zero, a ``Scan``
+radians counter-clockwise from ahead (REP-103), and the mount says where the
+zero points (``harness.lidar.mount``). This is the one place that converts,
+so the codecs only see device samples (docs/devices.md).
 """
 
 from __future__ import annotations
@@ -52,12 +48,10 @@ def device_angle_deg(
 
 
 def encode_distances_mm(ranges_m: np.ndarray, max_range_m: float | None = None) -> np.ndarray:
-    """Metres (REP-117 values) to device millimetres, with 0 for "nothing usable".
+    """Metres (REP-117) to device millimetres; 0 for "nothing usable" or beyond ``max_range_m``.
 
-    Non-finite, zero or negative readings become 0, as does anything beyond
-    ``max_range_m`` when given. A finite reading below the scan's range_min
-    (a spurious return) is kept: the device would report it, and filtering it
-    is the driver's job.
+    A finite reading below range_min is kept: the device would report it, and
+    filtering it is the driver's job.
     """
     r = np.asarray(ranges_m, dtype=np.float64)
     with np.errstate(invalid="ignore"):
@@ -77,13 +71,10 @@ def samples_from_scan(
 ) -> list[Sample]:
     """The samples of one revolution, in increasing device angle from about 0.
 
-    Each beam is where `mount` puts it in the device's angles. Without
-    ``samples_per_rev`` there is one sample per beam. With it, the
-    revolution is resampled to the device's native count: sample ``j`` looks
-    at device angle ``j * 360 / samples_per_rev`` (plus less than a step, so
-    that every mount looks at the same robot-frame angles; nothing on the
-    generic mount) and takes the nearest beam, or no return where the scan
-    has no beam within half an increment.
+    Without ``samples_per_rev``, one sample per beam; with it, sample ``j``
+    looks at device angle ``j * 360 / samples_per_rev`` (plus ``_grid_phase``)
+    and takes the nearest beam, or no return where none is within half an
+    increment.
     """
     distances = encode_distances_mm(scan.ranges, max_range_m)
     if samples_per_rev is None:
@@ -114,11 +105,8 @@ def samples_at_beams(
 ) -> list[Sample]:
     """One sample per beam, at the angle the simulator cast it, in increasing device angle.
 
-    A device that reports each sample's own angle (the RPLIDAR's standard
-    nodes, 1/64 degree) need not resample: it can say exactly where each
-    beam looked (in its own angles: `mount`). With ``max_count`` below the
-    number of beams, that many beams are kept, spread evenly over the scan,
-    each still at its own angle.
+    A device that reports each sample's angle (RPLIDAR standard nodes) need
+    not resample; ``max_count`` keeps that many beams, spread evenly.
     """
     n = scan.ranges.size
     index = np.arange(n)
@@ -140,11 +128,9 @@ def samples_at_beams(
 def _grid_phase(mount: LidarMount, step: float) -> float:
     """Where the resampled device angles start, in [0, step): 0 on the generic mount.
 
-    A real device's samples fall wherever its rotation puts them; the emulator
-    puts them on the same robot-frame angles whatever the mount (a multiple of
-    `step` from straight ahead), so a mount whose yaw is not a whole number of
-    steps (the v2's -90 deg is 112.5 of an LD19's 0.8) does not land every
-    sample half-way between a driver's bins.
+    The samples fall on the same robot-frame angles whatever the mount, so a
+    yaw that is no whole number of steps (the v2's -90 deg of an LD19's 0.8)
+    does not put every sample half-way between a driver's bins.
     """
     turn = -mount.yaw_deg if mount.mirrored else mount.yaw_deg
     phase = float(np.mod(turn, step))

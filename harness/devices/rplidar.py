@@ -1,14 +1,10 @@
 """Slamtec RPLIDAR A1M8: the device's side of its serial protocol, as pure code.
 
-``RplidarDevice`` is a state machine fed with the bytes the host writes; it
-returns the device's immediate replies and, once scanning, encodes each
-revolution as the device would stream it (standard 5-byte nodes or legacy
-express capsules, ``rplidar_scans``). No I/O here: the serial front end
-paces the bytes, drives the motor line (DTR) and decides when a revolution
-is due.
-
-The module also holds the host side of requests (``encode_request``,
-``decode_descriptor``). Facts and their sources: docs/devices.md.
+``RplidarDevice`` is a state machine fed the host's bytes: it returns the
+immediate replies and, once scanning, encodes each revolution
+(``rplidar_scans``); the front end paces the bytes and drives DTR. The
+host side of requests is here too (``encode_request``,
+``decode_descriptor``). Facts and sources: docs/devices.md.
 """
 
 from __future__ import annotations
@@ -186,12 +182,10 @@ def decode_descriptor(data: bytes) -> tuple[int, int, int]:
 class RplidarDevice(DeviceDefaults):
     """An A1M8 as seen from its serial line: requests in, replies and scans out.
 
-    Motor: on the A1 the USB adapter drives the motor from DTR (DTR asserted,
-    e.g. pyserial ``setDTR(True)``, stops it). The front end reports that
-    with ``set_motor``; MOTOR_PWM requests also switch it (pwm > 0 runs),
-    last writer wins, unless ``pwm_controls_motor`` is False (a bare A1 has
-    no PWM input). SCAN and EXPRESS_SCAN stream nothing while the motor is
-    off (the device waits for a stable rotation); FORCE_SCAN streams anyway.
+    Motor: the A1's adapter drives it from DTR (asserted stops it), told by
+    ``set_motor``; MOTOR_PWM switches it too (last writer wins) unless
+    ``pwm_controls_motor`` is False. SCAN and EXPRESS_SCAN stream nothing while
+    it is off (the device waits for a stable rotation); FORCE_SCAN streams anyway.
     """
 
     follows_motor_line = True  # the adapter's DTR drives the motor
@@ -299,12 +293,9 @@ class RplidarDevice(DeviceDefaults):
     def receive(self, data: bytes) -> bytes:
         """Feed bytes from the host; return the device's immediate replies.
 
-        Partial requests wait for more bytes; bytes before a 0xA5 are skipped;
-        payload requests with a wrong checksum are dropped whole, silently,
-        as is any request the device does not know. Any request other than
-        MOTOR_PWM ends a running scan (the protocol lets any request interrupt
-        one): the front end should drop revolution bytes it has not sent yet
-        when ``session`` changes.
+        Partial requests wait, bytes before 0xA5 are skipped, bad checksums and
+        unknown requests are dropped silently. Any request but MOTOR_PWM ends a
+        running scan: drop unsent revolution bytes when ``session`` changes.
         """
         if self.rebooting:
             self._error("ignored_rebooting", bytes(data), len(data))
@@ -525,13 +516,11 @@ class RplidarDevice(DeviceDefaults):
     # -- revolutions out -------------------------------------------------------
 
     def encode_revolution(self, samples: Sequence[Sample], *, start_ms: float = 0.0) -> bytes:
-        """The bytes the device streams for one revolution in the current mode
-        (nodes and capsules carry no time: `start_ms` is not sent).
+        """The bytes streamed for one revolution in the current mode (`start_ms` is not sent).
 
-        Empty when idle, rebooting, or when the motor is off (except after
-        FORCE_SCAN). Express capsules need the next capsule's start angle,
-        and a revolution is rarely a multiple of 32 samples, so samples not
-        yet in a complete capsule wait for the next call.
+        Empty when idle, rebooting or with the motor off (but after FORCE_SCAN).
+        Express samples short of a capsule wait for the next call (a capsule
+        needs the next one's start angle).
         """
         if self.rebooting or self._mode == "idle":
             return b""

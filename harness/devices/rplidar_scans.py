@@ -1,12 +1,9 @@
 """Slamtec RPLIDAR A1M8: the scan stream's two formats, as pure code.
 
-Standard scans are 5-byte nodes, one sample each, the start flag on the
-revolution's first; legacy express scans are 84-byte capsules of 32
-samples whose angles the host learns from the next capsule's start angle.
-Each encoder has a slow, obvious reference decoder (``decode_standard``,
-``decode_express``, integer arithmetic as in the vendor SDK) that the
-tests check it against. The request/response state machine that streams
-them is ``rplidar.RplidarDevice``.
+Standard scans are 5-byte nodes (the start flag on the revolution's first);
+legacy express scans 84-byte capsules of 32 samples whose angles come from
+the next capsule's start. Each encoder has a slow, obvious reference
+decoder (the vendor SDK's integer arithmetic) the tests check it against.
 """
 
 from __future__ import annotations
@@ -54,12 +51,7 @@ def encode_node(sample: Sample, *, start: bool) -> bytes:
 
 
 def encode_standard(samples: Sequence[Sample]) -> bytes:
-    """One revolution of nodes, starting at (and flagging) the smallest angle.
-
-    The device starts a new revolution where the angle wraps past zero, so
-    the start flag goes on the sample with the smallest angle; samples before
-    it in the list are rotated to the end, keeping the cyclic order.
-    """
+    """One revolution of nodes, the smallest angle (where the device wraps) flagged as the start."""
     if not samples:
         return b""
     ordered = list(samples)
@@ -110,11 +102,9 @@ def encode_capsule(
 ) -> bytes:
     """One 84-byte express capsule holding 32 samples.
 
-    The host only learns capsule i's angles from the start angle of capsule
-    i + 1: sample k sits at start + k * AngleDiff / 32 - dtheta_k. So the
-    encoder needs the angle of the next capsule's first sample. dtheta is
-    kept in 0..31 (0..3.875 degrees), where the protocol's signed reading
-    and the SDK's unsigned one agree; larger corrections are clipped.
+    Sample k sits at start + k * AngleDiff / 32 - dtheta_k, the host learning
+    AngleDiff from the next capsule's start; dtheta is kept in 0..31 (0..3.875
+    deg), where the protocol's signed reading and the SDK's unsigned agree.
     """
     if len(samples) != SAMPLES_PER_CAPSULE:
         raise ValueError(f"a capsule holds {SAMPLES_PER_CAPSULE} samples, got {len(samples)}")
@@ -157,9 +147,8 @@ def capsule_start_flag(capsule: bytes) -> bool:
 def decode_express(capsule_a: bytes, capsule_b: bytes) -> list[Sample]:
     """Reference decoder: capsule_a's 32 samples, using capsule_b's start angle.
 
-    Integer arithmetic as in the vendor SDK (q16 angles, dtheta read unsigned),
-    so results match what ``rplidar_ros`` would compute. Distances are whole
-    millimetres; quality is the SDK's fixed value for a return.
+    Integer arithmetic as in the vendor SDK (q16 angles, dtheta unsigned), so
+    the results match ``rplidar_ros``'s.
     """
     _check_capsule(capsule_a)
     _check_capsule(capsule_b)

@@ -1,14 +1,7 @@
 """Drives everything: a scenario simulated, spoiled, delivered and judged; a suite; a replay.
 
-- ``scenario_run``: one scenario through a link (``run``, ``run_scenario``);
-- ``frames``: the lockstep loop every run shares (``judge_frames``);
-- ``settings``: what a run may override, checked before any run starts;
-- ``suite``: scenarios in order, each with a fresh link, ``link_pipeline``
-  starting the next ones ahead and stopping finished ones behind;
-- ``replay``: a recorded scan stream judged the same way;
-- ``emulate``: a scenario's scans served as a LIDAR device on a port.
-
-The commands, the pytest plugin, grading and the bench all run through here.
+The commands, the pytest plugin, grading and the bench all run through here
+(the modules: docs/architecture.md).
 """
 
 from harness import lazy_exports

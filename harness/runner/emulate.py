@@ -1,17 +1,11 @@
 """`fossbot-hil emulate`: serve a scenario's scans as a LIDAR device on a port.
 
 For users testing their own drivers: the harness is the device, in real
-time, and nothing else runs. With no port named, a pty pair stands in for
-the cable and its path is printed first, so a script can read it and point
-its driver there; the next line is the environment (``modem lines: export
-...``) under which a pyserial client's DTR/RTS calls on that pty succeed
-and reach the emulator, as over a wired adapter. No ROS is needed.
-
-It explains itself: with ``verbose`` every request, answer and protocol
-error is logged as it happens; otherwise a one-line status every few
-seconds. Ctrl-C or SIGTERM ends it normally, with the same summary as the
-scenario's end: what was asked, what was served, what went wrong, and the
-likely cause when no client read anything.
+time, with no ROS. Without a port a pty stands in for the cable: its path
+is printed first, then the environment under which a pyserial client's
+DTR/RTS calls reach the emulator. It explains itself (every event with
+``verbose``, else a status line every few seconds), and Ctrl-C ends it with
+the same summary as the scenario's end.
 """
 
 from __future__ import annotations
@@ -202,12 +196,7 @@ def emulate(
     status_every_s: float = STATUS_EVERY_S,
     mount: LidarMount = FORWARD,
 ) -> EmulationSummary:
-    """Serve every revolution of `scenario` in real time until it ends or is stopped;
-    `mount` says where the device's zero points on the robot.
-
-    Ctrl-C or SIGTERM (``KeyboardInterrupt``) stops it like the scenario's
-    end: the summary says which.
-    """
+    """Serve every revolution of `scenario` in real time until it ends or Ctrl-C stops it."""
     settings = settings or RunSettings()
     from harness.serial_line.device_line import open_device_line
     from harness.serial_line.diagnosis import diagnose, line_errors

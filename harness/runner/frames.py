@@ -65,15 +65,11 @@ def judge_frames(
 ) -> RunResult:
     """Deliver each frame's scan through an opened `link`; judge and record every tick.
 
-    Simulated runs and replayed recordings share this loop, so both are
-    judged the same way. `link_faults` decide how each scan travels (late,
-    dropped, twice, out of order, stale); the oracle is told, so a dropped
-    scan expects no answer and a late one is timed from when it went out.
-    With `diagnose`, the link's diagnostics end the run (which stops a node
-    process); without, the link stays usable for another run. With
-    `stop_at_first_failure`, the run ends at its first failed tick (the last
-    record; `result.stopped_early` says so): a tick that got no status by its
-    deadline at once, a wrong answer as soon as it is judged.
+    `link_faults` decide how each scan travels, and the oracle is told (a
+    dropped scan expects no answer, a late one is timed from when it went out).
+    With `diagnose` the link's diagnostics end the run (stopping its node);
+    without, the link stays usable. `stop_at_first_failure` ends the run at
+    its first failed tick (`result.stopped_early`).
     """
     # A tick waits in `pending` until the next scan's exchange is over:
     # answers to scan k that arrive after scan k+1 was sent (a Bool published

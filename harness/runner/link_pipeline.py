@@ -1,24 +1,15 @@
 """A suite's links: the next scenarios' started ahead, finished ones left stopping behind.
 
-Bringing a node up (its start, rclpy, discovery) and stopping it take
-longer than running most scenarios. A link that can be isolated from its
-neighbours (each ros2 link has its own ROS domain and its own node process)
-is started a few scenarios ahead and, once its scenario is judged, stops
-while the next one runs. Nothing is shared between them: every scenario
-still gets a fresh node, and lockstep verdicts do not depend on timing.
-The suite waits for every link to close (every process reaped, every
-domain released) before it returns, and reports results in scenario order.
+Starting and stopping a node take longer than most scenarios, so a link
+isolated from its neighbours (its own ROS domain and node) starts a few
+scenarios ahead and stops while the next runs; every scenario still gets a
+fresh node, and the suite waits for every link to close.
 
-Why four ahead: for up to about 0.6 s after a node starts, its side of the
-graph may not have matched the harness's yet, and its link waits for that
-before the first scan (``Ros2Link.open``; sent earlier, the scan would wait
-0.1-0.4 s for Fast DDS to repair it). Short scenarios (0.1-0.2 s each)
-reach a link started three ahead inside that window; four ahead, its node
-is mostly old enough (five was no faster). Nodes waiting their turn are
-idle (an executor asleep on its wait set), but each holds a ROS domain:
-a suite holds up to AHEAD + BEHIND + 1 of the 101, so about 14 suites fit
-on one machine at once (a grading cluster runs one per core). A link
-started ahead that finds no domain free waits for its turn to take one.
+Why four ahead: for up to 0.6 s after a node starts its graph may not match
+the harness's yet (``Ros2Link.open`` waits); short scenarios reach a link
+started three ahead inside that window, four is mostly old enough (five was
+no faster). Each waiting node holds a ROS domain: AHEAD + BEHIND + 1 of the
+101, so about 14 suites fit on one machine; one that finds none free waits.
 """
 
 from __future__ import annotations
@@ -126,18 +117,13 @@ class LinkPipeline:
 
 
 class ReportsBehind(Generic[R]):
-    """Hands each finished scenario's result to `report` in order: at once, or with
-    `behind` once the suite's links are done (`finish`).
+    """Hands each finished result to `report` in order: at once, or with `behind` at `finish`.
 
-    A serial link's next scenario follows its device's stream in real time;
-    writing the finished one's report (its plot, its recording: seconds on
-    a loaded machine) between the two would keep the device streaming
-    revolutions nobody judges, and writing it beside the next scenario
-    would take the interpreter from the thread that paces the device's
-    bytes (a revolution was seen to miss its slot). So those reports wait
-    for the device session to end; the verdicts are shown as each scenario
-    is judged (`on_judged`). `finish` reports everything still held, in
-    order, even when the suite is ending on an error.
+    A serial link's next scenario follows its device's stream in real time:
+    writing a report (seconds on a loaded machine) in between keeps the device
+    streaming revolutions nobody judges, and beside it takes the interpreter
+    from the pacing thread. So those reports wait for the device session;
+    `finish` reports all still held, even on an error.
     """
 
     def __init__(self, report: Callable[[R], None], *, behind: bool) -> None:

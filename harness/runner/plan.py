@@ -1,12 +1,9 @@
 """Each scenario's run, decided once before anything starts: a `RunPlan`.
 
-A run's threshold, seed, fault profile, warning rule and link options are
-each derived from the scenario, the run's settings and the link's options.
-Deriving them where they are used (the link's start, the oracle, the record
-of a run that never started) did it several times over, and a mistake in the
-fifth scenario's overrides came after four were judged. Planning decides them
-all up front, so a usage error comes before any node starts and every later
-step reads the same values.
+Deriving threshold, seed, faults, warning rule and link options where each
+was used did it several times over, and a mistake in the fifth scenario's
+overrides came after four were judged: planned up front, a usage error
+comes before any node starts and every step reads the same values.
 """
 
 from __future__ import annotations

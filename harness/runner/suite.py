@@ -30,21 +30,14 @@ def run_suite(
     on_result: Callable[[RunResult], None] | None = None,
     on_judged: Callable[[RunResult], None] | None = None,
 ) -> list[RunResult]:
-    """Run each scenario in turn, each through a link of its own, and report the
-    results in order.
+    """Run each scenario through a link of its own, and report the results in order.
 
-    `on_result` gets each result once its link is closed (complete: the stop's
-    time and notes in it); `on_judged` gets it as soon as its ticks are judged,
-    while its node may still be stopping (the verdict is final; a screen can
-    show it at once). A scenario skipped or cut short by Ctrl-C is only
-    reported to `on_result`.
-
-    Where links can overlap (their own ROS domains), the next scenarios'
-    links start while one runs and finished ones stop behind it
-    (``harness.runner.link_pipeline``). What the links share for the whole run
-    (a serial link's device, line and board software) is their class's
-    ``run_session``. Once the software under test fails to come up, the rest
-    are marked not run instead of each waiting out its start.
+    `on_result` gets each once its link is closed; `on_judged` as soon as its
+    ticks are judged (a screen can show it while its node stops); a scenario
+    cut short by Ctrl-C only goes to `on_result`. Links that can overlap start
+    ahead and stop behind (``link_pipeline``); what they share for the run is
+    their class's ``run_session``. Once the software under test fails to come
+    up, the rest are marked not run.
     """
     results: list[RunResult] = []
     if not scenarios:
