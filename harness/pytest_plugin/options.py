@@ -31,10 +31,6 @@ from harness.run_request import OPTIONS as TABLE
 from harness.run_request import OptionError, RunOption, RunRequest, table
 from harness.run_request.table import names as option_names
 
-DEFAULT_TIMEOUT_S = table.DEFAULT_TIMEOUT_S
-DEFAULT_READY_TIMEOUT_S = table.DEFAULT_READY_TIMEOUT_S
-DEFAULT_PORT_WAIT_S = table.DEFAULT_PORT_WAIT_S
-
 
 def _typed(row: RunOption) -> Callable[[str], Any] | None:
     """The row's reader as an argparse type: its problem in one line after pytest's
@@ -73,22 +69,6 @@ class _Option:
     def parse(self) -> Callable[[str], Any] | None:
         return _typed(self.row)
 
-    @property
-    def ini(self) -> bool:
-        return self.row.ini
-
-    @property
-    def repeat(self) -> bool:
-        return self.row.repeat
-
-    @property
-    def flag(self) -> str:
-        return self.row.hil_flag
-
-    @property
-    def ini_name(self) -> str:
-        return self.row.ini_key
-
 
 LINK_HELP = (
     f"link to the software under test: {default_link()} (default), "
@@ -110,14 +90,14 @@ def add_options(parser: pytest.Parser) -> None:
         kwargs: dict[str, Any] = {"metavar": opt.metavar, "help": opt.help, "default": None}
         if opt.parse is not None:
             kwargs["type"] = opt.parse
-        if opt.repeat:
+        if opt.row.repeat:
             kwargs.update(action="append", default=[])
-        group.addoption(opt.flag, dest="hil_" + opt.name, **kwargs)
-        if opt.ini:
-            if opt.repeat:
-                parser.addini(opt.ini_name, f"default for {opt.flag}", type="linelist")
+        group.addoption(opt.row.hil_flag, dest="hil_" + opt.name, **kwargs)
+        if opt.row.ini:
+            if opt.row.repeat:
+                parser.addini(opt.row.ini_key, f"default for {opt.row.hil_flag}", type="linelist")
             else:
-                parser.addini(opt.ini_name, f"default for {opt.flag}", type="string")
+                parser.addini(opt.row.ini_key, f"default for {opt.row.hil_flag}", type="string")
 
 
 @dataclass(frozen=True)
@@ -129,14 +109,14 @@ class HilConfig:
     package: str | None = None
     executable: str | None = None
     workspace: str | None = None
-    param: tuple[str, ...] = ()
+    param: tuple[str, ...] = table.option("params").default
     port: str | None = None
     domain_id: int | None = None
     seed: int | None = None
     warning_when_clear: str | None = None
-    timeout: float = DEFAULT_TIMEOUT_S
-    ready_timeout: float = DEFAULT_READY_TIMEOUT_S
-    port_wait: float = DEFAULT_PORT_WAIT_S
+    timeout: float = table.option("scan_timeout").default
+    ready_timeout: float = table.option("ready_timeout").default
+    port_wait: float = table.option("port_wait").default
     given: dict[str, str] = field(default_factory=dict, compare=False)
 
     @property
@@ -153,8 +133,8 @@ class HilConfig:
 
 
 def _from_ini(config: pytest.Config, opt: _Option, where: str) -> Any:
-    raw = config.getini(opt.ini_name)
-    if opt.repeat:
+    raw = config.getini(opt.row.ini_key)
+    if opt.row.repeat:
         items = [str(x).strip() for x in raw if str(x).strip()]
         if opt.parse is not None:
             items = [_parse_ini(opt, x, where) for x in items]
@@ -162,7 +142,7 @@ def _from_ini(config: pytest.Config, opt: _Option, where: str) -> Any:
     text = str(raw).strip() if raw else ""
     if not text:
         return None
-    text = _expanded(opt, text, f"{opt.ini_name} in {where}")
+    text = _expanded(opt, text, f"{opt.row.ini_key} in {where}")
     if opt.name == "workspace" and config.inipath is not None:
         text = str(config.inipath.parent / text)  # relative to the ini file, as its paths are
     return _parse_ini(opt, text, where) if opt.parse is not None else text
@@ -192,7 +172,7 @@ def _parse_ini(opt: _Option, text: str, where: str) -> Any:
     try:
         return opt.parse(text)
     except argparse.ArgumentTypeError as err:
-        raise pytest.UsageError(f"{opt.ini_name} in {where}: {err}") from None
+        raise pytest.UsageError(f"{opt.row.ini_key} in {where}: {err}") from None
 
 
 def read_config(config: pytest.Config) -> HilConfig:
@@ -202,14 +182,14 @@ def read_config(config: pytest.Config) -> HilConfig:
     given: dict[str, str] = {}
     for opt in OPTIONS:
         value = config.getoption("hil_" + opt.name)
-        if opt.repeat:
+        if opt.row.repeat:
             value = tuple(value) or None
         elif isinstance(value, str):
-            value = _expanded(opt, value, opt.flag)
-        if value is None and opt.ini:
+            value = _expanded(opt, value, opt.row.hil_flag)
+        if value is None and opt.row.ini:
             value = _from_ini(config, opt, where)
             if value is not None:
-                given[opt.name] = f"{opt.ini_name} in {where}"
+                given[opt.name] = f"{opt.row.ini_key} in {where}"
         if value is not None:
             values[opt.name] = value
     return HilConfig(**values, given=given)
