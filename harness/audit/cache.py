@@ -1,10 +1,8 @@
 """Audits kept in the user's cache, so grading the same suite again costs nothing.
 
-An audit's outcome depends only on what the suite is (each scenario's
-content, not its file name), how it is judged (threshold, status regex,
-warning rule, per-scan timeout, link), the seeds, and the mistake library
-itself; the key is a hash of all of them and of the harness's version. A
-cached audit is only ever a shortcut: anything unreadable is a miss.
+The key hashes all the outcome depends on: each scenario's content (not its
+name), how it is judged, the seeds, the mistake library and the harness's
+version. A cached audit is only a shortcut: anything unreadable is a miss.
 """
 
 from __future__ import annotations

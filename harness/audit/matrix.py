@@ -1,17 +1,10 @@
 """The kill matrix: which scenario catches which mistake, reliably (pure).
 
-A mutant is killed by a scenario when it failed it (FAIL or ERROR) in every
-seed's suite; a pair that failed in some seeds and passed in others is a
-flip: a verdict that depends on luck, reported, never counted as a kill. A
-scenario the correct node does not pass every time kills nothing: its
-failures say nothing about the mistakes.
-
-What could not run is neither a kill nor a pass: a unit (a mutant, or the
-correct control) that did not finish, a scenario a mutant's suite did not
-run, or a mutant's failure in a scenario the correct node could not run
-(so nothing says the scenario is sound). Such a mutant is an error, with
-why; it is no survivor (nothing says the suite lets it pass), and the score
-counts only the mutants that were judged.
+A kill is a failure (FAIL or ERROR) in every seed's suite; a pair that
+fails only in some seeds is a flip, reported, never a kill; a scenario the
+correct node does not always pass kills nothing. What could not run is
+neither kill nor pass: such a mutant is an error, with why, no survivor,
+and the score counts only the mutants judged (docs/audit.md).
 """
 
 from __future__ import annotations

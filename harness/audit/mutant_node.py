@@ -1,21 +1,13 @@
 #!/usr/bin/env python3
 """A Lab 07 node that makes one typical mistake, chosen by name (the audit's mutants).
 
-Run as ``python3 mutant_node.py NAME --ros-args -p threshold:=0.4 ...``.
-``correct`` is the control: the right node, written the same way. Every
-other name in ``MUTANT_NAMES`` is one mistake made on that same node
-(harness/audit/mutants.py says what each does wrong and what catches it).
-Search this file for a name to find the lines that make its mistake; every
-other line is the correct node.
-
-The node subscribes to ``lidar_topic`` (sensor_msgs/LaserScan), publishes
-the nearest valid return as a String on ``lidar_status_topic`` and a Bool
-warning on ``warning_topic`` (True below ``threshold`` metres), once per
-scan, the Bool first. Valid, as REP-117 says: finite and range_min <= r <=
-range_max; the angle of beam i is angle_min + i * angle_increment.
-
-It imports only rclpy, the message packages, numpy and the standard
-library: it runs as a student's node does, in a process of its own.
+Run as ``python3 mutant_node.py NAME --ros-args -p threshold:=0.4 ...``;
+``correct`` is the control. Search this file for a name to find the lines
+that make its mistake (harness/audit/mutants.py says what each does wrong);
+every other line is the correct node: the nearest valid return (REP-117)
+as a String and a Bool warning below ``threshold``, once per scan, the Bool
+first. Only rclpy, the message packages, numpy and the standard library:
+it runs as a student's node does, in a process of its own.
 """
 
 import math

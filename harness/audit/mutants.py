@@ -1,13 +1,8 @@
 """The catalogue of typical Lab 07 mistakes ("mutants") the audit runs (pure).
 
-Each mutant is one mistake students make, made on an otherwise correct node:
-``mutant_node.py`` beside this module is that node, the mistake chosen by
-its first argument (``mutant_command`` builds the command line). A suite
-that is worth its salt fails every mutant in at least one scenario; a
-mutant that passes every scenario shows a mistake the suite cannot see.
-
-``CONTROL`` (``correct``) is the same node with no mistake: it must pass.
-Neither rclpy nor pybullet is imported here.
+Each is one mistake made on an otherwise correct node (``mutant_node.py``,
+the mistake chosen by its first argument; ``mutant_command``). A suite
+worth its salt fails every mutant somewhere; ``CONTROL`` must pass.
 """
 
 from __future__ import annotations

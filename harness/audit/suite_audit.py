@@ -95,12 +95,13 @@ def audit_suite(
 
 
 def batches(units: Sequence[AuditUnit], count: int) -> list[tuple[AuditUnit, ...]]:
-    """`units` in at most `count` batches of about equal expected cost (`unit_cost`), the
-    costliest batch first and in each batch the costliest unit first: each unit in turn,
-    costliest first, joins the batch with the least cost so far (ties: the first), so the
-    mistakes that wait out deadlines spread over the batches and quick ones even them
-    out. Deterministic: the same units give the same batches. One batch shares one worker
-    process and its warm Python, so the fewer batches, the less start-up."""
+    """`units` in at most `count` batches of about equal expected cost (`unit_cost`).
+
+    Costliest first, each unit joins the batch with the least cost so far, so
+    the mistakes that wait out deadlines spread out and quick ones even them;
+    the same units give the same batches. A batch shares one warm worker
+    process, so the fewer batches, the less start-up.
+    """
     count = max(1, min(count, len(units)))
     loads = [0.0] * count
     chosen: list[list[AuditUnit]] = [[] for _ in range(count)]

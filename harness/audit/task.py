@@ -1,14 +1,9 @@
 """A batch of audit units as a Dask task: mutants (or the correct control) through the suite.
 
-The task runs ``harness.audit.worker`` as a bounded child process (as
-``grade`` runs a student's suite), so the nodes start by fork from the
-child's main thread (its warm Python started once for the batch, not once
-per mutant). Each unit's failure is its own: the worker bounds each unit in
-time and records a unit that cannot run (a usage error of its node, an
-error of the harness) as that unit's error, then runs the next; should the
-worker process itself die, the unit it was running gets the reason and the
-units it had not started run in a fresh worker. Everything the task needs
-travels with it, so any worker can take it.
+It runs ``harness.audit.worker`` as a bounded child process (as ``grade``
+does a student's), whose main thread forks the nodes from one warm Python
+per batch. Each unit's failure is its own; should the worker die, the unit
+it was running gets the reason and the rest run in a fresh worker.
 """
 
 from __future__ import annotations

@@ -1,20 +1,13 @@
-"""A batch of mutants through the audited suite, each once per seed:
-``python -m harness.audit.worker JOB``.
+"""A batch of mutants through the audited suite, each once per seed.
 
-Its own process, as a student's suite in ``grade`` is: its main thread may
-start the nodes by fork from a warm Python (a Dask worker's thread may not;
-the warm Python is started once for the batch). JOB is a JSON file
-(``write_job``) naming each mutant's node command, the scenarios, the link,
-the LinkOptions and RunSettings fields, the seeds, each unit's time bound,
-and where ``results.json`` goes; it is rewritten (atomically) when a unit
-starts and after every suite, so a batch stopped at its time limit still
-tells what it judged and which unit it was running.
-
-Each unit's failure is its own: a unit past its bound is stopped as SIGTERM
-stops a suite (its nodes stopped, its links closed), a unit whose node is a
-usage error (a ConfigError) or that meets an error of the harness gets that
-as its error, and the next unit runs. Only a scenario the worker cannot
-resolve, or a SIGTERM from the command, ends the batch.
+``python -m harness.audit.worker JOB``: its own process, so its main thread
+may fork the nodes from a warm Python (a Dask worker's thread may not).
+JOB (``write_job``) says what to run; ``results.json`` is rewritten
+atomically as each unit starts and after each suite, so a batch stopped at
+its limit still tells what it judged. A unit past its bound is stopped as
+SIGTERM stops a suite, one whose node is a usage error gets that as its
+error, and the next runs; only an unresolved scenario or the command's
+SIGTERM ends the batch.
 """
 
 from __future__ import annotations
@@ -55,10 +48,7 @@ def write_job(
     unit_timeout: float,
     overrides: dict[str, dict[str, dict[str, Any]]] | None = None,
 ) -> Path:
-    """Write a job file for this worker: each mutant's node command by name, LinkOptions and
-    RunSettings as their fields, which unit's runs give the reading coverage, each unit's
-    bound in seconds, and what a unit runs with of its own (`overrides`: by name, its
-    "settings": RunSettings fields, e.g. a mutant's stop at its first failed tick)."""
+    """Write a job file: node commands, LinkOptions and RunSettings fields, bounds, overrides."""
     job = {
         "commands": commands,
         "overrides": overrides or {},
@@ -89,10 +79,12 @@ def _entry(result: Any) -> dict[str, Any]:
 
 
 class UnitClock:
-    """One unit's time bound, counted from its start: past it, the main thread gets the
-    KeyboardInterrupt a SIGTERM gives it, so the suite stops the unit's nodes and closes its
-    links, and the worker goes on with the next unit. A SIGTERM from outside (the command
-    stopping the batch) is told apart: no unit was overdue."""
+    """One unit's time bound, counted from its start.
+
+    Past it the main thread gets a SIGTERM's KeyboardInterrupt, so the suite
+    stops the unit's nodes and the worker goes on; a SIGTERM from outside is
+    told apart (no unit was overdue).
+    """
 
     def __init__(self, seconds: float) -> None:
         self.seconds = seconds

@@ -1,23 +1,13 @@
 """Which factors a campaign's failures depend on, said in plain words (pure).
 
-``fossbot-hil sweep`` runs one node through every combination of scenario x
-fault profile x seed x threshold and writes one row per run. ``explain``
-reads those rows (as ``csv.DictReader`` gives them: every value may be a
-string) and returns a few lines, most telling first:
-
-* failures confined to some levels of one factor ("fails only with faults
-  drifting_rate: 12 of 20 runs there failed, 0 of 60 elsewhere"), for the
-  threshold and generated variations (``varied``: wall_distance, speed, ...)
-  as an ordered range ("fails only when threshold <= 0.2");
-* failures confined to a combination of two factors when that says more
-  than any single factor does;
-* "fails at every level of every factor" when nothing narrows them down;
-* then the totals and a line per factor with its failure rate per level.
-
-Seeds are numbers but carry no order that means anything, so they only
-ever say "some seeds" or "every seed". An ERROR counts as a failure and is
-named separately in the counts; any verdict other than PASS, FAIL or ERROR
-is taken as an ERROR (a run that does not say it passed did not pass).
+``explain`` reads the rows as ``csv.DictReader`` gives them (any value may
+be a string) and says, most telling first: failures confined to levels of
+one factor (an ordered range for the threshold and the variations), or to
+a pair of factors when that says more, or "every level of every factor";
+then the totals and each factor's rate per level (docs/campaigns.md).
+Seeds carry no meaningful order: "some seeds" or "every seed". A verdict
+that is not PASS or FAIL counts as an ERROR, a failure named apart (a run
+that does not say it passed did not pass).
 """
 
 from __future__ import annotations
@@ -365,11 +355,7 @@ def _tally_sum(tallies: Iterable[_Tally]) -> _Tally:
 def explain(
     rows: Iterable[Mapping[str, str | int | float | None]], varied: Sequence[str] = ()
 ) -> list[str]:
-    """The summary lines of a campaign, most telling first, each one line with counts.
-
-    `varied`: the columns of generated scenario variations (wall_distance,
-    speed, ...), factors like the others and ordered like the threshold.
-    """
+    """A campaign's summary lines, most telling first; `varied` ordered like the threshold."""
     factors: Factors = (*FACTORS, *varied)
     runs = _runs(rows, factors)
     total = _tally(runs)

@@ -1,10 +1,8 @@
 """One campaign run, as a Dask task: it runs on a worker and returns its row.
 
-Everything it needs travels with it (the run's levels and the node
-options), so any worker on any machine can take it; the link starts the
-node in its own process group and ROS domain there, and the run is bounded
-by the scenario's own deadlines, so a hanging node ends the run, not the
-campaign.
+It carries all it needs, so any worker can take it; the node runs in its
+own process group and ROS domain, bounded by the scenario's own deadlines,
+so a hanging node ends the run, not the campaign.
 """
 
 from __future__ import annotations

@@ -1,23 +1,11 @@
 """How close a run came to failing, and how it failed (pure).
 
-A hunt minimises the margin of its runs. A run that failed has a margin
-below 0; a run that passed has the mean of three closenesses, each the
-smallest over its ticks and clipped to [0, 1]:
-
-* the answer's closeness to its tolerance: 1 - the larger of the distance
-  error and the angle error beyond what printing explains, each divided by
-  the rest of the oracle's tolerance (0: an answer at the edge of what is
-  accepted, such as the angle of the next beam; 1 for a right answer);
-* the nearest return's distance from the warning threshold, divided by the
-  threshold (0: at the threshold, where a comparison written the wrong way,
-  or against a rounded or hard-coded number, goes wrong; 1 with no return);
-* ten times the share of the scan's beams holding a valid return (0:
-  nothing in range, the scan a node that assumes an obstacle mishandles).
-
-The mean, not the smallest, so that no one of them (nothing in range is
-easy to reach) holds the search; each still pulls it toward its edge.
-The way a run failed (``kinds``) names what its
-first failing tick got wrong, so shrinking keeps a failure of the same kind.
+A hunt minimises the margin: below 0 for a failed run; for a passed one the
+mean of three closenesses, each its ticks' smallest in [0, 1] (the answer
+to its tolerance, the nearest return to the threshold, the share of valid
+beams; docs/hunt.md). The mean, not the least, so no one of them (nothing in
+range is easy to reach) holds the search. ``kinds`` names what the first
+failing tick got wrong, so shrinking keeps a failure of the same kind.
 """
 
 from __future__ import annotations

@@ -1,17 +1,9 @@
-"""The hunt itself: ask an optimiser for candidates, run them in batches, keep the first
-failure that fails again, then shrink it.
+"""The hunt: an optimiser's candidates run in batches, the first failure confirmed and shrunk.
 
-Optuna's TPE sampler (seeded) proposes candidates and learns from each
-run's margin (``harness.hunt.margin``), so it homes in on scans where the
-node's answers come close to failing; after ``RESTART_AFTER`` runs without
-a smaller margin it starts afresh (a new study, its seed derived from the
-hunt's), so one narrow valley cannot hold it. Runs go in batches of a fixed
-size whatever the number of workers, and each batch is told to the
-optimiser in order, so the same seed gives the same hunt on any cluster.
-
-``run_batch`` runs candidates and returns their outcomes in order (the
-command gives a Dask one); ``feasible`` turns a proposal into the candidate
-that will run, or None when it makes no valid scenario.
+Optuna's seeded TPE learns from each run's margin; after ``RESTART_AFTER``
+runs without a smaller one it starts a fresh study, so one narrow valley
+cannot hold it. Batches have a fixed size whatever the workers and are told
+to the optimiser in order, so one seed gives one hunt on any cluster.
 """
 
 from __future__ import annotations

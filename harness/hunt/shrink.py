@@ -1,11 +1,8 @@
 """Simpler versions of a failing candidate, simplest change first (pure).
 
-Shrinking tries these one round at a time and keeps the first that still
-fails the same way, then starts the next round from it; it ends when no
-simpler version fails. "Simpler", in the order tried: no sensor fault, the
-REP-117 convention, no obstacle, standing still, a shorter run, the Gazebo
-preset, then rounder numbers (a threshold of 0.5, a wall straight ahead, a
-distance in tenths).
+Each round keeps the first that still fails the same way; shrinking ends
+when none does. The order: no sensor fault, REP-117, no obstacle, standing
+still, a shorter run, the Gazebo preset, rounder numbers.
 """
 
 from __future__ import annotations

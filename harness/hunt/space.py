@@ -1,17 +1,10 @@
 """The scenarios a hunt searches: one point of the space is one short scenario (pure).
 
-A point (``Candidate``) is at most one obstacle placed relative to the
-robot's start (kind, distance, bearing, size), one motion segment
-(standing, straight, reverse, turning; speed, duration), the LIDAR preset
-(angle_min -pi or 0), the driver's convention for "no return" (+inf, 0.0,
-NaN), at most one sensor fault, and the warning threshold. ``suggest``
-draws one from an optimiser's trial (optuna's ``Trial`` interface, duck
-typed), ``scenario_document`` turns one into a scenario file's contents.
-
-Motion never drives the robot into its obstacle: a straight, reverse or
-turning segment is cut short where the robot's own outline (from its URDF)
-would come within ``CLEARANCE_M`` of it, so every generated scenario is one
-a real robot could drive.
+A ``Candidate`` is at most one obstacle relative to the start, one motion
+segment, the LIDAR preset, the driver's convention, at most one sensor
+fault and the threshold; ``suggest`` draws one from an optimiser's trial
+(duck typed). Motion is cut short where the robot's outline would come
+within ``CLEARANCE_M`` of the obstacle, so a real robot could drive it.
 """
 
 from __future__ import annotations

@@ -1,9 +1,7 @@
 """One hunt run, as a Dask task: a candidate scenario through the node, assessed.
 
-Like a campaign's runs, it carries everything it needs (the candidate, the
-link's options, the judging settings), starts the node in its own process
-group and ROS domain on whatever worker takes it, and is bounded by the
-scenario's own deadlines.
+It carries all it needs and starts the node in its own process group and
+ROS domain on any worker, bounded by the scenario's own deadlines.
 """
 
 from __future__ import annotations
