@@ -1,21 +1,12 @@
 """An animated top-down view of one scenario run (GIF): evidence that a node works.
 
 Students used to hand in screen recordings of Gazebo, which show the world
-but not what the node said. Each frame here shows, from above, the world
-(walls, boxes and cylinders; a model as a labelled marker, its shape not
-drawn), the robot's rigid body at its pose, the returns of the scan the node
-saw (valid ones blue, finite ones outside [range_min, range_max] grey), the
-nearest valid return and its ray, where the node's status puts the nearest
-obstacle, the threshold around the LIDAR; below the map the time and tick,
-the node's status, its warning lamp, what a correct node says and the
-tick's verdict with its first failure.
-
-Bounded, so `fossbot-hil run --out DIR --animate` stays cheap: at most
-`MAX_FRAMES` (150) frames, a longer run subsampled evenly (its first failed
-tick always shown); 480 x 448 px; played in simulated time, at 4 to 20
-frames a second. A scenario's GIF is a few hundred kB and takes a few
-seconds. Deterministic: the same run gives the same bytes. matplotlib is
-imported only when drawing (Agg, no display).
+but not what the node said. Each frame shows the world, the robot, the scan
+the node saw, where its status puts the nearest obstacle, and below the map
+its status, warning lamp, what a correct node says and the tick's verdict.
+Bounded, so `run --animate` stays cheap: at most `MAX_FRAMES` frames (the
+first failed tick always among them), played in simulated time. The same
+run gives the same bytes; matplotlib is imported only when drawing.
 """
 
 from __future__ import annotations
@@ -198,12 +189,9 @@ def _draw_world(ax: Axes, scenario: Scenario) -> None:
 
 
 class _View:
-    """The figure and the artists that change from frame to frame.
-
-    With `blit` the rest (axes, ticks, world, legend) is drawn once and each
-    frame draws only what changed over a copy of it: ten times faster, and
-    text is most of the cost. Without (an .mp4), the writer redraws it all.
-    """
+    """The figure and the artists that change from frame to frame; with `blit` the rest is
+    drawn once and each frame only what changed over a copy (ten times faster; an .mp4's
+    writer redraws it all)."""
 
     def __init__(
         self, result: RunResult, scenario: Scenario, records: Sequence[TickRecord], blit: bool
@@ -466,12 +454,8 @@ def _render(result: RunResult, scenario: Scenario, path: Path, limit: int) -> No
 def write_animation(
     result: RunResult, scenario: Scenario, path: str | Path, *, max_frames: int = MAX_FRAMES
 ) -> Path:
-    """Write the animated top-down view of `result`, a run of `scenario`, to `path`.
-
-    `.gif` (Pillow); `.mp4` only where matplotlib finds ffmpeg, else a
-    one-line ConfigError, as for any other suffix. At most `max_frames`
-    frames: a longer run is subsampled evenly. Written atomically.
-    """
+    """Write the animated top-down view of `result`, a run of `scenario`, to `path`
+    atomically: `.gif`, or `.mp4` where matplotlib finds ffmpeg (else a ConfigError)."""
     target = Path(path)
     _movie_writer(target, MIN_FPS)  # a bad suffix fails before anything is drawn
     limit = max(1, max_frames)

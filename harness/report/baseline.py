@@ -1,21 +1,11 @@
 """Verdicts compared with an earlier run's summary.json (`fossbot-hil run --baseline`), pure.
 
 A node improved step by step fails some scenarios for weeks; CI should
-still catch the day a scenario that passed starts failing. So each
-scenario of this run is matched with the baseline's entry of the same
-scenario and fault profile, and called:
-
-- ``regressed``: passed then, fails now;
-- ``fixed``: failed then, passes now;
-- ``still failing`` / ``still passing``: the same verdict class both times;
-- ``new``: not in the baseline;
-- ``not compared``: in the baseline, but judged differently there (another
-  threshold, seed or link), so its verdict then says nothing about now;
-- ``missing``: in the baseline, not run now.
-
-A baseline written by another harness version is still compared, and says
-so. `--fail-on regression` fails a run only for a failure that is not
-known: a regression, or a failing scenario with nothing to compare with.
+still catch the day a scenario that passed starts failing. Each scenario is
+matched with the baseline's of the same scenario and fault profile and
+given one of ``KINDS`` (docs/ci.md); one judged differently there (another
+threshold, seed or link) is ``not compared``: its verdict then says nothing
+about now. `--fail-on regression` fails a run only for a failure not known.
 """
 
 from __future__ import annotations
@@ -77,11 +67,8 @@ class Baseline:
 
 
 def load_baseline(path: str) -> Baseline:
-    """Read and check `path` (a summary.json, or the report folder holding one).
-
-    ConfigError, one line naming the file, when it is missing or is not a
-    summary that `fossbot-hil run --out` writes.
-    """
+    """Read and check `path` (a summary.json, or the report folder holding one): a
+    ConfigError naming the file when it is missing or not one `run --out` writes."""
     file = Path(path)
     folder = file.is_dir()
     if folder:

@@ -1,11 +1,8 @@
 """index.html: the run on one page, readable offline and from a CI artifact.
 
-Each scenario's section shows its plot and, with `--animate`, its animation.
-
-Built from summary.json's data (so the page and the file cannot disagree),
-plain HTML with inline CSS, no scripts. All text is escaped, with every
-non-printable character shown as its escape (harness.safe_text): scenario
-names, status strings and a node's output come from users and students.
+Built from summary.json's data, so the page and the file cannot disagree;
+no scripts. All text is escaped (safe_text): names, statuses and a node's
+output come from users and students.
 """
 
 from __future__ import annotations

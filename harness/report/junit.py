@@ -1,15 +1,9 @@
 """JUnit XML: one test case per scenario, the oracle's explanation as the failure.
 
-Each case carries properties: the run's settings and counts, the first
-failure's explanation (`explanation`, when the scenario did not pass) and
-the files written for it (`plot`, `recording`, `summary`, when written).
-File paths are relative to the folder holding the XML file, so a CI
-artifact with the report folder keeps its links; without a known folder
-they are absolute.
-
-Every text is made valid XML 1.0 and harmless on a terminal (a node's
-stderr may hold escape sequences or NUL) and bounded in length
-(harness.safe_text).
+Properties name the run's settings, the explanation and the files written;
+paths are relative to the XML file's folder, so a CI artifact keeps its
+links. Every text is valid XML 1.0, harmless on a terminal and bounded (a
+node's stderr may hold escape sequences or NUL).
 """
 
 from __future__ import annotations
@@ -42,11 +36,8 @@ def junit_xml(
     artifacts: Sequence[Mapping[str, Path]] | None = None,
     base: Path | None = None,
 ) -> bytes:
-    """The report as bytes (CI systems read `failure/@message` and the properties).
-
-    `artifacts[i]` names the files written for `results[i]` (name -> path);
-    `base` is the folder the XML file will live in.
-    """
+    """The report as bytes (CI reads `failure/@message` and the properties); `artifacts[i]`
+    names `results[i]`'s files, `base` is the XML file's folder (None: absolute paths)."""
     if artifacts is not None and len(artifacts) != len(results):
         raise ValueError("junit_xml: one artifacts mapping per result")
     verdicts = [verdict_of(r) for r in results]  # the table's words: FAIL and ERROR as there

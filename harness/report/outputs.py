@@ -1,20 +1,10 @@
-"""The report folder (`fossbot-hil run --out DIR`): per-scenario files, then the run's.
+"""The report folder (`fossbot-hil run --out DIR`, docs/reports.md): per-scenario files,
+then the run's.
 
-Layout (docs/reports.md)::
-
-    DIR/summary.json  junit.xml  index.html
-    DIR/scenarios/<name>.png  <name>.mcap  <name>.json  (<name>.gif with --animate)
-
-Per-scenario artifacts come from a short list of writers, each
-``(name, suffix, write(path, result) -> Path)``: adding a kind of file is
-one entry in ``artifact_writers``. A file drawn from the scenario's world
-too (the animation) is a ``WorldArtifactWriter``, whose `write` also takes
-the Scenario; it is written when ``add`` is given one. Every file lands
-atomically: a writer writes a hidden temporary file beside the final name,
-which is renamed over it only once the writer returned, so an interrupted
-run never leaves half a file under its final name. Paths inside a report
-file are relative to the folder of that file, so the folder can be moved or
-archived whole.
+Adding a kind of per-scenario file is one entry in ``artifact_writers``.
+Every file lands atomically, so an interrupted run never leaves half a file
+under its final name; paths inside a report file are relative to its
+folder, so the folder can be moved or archived whole.
 """
 
 from __future__ import annotations
@@ -125,11 +115,8 @@ def _write_recording(path: Path, result: RunResult) -> Path:
 
 
 def prepare_folder(path: str | Path) -> Path:
-    """Create the report folder (and its parents) now, before anything runs.
-
-    ConfigError, one line, when `path` is a file or cannot be created or
-    written.
-    """
+    """Create the report folder (and its parents) now, before anything runs: a
+    ConfigError when it cannot be made or written."""
     folder = Path(path)
     if folder.exists() and not folder.is_dir():
         raise ConfigError(f"{path}: exists and is not a folder")
@@ -154,12 +141,8 @@ def safe_stem(name: str) -> str:
 def _write_via_temporary(
     writer: Writer, final: Path, result: RunResult, scenario: Scenario | None
 ) -> Path | None:
-    """Run `writer` on a hidden temporary file, then rename it to `final` (atomic).
-
-    A writer that returns another path chose its own; it answers for it.
-    None: a world writer without the scenario, so nothing written. A promised file is
-    left to its writer (it lands atomically where another process writes it).
-    """
+    """Run `writer` on a hidden temporary file, then rename it to `final`; None for a
+    world writer without its scenario. A promised file is left to its writer."""
     if isinstance(writer, PromisedArtifactWriter):
         return writer.write(final, result)
     if isinstance(writer, ArtifactWriter):
@@ -176,12 +159,8 @@ def _write_via_temporary(
 
 
 def stored(result: RunResult) -> RunResult:
-    """`result` as report files keep it: its texts bounded and storable as UTF-8.
-
-    Tick records are bounded when judged (harness.runner); the run's own
-    texts come from the node too (its error, its output tails and the
-    graph's topic names) and are bounded here.
-    """
+    """`result` as report files keep it: the run's own texts, from the node too, bounded
+    and storable as UTF-8 (tick records are bounded when judged)."""
     return replace(
         result,
         scenario=for_storage(result.scenario),
@@ -199,13 +178,8 @@ class ScenarioFiles:
 
 
 class ReportFolder:
-    """Fills a report folder: `add` each result as it finishes, then `finish`.
-
-    Writing per scenario as soon as it ends keeps the plots of finished
-    scenarios when a later one hangs or the run is interrupted. The folder
-    is locked from here until `finish` or `close` (report.folder_lock): a
-    second run on it is refused with a ConfigError naming this one.
-    """
+    """Fills a report folder, locked until `finish` or `close`: `add` each result as it
+    finishes (a later scenario that hangs keeps the earlier plots), then `finish`."""
 
     def __init__(self, root: str | Path, writers: Sequence[Writer] | None = None) -> None:
         self.root = prepare_folder(root)
@@ -226,10 +200,8 @@ class ReportFolder:
         return stem
 
     def add(self, result: RunResult, scenario: Scenario | None = None) -> ScenarioFiles:
-        """Write this scenario's artifacts (none for a scenario with no ticks) and its JSON.
-
-        `scenario`, the one `result` ran, for the writers that draw its world.
-        """
+        """Write this scenario's artifacts (none without ticks) and its JSON; `scenario`,
+        the one `result` ran, for the writers that draw its world."""
         folder = self.root / SCENARIO_FOLDER
         result = stored(result)
         stem = self._stem(result.scenario)

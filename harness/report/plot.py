@@ -19,6 +19,7 @@ import numpy as np
 from harness.atomic_write import write_atomically
 from harness.judge.records import RunResult
 from harness.judge.verdicts import verdict_of
+from harness.lidar.scan import Scan
 from harness.safe_text import visible
 
 __all__ = [
@@ -110,12 +111,10 @@ def series_from_data(data: dict[str, Any]) -> PlotSeries:
     return PlotSeries(title=title, threshold=threshold, **arrays)
 
 
-def _nearest_valid(ranges: np.ndarray, range_min: float, range_max: float) -> float:
-    """REP-117: the smallest finite reading within [range_min, range_max], else NaN."""
-    r = np.asarray(ranges, dtype=np.float32)
-    with np.errstate(invalid="ignore"):
-        valid = np.isfinite(r) & (r >= range_min) & (r <= range_max)
-    return float(r[valid].min()) if valid.any() else math.nan
+def _nearest_valid(scan: Scan) -> float:
+    """The smallest valid reading (REP-117), else NaN."""
+    valid = scan.valid_mask()
+    return float(scan.ranges[valid].min()) if valid.any() else math.nan
 
 
 def _flag(value: bool | None) -> float:
@@ -148,7 +147,7 @@ def plot_series(result: RunResult) -> PlotSeries:
     records = sorted(result.records, key=lambda r: r.t)
     for r in records:
         seen = r.answers.seen if r.answers.seen is not None else r.scan
-        nearest.append(_nearest_valid(seen.ranges, seen.range_min, seen.range_max))
+        nearest.append(_nearest_valid(seen))
         claim = r.verdict.claim
         d = claim.distance if claim is not None and claim.obstacle else None
         finite = d is not None and math.isfinite(d)

@@ -1,11 +1,9 @@
 """What an earlier run left in a reused report folder, so a new run can clear it.
 
-A report folder reused by ``--out`` must not keep the files of scenarios
-the new run does not have beside an index.html that no longer lists them.
-The earlier run's summary.json names every file it wrote; those files (and
-only those: the folder may hold the user's own) are what the new run owns
-and removes before it writes. Paths are checked to stay inside the
-folder's ``scenarios/``, so a tampered summary cannot delete anything else.
+Old scenarios' files must not stay beside an index.html that no longer
+lists them. Only the files the earlier summary.json names go (the folder
+may hold the user's own), and only inside ``scenarios/``, so a tampered
+summary cannot delete anything else.
 """
 
 from __future__ import annotations

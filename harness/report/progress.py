@@ -30,11 +30,8 @@ SINGLE_SCENARIO_DELAY_S = 1.0  # one scenario: show the bar only once it takes t
 
 
 class RunProgress:
-    """Feed it run_suite's on_tick/on_result; it draws scenarios done, ticks, failures.
-
-    Several scenarios: shown from the start. One scenario: shown once it has
-    run for `delay` seconds, so quick runs never flash a bar.
-    """
+    """Feed it run_suite's on_tick/on_result; it draws scenarios done, ticks, failures,
+    one scenario's only after `delay` seconds, so quick runs never flash a bar."""
 
     def __init__(
         self,

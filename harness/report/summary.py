@@ -184,14 +184,9 @@ def run_summary(
     alignment_mode: str = "warn",
     coverage: dict[str, Any] | None = None,
 ) -> dict[str, Any]:
-    """summary.json: totals first (what CI checks), then every scenario.
-
-    `wall_s` is the command's wall time, when known; otherwise the sum of
-    what each scenario cost. `alignment`, the fit of the board's /scan
-    against the truth (serial links); with `alignment_mode` "fail" a
-    misaligned one makes the run not `ok`, as it makes the exit code 1.
-    `coverage`, the readings the suite delivered (`coverage_entry`).
-    """
+    """summary.json: totals first (what CI checks), then every scenario. `wall_s` is the
+    command's wall time (else the scenarios' sum); a misaligned board's /scan with
+    `alignment_mode` "fail" makes the run not `ok`, as it makes the exit code 1."""
     passed = sum(1 for e in entries if e["ok"])
     return {
         "format": FORMAT,

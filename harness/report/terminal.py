@@ -56,13 +56,9 @@ def scenario_table(scenarios: Sequence[Scenario]) -> Table:
 
 
 def results_table(results: Sequence[RunResult], wall_s: float | None = None) -> Table:
-    """`fossbot-hil run`: scenario / ticks / failed / verdict / time, and a total row.
-
-    A scenario's time is what it cost the run: waiting for the software
-    under test to come up, the run itself and waiting for it to stop (work
-    done ahead or behind, while another scenario ran, is not counted twice).
-    The total row gives the command's wall time when known.
-    """
+    """`fossbot-hil run`: scenario / ticks / failed / verdict / time, and a total row (the
+    command's wall time when known). A scenario's time is what it cost the run: start,
+    run and stop of the software under test, work overlapping another scenario once."""
     table = Table(box=None, pad_edge=False)
     for column in ("scenario", "link", "ticks", "failed", "verdict", "time s"):
         table.add_column(
