@@ -1,22 +1,11 @@
 """Stage 'suite': scenarios end to end over ROS 2, node start-up included.
 
-``lab_suite_wall_s`` is ``runner.run_suite`` over the lab's three scenarios
-in this process, as the CLI and the pytest plugin run them; its CLI figure
-(``lab_suite_cli_wall_s``) is ``fossbot-hil run`` with the three names, from
-spawn to exit.
-
-``suite_s`` is what a user waits for after an edit: ``fossbot-hil run`` (all
-shipped scenarios, the bundled reference node, a fresh process, interpreter
-start included), the median of a few runs. ``student_suite_s`` is the same
-command against the lab's package built in a colcon workspace of its own
-(``--workspace``: what a student runs), and ``inprocess_suite_s`` the same
-with ``--link inprocess`` (no ROS, no node process): the three take turns,
-so their ratios (``student_suite_ratio``, ``inprocess_suite_ratio``) hold
-under a changing load. Their split comes from the same scenarios run in
-this process: waiting for nodes to come up (``suite_startup_s``), ticking
-(``suite_ticking_s``: simulating, exchanging, judging), waiting for nodes to
-stop (``suite_stop_s``); ``suite_process_s`` is the rest of the command
-(interpreter start, imports, output, exit); ``student_suite_*`` likewise.
+The lab trio through ``runner.run_suite`` in this process and as a command;
+then what a user waits for after an edit, ``fossbot-hil run`` from spawn to
+exit with the bundled node, a colcon workspace's node and the inprocess
+link, taking turns so their ratios hold under a changing load; and where
+the time goes, from the same scenarios run in this process. Each figure is
+defined in docs/benchmarks.md.
 """
 
 from __future__ import annotations

@@ -1,12 +1,9 @@
 """The lab's node package in a colcon workspace of its own, as a student's workspace holds it.
 
 The bench times ``fossbot-hil run --workspace`` against the bundled node, so
-the workspace is what a student has after following the lab: the package
-copied into ``src/`` and ``colcon build`` run there. It needs the
-repository's ``node/`` folder beside the harness (a source checkout) and
-colcon (the ``test`` extra's colcon-common-extensions); without either the
-bench says so instead of timing something else. The build's own time is
-reported apart: a student builds once, then runs many times.
+the workspace is what a student has after following the lab. It needs a
+source checkout and colcon; without either the bench says so instead of
+timing something else. The build is timed apart: a student builds once.
 """
 
 from __future__ import annotations
@@ -66,12 +63,8 @@ class LabWorkspace:
 
 
 def lab_package_source(harness_dir: Path | None = None) -> Path:
-    """node/fossbot_lidar_processing of the checkout the harness runs from (an editable
-    install), else of the checkout the bench runs in (the working folder).
-
-    `harness_dir` is the harness package's folder (default: the one imported).
-    An installed wheel run elsewhere has neither: HarnessError says so.
-    """
+    """node/fossbot_lidar_processing of the checkout the harness (`harness_dir`) runs
+    from, else of the working folder; an installed wheel run elsewhere has neither."""
     here = (harness_dir or Path(harness.__file__).parent).resolve()
     for root in (here.parent, Path.cwd()):
         source = root / "node" / LAB_PACKAGE

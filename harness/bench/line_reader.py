@@ -1,15 +1,10 @@
 """The board's end of a paced serial line, in its own process, timing what arrives.
 
-Run as ``python -m harness.bench.line_reader PTY SECONDS``: opens the pty's
-slave, sends an RPLIDAR SCAN request, and reads until the line closes or
-SECONDS pass, recording the monotonic time and size of every read. Prints
-one JSON object: ``{"reads": [[t, n], ...], "data": "<hex>", "realtime": bool}``.
-A separate process, as the board's driver is: the harness's threads (and its
-GIL) do not delay the reads it times. Where the system allows it, the
-reader runs under SCHED_FIFO (``harness.serial_line.realtime_priority``), as a board's
-UART interrupt would: then its read times are the line's, not the moments
-the scheduler got round to waking it; ``realtime`` says whether it did.
-Standard library only, so it starts fast.
+``python -m harness.bench.line_reader PTY SECONDS`` sends a SCAN request and
+prints ``{"reads": [[t, n], ...], "data": "<hex>", "realtime": bool}``. A
+process of its own, as the board's driver is, so the harness's GIL does not
+delay the reads it times; under SCHED_FIFO where allowed (``realtime``), as
+a UART interrupt would, so the times are the line's, not the scheduler's.
 """
 
 from __future__ import annotations

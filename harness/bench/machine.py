@@ -53,12 +53,8 @@ def describe() -> dict[str, object]:
 
 
 def peak_rss_mb() -> float:
-    """Peak resident memory of this process (``ru_maxrss``), MB.
-
-    Not ``RUSAGE_CHILDREN``: a child started by fork and exec keeps the
-    parent's high-water mark from before its exec, so that figure only
-    mirrors the harness. The bench reads its node processes' own peaks
-    (``VmHWM``) instead, while they run.
-    """
+    """Peak resident memory of this process (``ru_maxrss``), MB. Not ``RUSAGE_CHILDREN``:
+    a forked child keeps the parent's mark from before its exec; the bench reads the
+    nodes' own ``VmHWM`` while they run."""
     scale = 1.0 if platform.system() == "Darwin" else 1024.0  # macOS reports bytes, Linux KiB
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * scale / 1e6

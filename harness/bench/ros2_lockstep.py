@@ -1,16 +1,10 @@
 """The ros2 stage: lockstep with the bundled reference node in its own process over Fast DDS.
 
-The link is opened (node started, graph matched: ``node_startup_s``), the
-first scan is exchanged once untimed, then the workload's scans go through
-the product's loop. The round trip of a scan is the link's own measure: from
-the scan's publish returning to the node's status String being taken by the
-harness (``Received.after`` of the first status), measured on its own by
-exchanging one scan 100 times before the timed run (in a run, the harness
-simulates the next scan while the node answers, which hides part of the
-round trip and delays taking the answer; that in-run figure is reported
-beside it). Three rounds on one open link, each measuring the ray-casting
-floor again just before it, so the overhead compares costs measured at
-the same moment.
+The round trip is measured alone, one scan exchanged 100 times: in a run
+the harness simulates the next scan while the node answers, which hides
+part of it (that in-run figure is reported beside). Three rounds on one
+open link, each measuring the ray-casting floor just before, so the
+overhead compares costs measured at the same moment.
 """
 
 from __future__ import annotations
@@ -72,12 +66,8 @@ def process_peak_rss_mb(pid: int | None) -> float | None:
 
 
 def ping_pong_s(link: Link, workload: Workload, count: int = PING_PONGS) -> list[float]:
-    """One DDS round trip, alone: the same scan exchanged `count` times, nothing between.
-
-    In a run the harness simulates the next scan while the node answers
-    (runner.judge_frames), so an answer is taken up to that long after it
-    arrived; the round trip the overhead is measured against is this one.
-    """
+    """One DDS round trip, alone: the same scan exchanged `count` times, nothing between
+    (the overhead's floor: in a run an answer waits while the next scan is simulated)."""
     with prepared_frames(workload) as frames:
         scan = replace(next(iter(frames)).scan, stamp=0.0)  # runs start at t = 0: no clock jump
     link.warm_up(scan)
@@ -149,13 +139,9 @@ def measure_link(
 ) -> StageResult:
     """Open `link_name` with the reference node, run the workload through it, close it.
 
-    With several `rounds` (each: the ping-pong, then the timed run, on the
-    same open link), the round whose time per scan is the median is
-    reported and the round trip is the median of all the exchanges: one
-    round slowed by the machine's other work then moves neither. With
-    `floor` (seconds of ray casting per scan), each round first measures
-    its floor, and the overhead is each round's own figure, the median
-    kept: floor, round trip and lockstep then share the machine's moment.
+    Of several `rounds` the median is kept, so one slowed by the machine's
+    other work moves nothing; with `floor` (ray casting s per scan) each
+    round measures its own, so floor, round trip and lockstep share a moment.
     """
     options = LinkOptions(threshold=workload.threshold, scan_rate_hz=workload.scan_rate_hz)
     link = create_link(link_name, options)

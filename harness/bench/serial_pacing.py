@@ -1,20 +1,12 @@
 """Stage 'pacing': real-time RPLIDAR streaming at 115200 baud over a pty, timed at both ends.
 
 A pty ignores the baud rate, so real-time emulation paces itself
-(``serial_line.pacing``). Here the device server streams a scenario's
-revolutions in realtime mode to a reader in another process (the board's
-end, ``line_reader``), which asks for a scan as a driver does and stamps
-every read. Figures, at the reader (what the board sees):
-
-- byte rate error: bytes per second inside each revolution's back-to-back
-  stretch, over the nominal 115200 / 10 bytes per second, minus 1, in %;
-- period jitter p99: nearest-rank p99 of |start-to-start interval - period|
-  of the revolutions' start nodes, in ms (with under 100 intervals, the
-  maximum: the full bench streams 300 revolutions), and the maximum beside it.
-
-The pacer's own view (write times) is reported beside them. Revolutions are
-handed over one period ahead of their slot, as a real-time producer should,
-so the figures are the line's, not the producer's.
+(``serial_line.pacing``). The device server streams a scenario's
+revolutions to ``line_reader`` in another process (the board's end); the
+byte rate error and the revolutions' period jitter are taken at the reader
+(what the board sees), the pacer's own view beside them. Revolutions are
+handed over one period ahead, as a real-time producer should, so the
+figures are the line's, not the producer's.
 """
 
 from __future__ import annotations

@@ -59,18 +59,10 @@ class LinkRun:
 def run_through(
     link: Link, workload: Workload, *, at_end: Callable[[], None] | None = None
 ) -> LinkRun:
-    """Judge the workload's chained frames through an opened `link`, timed.
-
-    The first scan is exchanged once as a warm-up before the clock starts
-    (judge_frames then sends it as its first tick: one more exchange, inside
-    the timing, as in every run). The clock stops at the last judged tick; `at_end` is
-    called then, e.g. to read the node's CPU time. The link's diagnostics
-    are not asked for (they stop a node process), so the link can run the
-    workload again.
-    Building and closing worlds between runs is taken out. CPU time is
-    taken over the same stretch: on a shared machine it moves less than
-    wall time.
-    """
+    """Judge the workload's chained frames through an opened `link`, timed from after a
+    warm-up exchange to the last judged tick (`at_end` is called then), worlds' set-up
+    taken out. No diagnostics (they stop a node), so the link can run it again; CPU time
+    beside, as on a shared machine it moves less than wall time."""
     oracle = workload.oracle()
     result = RunResult(
         scenario="+".join(s.name for s in workload.scenarios),

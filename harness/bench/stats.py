@@ -96,14 +96,9 @@ def read_times(reads: Sequence[tuple[float, int]], offsets: Sequence[int]) -> li
 def arrival_rate(
     reads: Sequence[tuple[float, int]], segments: Sequence[tuple[int, int]]
 ) -> float | None:
-    """Bytes per second inside busy stretches, as the reader saw them arrive.
-
-    `reads` are (time, bytes) of each read in order; `segments` are byte
-    ranges [start, end) sent back to back (one revolution each). For each,
-    the bytes that came between the first and the last read ending inside it
-    over the time between those reads; idle gaps between stretches never
-    count. None if no stretch had two reads.
-    """
+    """Bytes per second inside busy stretches, as the reader saw them arrive: for each
+    byte range [start, end) sent back to back, what came between its first and last read
+    (`reads`: (time, bytes) in order), so idle gaps never count; None without two reads."""
     ends = list(zip((t for t, _ in reads), accumulate(n for _, n in reads), strict=True))
     got_bytes = got_time = 0.0
     for lo, hi in segments:

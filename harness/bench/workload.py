@@ -79,16 +79,10 @@ def lab_workload(repeats: int = 1, names: Sequence[str] = LAB_TRIO) -> Workload:
 
 
 class FrameStream:
-    """The workload's frames, chained; iterate once.
-
-    Each run's simulation is built when the run starts and closed when it
-    ends, so one world is alive at a time, as in a real run (a PyBullet
-    client holds tens of MB). The time spent building and closing worlds is
-    kept in ``setup_s`` (wall) and ``setup_cpu_s`` (CPU), for the stages to
-    take out of their per-scan figures. Ticks and times run on across runs
-    (run 2's tick 0 follows run 1's last tick one scan time later), so
-    answers never look older than the scan.
-    """
+    """The workload's frames, chained; iterate once. One world alive at a time, as in a
+    real run; building and closing them is kept in ``setup_s`` and ``setup_cpu_s`` for
+    the stages to take out. Ticks and times run on across runs, so answers never look
+    older than their scan."""
 
     def __init__(self, workload: Workload) -> None:
         self.workload = workload
