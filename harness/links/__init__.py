@@ -13,8 +13,10 @@ link's class lives in its own module here and registers itself by name with
 ``@register``, checked against its row; ``create_link("ros2", options)``
 imports ``harness.links.ros2`` on demand, so the pure parts of the harness
 never import rclpy or pyserial. A new link is a row in ``kinds`` and a new
-module with a ``Link`` subclass (``base``); one from outside the harness
-calls ``kinds.declare``.
+module with a ``Link`` subclass (``base``), composing what links share
+(``node_graph``, ``node_exchange``) rather than subclassing another link; a
+new serial LIDAR's module registers its name with its device profile
+(``board.serial_lidar``). One from outside the harness calls ``kinds.declare``.
 """
 
 from harness import lazy_exports

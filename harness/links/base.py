@@ -65,13 +65,13 @@ class Link(ABC):
     # A scenario's node_topics are set through the node's topic parameters (the harness
     # publishes the scans itself, so it can publish them on any topic).
     sets_node_topics: ClassVar[bool] = False
+    node_start = ""  # how the node under test was started, for the user
 
     def __init__(self, options: LinkOptions) -> None:
         self.options = options
         # On a run-long device session: seconds between the previous scenario's last
         # judged revolution and this one's first (None where there is no session).
         self.gap_s: float | None = None
-        self.node_start = ""  # how the node under test was started, for the user
 
     @classmethod
     def run_session(cls, options: LinkOptions) -> AbstractContextManager[Any]:
@@ -168,6 +168,7 @@ class Link(ABC):
 
 _REGISTRY: dict[str, type[Link]] = {}
 L = TypeVar("L", bound=type[Link])
+M = TypeVar("M")
 
 
 def register(name: str) -> Callable[[L], L]:
@@ -175,24 +176,31 @@ def register(name: str) -> Callable[[L], L]:
     it: a class whose own ClassVars say otherwise than its row is refused."""
 
     def decorate(cls: L) -> L:
-        known = _REGISTRY.get(name)
-        if known is not None and _where(known) != _where(cls):  # a re-import may replace it
-            raise RuntimeError(f"link {name!r} is registered twice")
-        kind = link_kind(name)
-        if cls.serial_line != kind.serial_line:
-            raise RuntimeError(
-                f"link {name!r}: the class says serial_line={cls.serial_line}, "
-                f"harness.links.kinds says {kind.serial_line}"
-            )
-        cls.name = name
-        _REGISTRY[name] = cls
-        return cls
+        return add_link(name, cls)
 
     return decorate
 
 
-def _where(cls: type[Link]) -> str:
-    return f"{cls.__module__}.{cls.__qualname__}"
+def add_link(name: str, link: M) -> M:
+    """Make `link` (a ``Link`` class, or what makes links as one does: a serial LIDAR's
+    ``board.SerialLidar``) available under `name`, checked against its ``kinds`` row."""
+    known = _REGISTRY.get(name)
+    if known is not None and _where(known) != _where(link):  # a re-import may replace it
+        raise RuntimeError(f"link {name!r} is registered twice")
+    kind = link_kind(name)
+    serial_line = link.serial_line  # type: ignore[attr-defined]
+    if serial_line != kind.serial_line:
+        raise RuntimeError(
+            f"link {name!r}: the class says serial_line={serial_line}, "
+            f"harness.links.kinds says {kind.serial_line}"
+        )
+    link.name = name  # type: ignore[attr-defined]
+    _REGISTRY[name] = link  # type: ignore[assignment]
+    return link
+
+
+def _where(link: Any) -> str:
+    return f"{link.__module__}.{getattr(link, '__qualname__', '')}"
 
 
 def known_links() -> list[str]:

@@ -3,7 +3,7 @@
 A board's node hears scans before its scenario's first tick: the device
 streams from the moment the run's session opens, and between scenarios it
 keeps scanning the last world (``board_session.BoardSession.between``). A
-node started ahead of its turn (``BoardLink.links_ahead``) has been
+node started ahead of its turn (``board.SerialLidar.links_ahead``) has been
 answering that stream, on topics of its own, for a whole scenario. Before
 the first push the link makes sure the node is answering, lets it answer
 what the stream brought, and forgets those answers, so none is taken for
@@ -19,7 +19,7 @@ within a scenario.
 from __future__ import annotations
 
 import time
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 from harness.judge.answers import Answers
 from harness.nodes.quiescence import Quiescence
@@ -27,9 +27,8 @@ from harness.nodes.quiescence import Quiescence
 if TYPE_CHECKING:
     from collections.abc import Callable
 
-    from harness.lidar.scan import Scan
     from harness.links.board_session import BoardSession
-    from harness.ros.observer import Observer
+    from harness.links.node_exchange import NodeExchange
 
 IDLE_ANSWER_S = 1.0  # before the first tick: for the node to answer the idle stream (each wait)
 STREAM_QUIET_REVOLUTIONS = 3  # no board scan of the idle stream in this many: none is coming
@@ -42,25 +41,19 @@ IDLE_IN_FLIGHT_S = 0.03  # then for an answer already published to reach us
 
 
 class IdleStreamEnd:
-    """BoardLink's part that ends the session's idle stream before a scenario's first push."""
+    """The board delivery's part that ends the session's idle stream before a scenario's
+    first push; the delivery asks it whether the node may still owe idle answers."""
 
-    observer: Observer | None
-    session: BoardSession | None
-    server: Any
-    physical: bool
-    process: Any
-    _pushed: bool
-    _line_damage: Any
-    _idle_quiet_s: float
-    _idle_owed: bool
+    def __init__(self, exchange: NodeExchange, on_over: Callable[[], None]) -> None:
+        self.exchange = exchange
+        self.on_over = on_over  # the stream is over: line damage acts from then on
+        self.pushed = False  # the first push ends the session's idle stream
+        # The node may still answer idle revolutions during the first tick (it lagged, or
+        # answered none before the first tick, so how many it owes is not known).
+        self.owed = False
+        self.quiet_s = 0.0  # three revolutions at the first scan's rate
 
-    # The link's own (Ros2Link's and BoardLink's).
-    _wait_for: Callable[..., str | None]
-    _grace: Callable[[], float]
-    _rate: Callable[[Scan], float]
-    options: Any
-
-    def _end_idle_stream(self, scan: Scan) -> None:
+    def end(self, session: BoardSession, rate: float) -> None:
         """Before the first tick: wait (bounded) until the node answers one of the idle
         stream's scans, so its subscription has matched the board's publisher and the
         first scan reaches it; stop the idle stream; let the node answer the last scan
@@ -72,11 +65,11 @@ class IdleStreamEnd:
         and none is made when the board publishes no scan of the stream (a driver
         skipping sparse revolutions).
         """
-        assert self.observer is not None
-        if self._pushed:
+        obs = self.exchange.graph.observer
+        assert obs is not None
+        if self.pushed:
             return
-        obs = self.observer
-        rate = self._rate(scan)
+        wait_for, grace = self.exchange.wait_for, self.exchange.grace
         began = time.perf_counter()
 
         def answering() -> bool:
@@ -85,10 +78,10 @@ class IdleStreamEnd:
             quiet = not any(h.kind == "scan" for h in obs.inbox)
             return quiet and time.perf_counter() - began > STREAM_QUIET_REVOLUTIONS / rate
 
-        self._wait_for(answering, IDLE_ANSWER_S)
+        wait_for(answering, IDLE_ANSWER_S)
         answered = obs.heard_since("status", 1)
-        self._idle_over(rate)
-        if self.session is not None and self.session.mode == "realtime":
+        self.over(session, rate)
+        if session.mode == "realtime":
             self._caught_up(answered, STREAM_QUIET_REVOLUTIONS / rate)
             return
         # A driver that lags (a loaded machine: it clears its input buffer) still has
@@ -100,28 +93,28 @@ class IdleStreamEnd:
             last = max((h.arrived for h in obs.inbox if h.kind == "scan"), default=began)
             return time.perf_counter() - last > quiet_s
 
-        self._wait_for(driver_quiet, IDLE_QUIET_MAX_S)
+        wait_for(driver_quiet, IDLE_QUIET_MAX_S)
         idle = [h.source_ns for h in obs.inbox if h.kind == "scan"]
-        self._idle_quiet_s, self._idle_owed = quiet_s, bool(idle)
-        pids = self._local_pids()
+        self.quiet_s, self.owed = quiet_s, bool(idle)
+        pids = self._local_pids(session)
         if idle and pids:
             # The node and the board's software run here: wait (bounded) until every
             # thread of theirs sleeps, so none has a revolution left to answer.
             # A node that answered none of the stream may be asleep in its first
             # callback with the rest queued: asleep is not done for it.
-            done = self._wait_for(Quiescence(pids), IDLE_LAST_ANSWER_S) is None
-            self._idle_owed = not (done and answered)
-            self._wait_for(lambda: False, max(self._grace(), IDLE_IN_FLIGHT_S))
+            done = wait_for(Quiescence(pids), IDLE_LAST_ANSWER_S) is None
+            self.owed = not (done and answered)
+            wait_for(lambda: False, max(grace(), IDLE_IN_FLIGHT_S))
         elif idle and answered:
             # A node lagging on a loaded machine answers older scans after the last one
             # was published: wait (bounded) until it answered after the last idle scan and
             # then said nothing for three revolutions, so no idle answer is left to arrive
             # during the first tick.
             def answers_done() -> bool:
-                return obs.heard_since("status", max(idle)) and self._statuses_quiet()
+                return obs.heard_since("status", max(idle)) and self.statuses_quiet()
 
-            self._idle_owed = self._wait_for(answers_done, IDLE_LAST_ANSWER_S) == "timeout"
-            self._wait_for(lambda: False, self._grace())  # its Bool, if any
+            self.owed = wait_for(answers_done, IDLE_LAST_ANSWER_S) == "timeout"
+            wait_for(lambda: False, grace())  # its Bool, if any
         obs.drain()
         obs.inbox.clear()
 
@@ -135,58 +128,58 @@ class IdleStreamEnd:
         A node that answered none of the stream (silent when nothing is in range)
         may owe answers still: the first tick waits for it to fall quiet.
         """
-        assert self.observer is not None
-        obs = self.observer
-        self._idle_quiet_s = quiet_s
+        obs = self.exchange.graph.observer
+        assert obs is not None
+        self.quiet_s = quiet_s
         if answered:
 
             def caught_up() -> bool:
                 return obs.heard_since("status", obs.latest.get("scan", 0))
 
-            self._idle_owed = self._wait_for(caught_up, IDLE_LAST_ANSWER_S) == "timeout"
-            self._wait_for(lambda: False, max(self._grace(), IDLE_IN_FLIGHT_S))
+            self.owed = self.exchange.wait_for(caught_up, IDLE_LAST_ANSWER_S) == "timeout"
+            self.exchange.wait_for(lambda: False, max(self.exchange.grace(), IDLE_IN_FLIGHT_S))
         else:
-            self._idle_owed = any(h.kind == "scan" for h in obs.inbox)
+            self.owed = any(h.kind == "scan" for h in obs.inbox)
         obs.drain()
         obs.inbox.clear()
 
-    def _local_pids(self) -> list[int]:
+    def _local_pids(self, session: BoardSession) -> list[int]:
         """The node under test and the virtual board's processes (none for a physical
         board: its software runs elsewhere)."""
-        if self.physical:
+        if session.physical:
             return []
-        processes = [p for _, p in self.session.processes] if self.session is not None else []
-        processes += [self.process] if self.process is not None else []
+        processes = [p for _, p in session.processes]
+        node = self.exchange.graph.process
+        processes += [node] if node is not None else []
         return [p.node_pid for p in processes if p.node_pid is not None]
 
-    def _idle_over(self, rate: float) -> None:
+    def over(self, session: BoardSession, rate: float) -> None:
         """End the session's idle stream (this scenario's first push comes next); line
         damage acts from then on."""
-        assert self.server is not None
-        self._pushed = True
-        self._after_idle_stream(rate)
-        if self._line_damage is not None:
-            self.server.damage = self._line_damage
+        self.pushed = True
+        self._after_idle_stream(session, rate)
+        self.on_over()
 
-    def _after_idle_stream(self, rate: float) -> None:
+    def _after_idle_stream(self, session: BoardSession, rate: float) -> None:
         """Lockstep: stop the session's idle stream and let the driver's scan of its last
         revolution come first, so it is never taken for this scenario's."""
-        assert self.session is not None and self.observer is not None
-        since = self.session.end_idle()
+        obs = self.exchange.graph.observer
+        assert obs is not None
+        since = session.end_idle()
         if since is None:
             return
-        obs = self.observer
 
         def idle_scan() -> bool:
             return any(h.kind == "scan" and h.source_ns >= since for h in obs.inbox)
 
-        self._wait_for(idle_scan, max(self.options.scan_timeout, 1.0 / rate))
+        self.exchange.wait_for(idle_scan, max(self.exchange.options.scan_timeout, 1.0 / rate))
 
-    def _statuses_quiet(self) -> bool:
+    def statuses_quiet(self) -> bool:
         """The node said nothing for three revolutions (it has at least answered once)."""
-        assert self.observer is not None
-        last = max((h.arrived for h in self.observer.inbox if h.kind == "status"), default=0.0)
-        return time.perf_counter() - last > self._idle_quiet_s
+        obs = self.exchange.graph.observer
+        assert obs is not None
+        last = max((h.arrived for h in obs.inbox if h.kind == "status"), default=0.0)
+        return time.perf_counter() - last > self.quiet_s
 
 
 def set_aside_answers_to_the_idle_stream(answers: Answers, scans: int) -> None:

@@ -28,14 +28,17 @@ from typing import TYPE_CHECKING
 
 from harness.devices.profiles import DeviceProfile
 from harness.devices.revolution import Sample
-from harness.errors import ConfigError, LinkError
+from harness.errors import ConfigError, LinkError, OptionError
 from harness.lidar.mount import FORWARD, LidarMount
 from harness.links.base import LinkOptions
+from harness.links.bounds import lockstep_wait_s
 from harness.nodes.command import NodeCommand, ros_arguments, shell_node
 from harness.nodes.process import NodeProcess
+from harness.option_names import named
 from harness.ros.domain import DomainReservation, discovery_environment, reserve_domain
 
 if TYPE_CHECKING:
+    from harness.serial_line.diagnosis import LineReport
     from harness.serial_line.ports import DevicePort
     from harness.serial_line.server import DeviceServer
 
@@ -50,7 +53,7 @@ def board_command(text: str, port: str = "/dev/null") -> NodeCommand:
     node's command is (the program exists; ConfigError naming the item as given)."""
     try:
         argv = shell_node(
-            text.replace(PORT_FIELD, shlex.quote(port)), option="--board-command"
+            text.replace(PORT_FIELD, shlex.quote(port)), option=named("board_commands")
         ).argv
     except ConfigError as err:
         raise ConfigError(str(err).replace(shlex.quote(port), PORT_FIELD)) from None
@@ -78,8 +81,9 @@ def board_options(options: LinkOptions) -> LinkOptions:
     """Options for a board: a physical board's own nodes, in its own domain."""
     physical = options.port is not None
     if physical and (options.node or options.package):
-        raise ConfigError(
-            "--port drives a physical board, which runs its own nodes: drop --node/--package"
+        raise OptionError(
+            "port",
+            "{port} drives a physical board, which runs its own nodes: drop {node}/{package}",
         )
     if physical and options.domain_id is None:
         # Joining a board's graph: its domain, not a reserved private one.
@@ -101,9 +105,10 @@ class BoardSession:
         self.options = options
         self.physical = options.port is not None
         if self.physical and options.board_commands:
-            raise ConfigError(
-                "--board-command runs the board's software on the virtual board; with --port "
-                "the physical board runs its own"
+            raise OptionError(
+                "board_commands",
+                "{board_commands} runs the board's software on the virtual board; with {port} "
+                "the physical board runs its own",
             )
         check_board_commands(options.board_commands)
         self.mount: LidarMount = options.lidar_mount or FORWARD
@@ -207,9 +212,7 @@ class BoardSession:
         # in lockstep it pauses while the harness waits for the node (the
         # deadline, then the catch-up wait): the driver's no-data timeout
         # must outlast that.
-        from harness.links.ros2 import CATCH_UP_S
-
-        longest_wait = opts.scan_timeout + max(CATCH_UP_S, 3 * opts.scan_timeout)
+        longest_wait = lockstep_wait_s(opts.scan_timeout)
         return ros_arguments(
             (
                 f"port:={path}",
@@ -262,6 +265,18 @@ class BoardSession:
         assert self.server is not None
         delivery = self.server.end_idle(END_IDLE_S)
         return delivery.written_ns if delivery is not None else None
+
+    def line_diagnosis(self) -> LineReport:
+        """The serial line's story in its three parts: sent, came back, likely cause."""
+        from harness.serial_line.diagnosis import diagnose
+
+        assert self.server is not None and self.port is not None
+        return diagnose(
+            self.server.stats(),
+            port=f"{named('port')} {self.port.name}" if self.physical else self.port.name,
+            baudrate=self.profile.baudrate,
+            streams_unasked=self.profile.streams_unasked,
+        )
 
     def gone(self, when: str = "") -> str | None:
         """Why the device or the board's software stopped, or None while all run."""

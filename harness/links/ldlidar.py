@@ -1,14 +1,9 @@
-"""The ldlidar link: the harness plays an LDROBOT LD06/LD19 (230400 baud, stream only)."""
+"""The ldlidar link: the harness plays an LDROBOT LD06/LD19 (230400 baud, stream only),
+read by the board's LD driver."""
 
 from __future__ import annotations
 
 from harness.devices.profiles import PROFILES
-from harness.links.base import register
-from harness.links.board import BoardLink
+from harness.links.board import serial_lidar
 
-
-@register("ldlidar")
-class LdlidarLink(BoardLink):
-    """An emulated LD19 read by the board's LD driver."""
-
-    profile = PROFILES["ldlidar"]
+LdlidarLink = serial_lidar("ldlidar", PROFILES["ldlidar"], __name__)

@@ -1,15 +1,10 @@
-"""The toy LIDAR's link, as a link module in harness/links/ would be."""
+"""The toy LIDAR's link, as a link module in harness/links/ would be: its name and its
+device profile, nothing else (the board link does the rest)."""
 
 from __future__ import annotations
 
-from harness.links.base import register
-from harness.links.board import BoardLink
+from harness.links.board import serial_lidar
 from toy_lidar import NAME
 from toy_lidar.preset import PROFILE
 
-
-@register(NAME)
-class ToyLink(BoardLink):
-    """An emulated toy LIDAR read by its own board driver."""
-
-    profile = PROFILE
+ToyLink = serial_lidar(NAME, PROFILE, __name__)
