@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import signal
 
-from harness.option_names import Names, worded
+from harness.option_names import Names, escaped, worded
 
 
 def one_line(err: BaseException, limit: int = 200) -> str:
@@ -38,6 +38,11 @@ class OptionError(ConfigError):
         self.key = key
         self.template = template
         super().__init__(self.render(names))
+
+    @classmethod
+    def saying(cls, key: str, text: str) -> OptionError:
+        """`text` (values and all, braces kept) as option `key`'s problem: "{key} text"."""
+        return cls(key, f"{{{key}}} " + escaped(text))
 
     def render(self, names: Names | None = None, *, subject: bool = False) -> str:
         """The message with `names`; `subject`: a value's problem that does not say

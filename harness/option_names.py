@@ -48,6 +48,11 @@ def named(key: str) -> str:
     return _spoken.get(key, key)
 
 
+def escaped(text: str) -> str:
+    """Text from elsewhere (a value, another library's error), safe in a template."""
+    return text.replace("{", "{{").replace("}", "}}")
+
+
 def worded(template: str, names: Names | None = None) -> str:
     """`template` with each ``{key}`` as `names` (by default the caller's) name it."""
     return template.format_map(_AsKey(_spoken if names is None else names))

@@ -14,11 +14,11 @@ import shutil
 import subprocess
 from pathlib import Path
 
-from harness.errors import ConfigError
+from harness.errors import ConfigError, OptionError
 from harness.launch_files.entries import LaunchFile
 from harness.launch_files.finding import package_launch_files, workspace_of
 from harness.launch_files.reading import read_launch_file
-from harness.nodes.command import NodeCommand, option_problem, workspace_environment
+from harness.nodes.command import NodeCommand, workspace_environment
 from harness.option_names import named, worded
 
 __all__ = ["find_launch_file", "launch_node", "ros2_launch_missing"]
@@ -66,13 +66,13 @@ def find_launch_file(package: str, file: str, workspace: str | None) -> LaunchFi
     match = next((path for path, _ in found.files if path.name == name), None)
     if match is None:
         listed = ", ".join(path.name for path, _ in found.files) or "none found"
-        raise option_problem(
+        raise OptionError.saying(
             "launch", f"{option}: {package} has no launch file {name} (its launch files: {listed})"
         )
     shown = next(s for path, s in found.files if path == match)
     read = read_launch_file(match, shown)
     if read is None:
-        raise option_problem(
+        raise OptionError.saying(
             "launch", f"{option}: {shown} is not a launch file (no launch description in it)"
         )
     return read

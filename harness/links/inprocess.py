@@ -13,12 +13,11 @@ import importlib.util
 from collections.abc import Callable
 from pathlib import Path
 
-from harness.errors import ConfigError
+from harness.errors import ConfigError, OptionError
 from harness.judge.answers import Answers, Received
 from harness.lidar.scan import Scan
 from harness.links.base import Link, LinkOptions, register
 from harness.links.processor_child import ProcessorChild
-from harness.nodes.command import option_problem
 
 DIAGNOSTIC_LINES = 14  # with the heading, what the terminal summary shows
 
@@ -37,12 +36,14 @@ def load_processor(ref: str) -> Processor:
     """Resolve ``module:function`` or ``file.py:function`` to a callable."""
     target, sep, attr = ref.rpartition(":")
     if not sep or not target or not attr:
-        raise option_problem("processor", f"{ref!r}: expected MODULE:FUNCTION or FILE.py:FUNCTION")
+        raise OptionError.saying(
+            "processor", f"{ref!r}: expected MODULE:FUNCTION or FILE.py:FUNCTION"
+        )
     try:
         if target.endswith(".py"):
             path = Path(target)
             if not path.is_file():
-                raise option_problem("processor", f"{ref!r}: no such file {target}")
+                raise OptionError.saying("processor", f"{ref!r}: no such file {target}")
             spec = importlib.util.spec_from_file_location(f"_processor_{path.stem}", path)
             assert spec is not None and spec.loader is not None
             module = importlib.util.module_from_spec(spec)
@@ -52,10 +53,10 @@ def load_processor(ref: str) -> Processor:
     except ConfigError:
         raise
     except Exception as err:  # the user's module failing to import is their error
-        raise option_problem("processor", f"{ref!r}: cannot import: {err}") from None
+        raise OptionError.saying("processor", f"{ref!r}: cannot import: {err}") from None
     fn = getattr(module, attr, None)
     if not callable(fn):
-        raise option_problem("processor", f"{ref!r}: {target} has no function {attr!r}")
+        raise OptionError.saying("processor", f"{ref!r}: {target} has no function {attr!r}")
     return fn
 
 

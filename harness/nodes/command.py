@@ -48,18 +48,13 @@ def reference_node() -> NodeCommand:
     )
 
 
-def option_problem(key: str, text: str) -> OptionError:
-    """`text` (values and all, braces kept) as option `key`'s problem: "{key} text"."""
-    return OptionError(key, f"{{{key}}} " + text.replace("{", "{{").replace("}", "}}"))
-
-
 def split_command(command: str, *, option: str = "node") -> list[str]:
     """A user's command line split like a shell does, never empty; OptionError names
     `option`, the key of the option that gave it."""
     try:
         argv = shlex.split(command)
     except ValueError as err:
-        raise option_problem(option, f"{command!r}: {err}") from None
+        raise OptionError.saying(option, f"{command!r}: {err}") from None
     if not argv:
         raise OptionError(option, f"{{{option}}}: the command is empty")
     return argv
@@ -75,14 +70,14 @@ def shell_node(command: str, *, option: str = "node") -> NodeCommand:
         program = argv[0]
     if "/" in program:
         if not Path(program).is_file():
-            raise option_problem(option, f"{command!r}: no such file {program}")
+            raise OptionError.saying(option, f"{command!r}: no such file {program}")
         if not os.access(program, os.X_OK):
-            raise option_problem(option, f"{command!r}: {program} is not executable")
+            raise OptionError.saying(option, f"{command!r}: {program} is not executable")
     elif shutil.which(program) is None:
-        raise option_problem(option, f"{command!r}: {program!r} not found on PATH")
+        raise OptionError.saying(option, f"{command!r}: {program!r} not found on PATH")
     script = python_script_of(argv)
     if script is not None and not Path(script).is_file():
-        raise option_problem(option, f"{command!r}: no such script {script}")
+        raise OptionError.saying(option, f"{command!r}: no such script {script}")
     return NodeCommand(tuple(argv), description=command)
 
 
@@ -141,12 +136,12 @@ def package_node(package: str, executable: str, workspace: str | None) -> NodeCo
     if workspace is not None:
         root = Path(workspace)
         if not root.is_dir():
-            raise option_problem("workspace", f"{workspace}: no such folder")
+            raise OptionError.saying("workspace", f"{workspace}: no such folder")
         install = root / "install" if (root / "install").is_dir() else root
         prefixes = install_prefixes(install)
         where = f"workspace {install}"
         if not prefixes:
-            raise option_problem(
+            raise OptionError.saying(
                 "workspace",
                 f"{workspace}: no colcon install folder with packages "
                 f"(run 'colcon build' in {root} first)",
@@ -169,7 +164,7 @@ def package_node(package: str, executable: str, workspace: str | None) -> NodeCo
             }
         )
         listed = ", ".join(found[:20]) or "none"
-        raise option_problem("package", f"{package}: not found in {where} (packages: {listed})")
+        raise OptionError.saying("package", f"{package}: not found in {where} (packages: {listed})")
     program = owner / "lib" / package / executable
     if not program.is_file():
         there = (
@@ -177,7 +172,7 @@ def package_node(package: str, executable: str, workspace: str | None) -> NodeCo
             if (owner / "lib" / package).is_dir()
             else []
         )
-        raise option_problem(
+        raise OptionError.saying(
             "executable",
             f"{executable}: not in package {package} (executables: {', '.join(there) or 'none'})",
         )

@@ -9,6 +9,7 @@ from collections.abc import Callable, Sequence
 from typing import Any
 
 from harness.errors import OptionError
+from harness.option_names import escaped
 
 Reader = Callable[[object], Any]
 MAX_WAIT_S = 86400.0  # the OS's timed waits overflow past 24 days; no wait needs a day
@@ -17,12 +18,7 @@ SEED_LIMIT = 2**32
 
 def literal(value: object, limit: int = 40) -> str:
     """`value` as a message shows it (repr, cut), braces doubled for the template."""
-    return _braces(repr(value[:limit] if isinstance(value, str) else value)[: limit + 20])
-
-
-def _braces(message: str) -> str:
-    """A message from elsewhere, safe as a template (its braces doubled)."""
-    return message.replace("{", "{{").replace("}", "}}")
+    return escaped(repr(value[:limit] if isinstance(value, str) else value)[: limit + 20])
 
 
 def _number(value: object, kind: type) -> float | int | None:
@@ -120,7 +116,7 @@ def parameter(value: object) -> str:
     try:
         return check_parameter_rule(value)
     except InvalidName as err:
-        raise OptionError("params", _braces(str(err))) from None
+        raise OptionError("params", escaped(str(err))) from None
 
 
 def link(value: object) -> str:
@@ -143,4 +139,4 @@ def lidar_mount(value: object) -> Any:
     try:
         return parse_mount(str(value))
     except ConfigError as err:
-        raise OptionError("lidar_mount", _braces(str(err).removeprefix("--lidar-mount "))) from None
+        raise OptionError("lidar_mount", escaped(str(err).removeprefix("--lidar-mount "))) from None
