@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING, Any
 
 from harness.errors import ConfigError
 from harness.live.robot_mount import RobotShape
+from harness.record.messages import verdict_fields
 from harness.safe_text import shown
 from harness.scenario.schema import Box, Cylinder, Model, Scenario, Wall
 
@@ -66,27 +67,9 @@ def _finite(value: float | None) -> float | None:
     return float(value) if value is not None and math.isfinite(value) else None
 
 
-def _tristate(value: bool | None) -> int:
-    return -1 if value is None else int(value)
-
-
 def verdict_message(verdict: Verdict) -> dict[str, Any]:
     """The recordings' Verdict fields as JSON: NaN becomes null, texts clipped."""
-    kept = verdict.clipped()
-    expected, claim = kept.expected, kept.claim
-    return {
-        "tick": kept.tick,
-        "ok": kept.ok,
-        "expected_obstacle": expected.obstacle,
-        "expected_distance": _finite(expected.distance),
-        "expected_angle": _finite(expected.angle),
-        "expected_warning": _tristate(expected.warning),
-        "claimed_obstacle": bool(claim and claim.obstacle),
-        "claimed_distance": _finite(claim.distance if claim else None),
-        "claimed_angle": _finite(claim.angle if claim else None),
-        "warning": _tristate(kept.warning_got),
-        "explanation": kept.explanation,
-    }
+    return verdict_fields(verdict.clipped(), _finite)
 
 
 def json_bytes(message: dict[str, Any]) -> bytes:

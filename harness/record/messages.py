@@ -7,6 +7,7 @@ definitions (the MCAP schemas); the verdict is the one type of our own.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from functools import lru_cache
 from typing import Any
 
@@ -116,21 +117,26 @@ def _or_nan(value: float | None) -> float:
     return math.nan if value is None else float(value)
 
 
-def verdict(judged: Verdict) -> Any:
+def verdict_fields(judged: Verdict, number: Callable[[float | None], Any]) -> dict[str, Any]:
+    """The Verdict message's fields, `number` writing each float (None where none is)."""
     expected, claim = judged.expected, judged.claim
-    return typestore().types[VERDICT](
-        tick=judged.tick,
-        ok=judged.ok,
-        expected_obstacle=expected.obstacle,
-        expected_distance=_or_nan(expected.distance),
-        expected_angle=_or_nan(expected.angle),
-        expected_warning=_tristate(expected.warning),
-        claimed_obstacle=bool(claim and claim.obstacle),
-        claimed_distance=_or_nan(claim.distance if claim else None),
-        claimed_angle=_or_nan(claim.angle if claim else None),
-        warning=_tristate(judged.warning_got),
-        explanation=judged.explanation,
-    )
+    return {
+        "tick": judged.tick,
+        "ok": judged.ok,
+        "expected_obstacle": expected.obstacle,
+        "expected_distance": number(expected.distance),
+        "expected_angle": number(expected.angle),
+        "expected_warning": _tristate(expected.warning),
+        "claimed_obstacle": bool(claim and claim.obstacle),
+        "claimed_distance": number(claim.distance if claim else None),
+        "claimed_angle": number(claim.angle if claim else None),
+        "warning": _tristate(judged.warning_got),
+        "explanation": judged.explanation,
+    }
+
+
+def verdict(judged: Verdict) -> Any:
+    return typestore().types[VERDICT](**verdict_fields(judged, _or_nan))
 
 
 def planar_pose(message: Any) -> tuple[float, float, float]:
