@@ -50,8 +50,9 @@ def _href(path: str) -> str:
     return escape(quote(path), quote=True)
 
 
-def _verdict(verdict: str) -> str:
-    return f'<span class="{verdict.replace(" ", "_")}">{_text(verdict)}</span>'
+def _word(word: str) -> str:
+    """A verdict or a change, styled by its own class."""
+    return f'<span class="{word.replace(" ", "_")}">{_text(word)}</span>'
 
 
 def _faults(faults: str) -> str:
@@ -64,18 +65,14 @@ def _file_links(files: Mapping[str, str | None]) -> str:
     return " ".join(f'<a href="{_href(p)}">{_text(n)}</a>' for n, p in files.items() if p)
 
 
-def _change(kind: str) -> str:
-    return f'<span class="{kind.replace(" ", "_")}">{_text(kind)}</span>'
-
-
 def _row(i: int, e: Mapping[str, Any]) -> str:
-    change = [_change(e["change"])] if "change" in e else []
+    change = [_word(e["change"])] if "change" in e else []
     cells = [
         f'<a href="#scenario-{i}">{_text(e["scenario"])}</a>',
         _text(e["link"]),
         f'<td class="n">{e["ticks"]}',
         f'<td class="n">{e["failed"]}',
-        _verdict(e["verdict"]),
+        _word(e["verdict"]),
         *change,
         f'<td class="n">{e["total_s"]:.2f}',
         f'<td class="n">{_text(e["seed"])}',
@@ -88,7 +85,7 @@ def _row(i: int, e: Mapping[str, Any]) -> str:
 
 
 def _section(i: int, e: Mapping[str, Any], diagnostics: str) -> list[str]:
-    out = [f'<h2 id="scenario-{i}">{_text(e["scenario"])} {_verdict(e["verdict"])}</h2>']
+    out = [f'<h2 id="scenario-{i}">{_text(e["scenario"])} {_word(e["verdict"])}</h2>']
     detail = f"{e['ticks']} ticks, {e['failed']} failed; link {e['link']}, seed {e['seed']}"
     out.append(f"<p>{_text(detail)}. {_file_links(e['files'])}</p>")
     if e["first_failure"]:
@@ -143,7 +140,7 @@ def _baseline(comparison: Mapping[str, Any]) -> list[str]:
         for c in rows:
             cells = [c["scenario"], c["faults"], c["then"] or "-", c["now"] or "-"]
             out.append(
-                f"<tr><td>{_change(c['change'])}"
+                f"<tr><td>{_word(c['change'])}"
                 + "".join(f"<td>{_text(x)}" for x in cells)
                 + f"<td>{_text(c['reason'] or '')}</tr>"
             )
