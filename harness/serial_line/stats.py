@@ -55,29 +55,13 @@ class ServerCounts:
     wrong_baud: int = 0  # times a client set a baud rate other than the device's
 
 
-@dataclass(frozen=True)
-class ServerStats:
-    """Counters of one server run; pacing figures only in realtime mode."""
+@dataclass(kw_only=True)
+class ServerStats(ServerCounts):
+    """A snapshot of one server run: its counts, the line's state and the device's
+    counters; pacing figures only in realtime mode."""
 
     mode: str
-    bytes_written: int
-    reply_bytes: int
-    host_bytes: int
-    host_reads: int
     requests_seen: int | None  # well-formed requests, where the device counts them
-    revolutions_sent: int
-    revolutions_dropped: int
-    revolutions_superseded: int
-    revolutions_repeated: int
-    markers_sent: int
-    stream_bytes_dropped: int
-    overrun_bytes: int
-    underruns: int
-    revolutions_whole: int
-    revolutions_cut: int
-    motor_off_revolutions: int
-    client_opens: int
-    wrong_baud: int
     peer_present: bool | None
     peer_seen: bool | None  # a client ever had the port open (None: cannot be seen)
     host_baud: int | None  # the client's baud rate where it can be seen (a pty)
