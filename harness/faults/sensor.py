@@ -367,22 +367,20 @@ def _inline(where: str, spec: Mapping[str, Any]) -> tuple[_Item, str]:
         if key not in args and key not in optional:
             raise ConfigError(f"{where}.{key}: required for {kind}")
         value = args.get(key)
-        if key in ("sigma", "rate") and value is not None:
-            if isinstance(value, bool) or not isinstance(value, (int, float)):
-                raise ConfigError(f"{where}.{key}: must be a number, got {value!r}")
-            lo, hi = (0, 1)
-            if not (math.isfinite(value) and lo <= value <= hi):
-                unit = " m" if key == "sigma" else ""
-                raise ConfigError(f"{where}.{key}: must be in [{lo}, {hi}]{unit}, got {value!r}")
-            args[key] = float(value)
-        if key in ("value", "name") and value is not None and not isinstance(value, str):
-            raise ConfigError(f"{where}.{key}: must be a string, got {value!r}")
-        if key == "length" and value is not None:
+        if value is None:
+            continue
+        if key in ("value", "name"):
+            if not isinstance(value, str):
+                raise ConfigError(f"{where}.{key}: must be a string, got {value!r}")
+        elif key == "length":
             if isinstance(value, bool) or not isinstance(value, int):
                 raise ConfigError(f"{where}.{key}: must be a whole number, got {value!r}")
-        elif key not in ("value", "name", "sigma", "rate") and value is not None:
-            if isinstance(value, bool) or not isinstance(value, (int, float)):
-                raise ConfigError(f"{where}.{key}: must be a number, got {value!r}")
+        elif isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise ConfigError(f"{where}.{key}: must be a number, got {value!r}")
+        elif key in ("sigma", "rate") and not (math.isfinite(value) and 0 <= value <= 1):
+            unit = " m" if key == "sigma" else ""
+            raise ConfigError(f"{where}.{key}: must be in [0, 1]{unit}, got {value!r}")
+        else:
             args[key] = float(value)
     try:
         item = cls(**args)
