@@ -38,11 +38,8 @@ class EmulationSummary:
     """What was served, for the closing lines and for tests."""
 
     revolutions: int  # simulated
-    revolutions_streamed: int  # queued on the line; the rest found the device idle
     bytes_written: int
-    requests_seen: int | None
     mean_rate_error_pct: float | None
-    period_jitter_p99_ms: float | None
     port: str = ""
     elapsed_s: float = 0.0
     stopped_by: str | None = None  # "SIGINT" / "SIGTERM"; None: the scenario ended
@@ -255,14 +252,10 @@ def emulate(
     report = diagnose(
         stats, port=name, baudrate=profile.baudrate, streams_unasked=profile.streams_unasked
     )
-    pacing = stats.pacing
     return EmulationSummary(
         revolutions=revolutions,
-        revolutions_streamed=stats.revolutions_sent,
         bytes_written=stats.bytes_written,
-        requests_seen=stats.requests_seen,
-        mean_rate_error_pct=pacing.mean_rate_error_pct if pacing else None,
-        period_jitter_p99_ms=pacing.period_jitter_p99_ms if pacing else None,
+        mean_rate_error_pct=stats.pacing.mean_rate_error_pct if stats.pacing else None,
         port=name,
         elapsed_s=time.monotonic() - started,
         stopped_by=stopped_by,
