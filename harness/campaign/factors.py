@@ -66,6 +66,9 @@ class _Tally:
     def minus(self, other: _Tally) -> _Tally:
         return _Tally(self.runs - other.runs, self.fail - other.fail, self.error - other.error)
 
+    def __add__(self, other: _Tally) -> _Tally:
+        return _Tally(self.runs + other.runs, self.fail + other.fail, self.error + other.error)
+
 
 @dataclass
 class _Finding:
@@ -333,20 +336,11 @@ def _factor_line(runs: list[_Run], index: int, factors: Factors) -> str:
     rest = ""
     if len(shown) > _MAX_RATE_LEVELS:
         shown.sort(key=lambda item: -item[1].rate)  # stable: sort order among equals
-        others = _tally_sum(t for _, t in shown[_MAX_RATE_LEVELS - 1 :])
+        others = sum((t for _, t in shown[_MAX_RATE_LEVELS - 1 :]), _Tally())
         rest = f", {len(shown) - _MAX_RATE_LEVELS + 1} more levels {_rate(others)}"
         shown = shown[: _MAX_RATE_LEVELS - 1]
     levels = ", ".join(f"{_label(factor, lv)} {_rate(t)}" for lv, t in shown)
     return f"{factor}, runs failed per level: {levels}{rest}"
-
-
-def _tally_sum(tallies: Iterable[_Tally]) -> _Tally:
-    total = _Tally()
-    for tally in tallies:
-        total.runs += tally.runs
-        total.fail += tally.fail
-        total.error += tally.error
-    return total
 
 
 # --- the summary --------------------------------------------------------------------------------
