@@ -25,6 +25,7 @@ from harness.devices.rplidar_scans import (
     encode_standard,
     xor_all,
 )
+from harness.option_names import worded
 
 # -- wire constants (Slamtec protocol v2.x, sl_lidar_cmd.h) --------------------
 
@@ -140,9 +141,8 @@ def _command_name(cmd: int) -> str:
 def _garbage_note(data: bytes | bytearray) -> str:
     """Name bytes that are another LIDAR's (else the generic hint applies)."""
     if starts_like_command(data):
-        return (
-            "an LDROBOT command frame (54 ...): an LD06/LD19 driver on an RPLIDAR; "
-            "use its own device type (emulate ldlidar, --link ldlidar)"
+        return "an LDROBOT command frame (54 ...): an LD06/LD19 driver on an RPLIDAR; " + worded(
+            "use its own device type (emulate ldlidar, {link} ldlidar)"
         )
     return ""
 
