@@ -1,11 +1,8 @@
 """`fossbot-hil audit [SCENARIO ...]`: which typical mistakes the suite catches.
 
-Runs the built-in library of Lab 07 mistakes (harness.audit.mutants) and
-a correct node written the same way through the chosen scenarios, on the
-Dask path ``grade`` uses, and prints the kill matrix, the mistakes no
-scenario catches (with the kind of scenario that would), the readings the
-suite delivered, and a score. Exit 0 when every mistake is caught, 1 when
-some survive (or the correct node fails a scenario), 2 for usage errors.
+The library of Lab 07 mistakes (harness.audit.mutants) and a correct node
+written the same way, through the scenarios on ``grade``'s Dask path. Exit 1
+when a mistake survives (or the correct node fails a scenario).
 """
 
 from __future__ import annotations

@@ -1,12 +1,7 @@
 """`fossbot-hil bench`: how fast each stage of the harness runs on this machine.
 
-Measures, in one run: ray casting alone, scan synthesis with faults, the
-inprocess, ROS 2 and serial lockstep loops, real-time serial pacing, the
-lab's three scenarios end to end and the shipped suite as users run it
-(bundled node, a colcon-built workspace node, the inprocess link;
-docs/benchmarks.md says how). Exit 0 when the bench ran, whether or not
-the targets were met (they are measured, not asserted); 1 when a stage
-could not run; 2 for bad options.
+Stage by stage (docs/benchmarks.md). Exit 0 when the bench ran, met or not:
+the targets are measured, not asserted; 1 when a stage could not run.
 """
 
 from __future__ import annotations

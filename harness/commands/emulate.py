@@ -1,10 +1,7 @@
 """`fossbot-hil emulate`: serve a scenario's scans as a LIDAR device.
 
-Exit 0 when it ends (the scenario's end, Ctrl-C or SIGTERM) and a client
-read from the device; 1 when the scenario ran out and nothing ever read,
-so a script notices. The summary says which either way. On a pty, the
-second line gives the environment a pyserial client needs for its DTR/RTS
-calls to work there (docs/hil.md, "Modem lines on a pty").
+Exit 1 when the scenario ran out and nothing ever read, so a script notices;
+else 0 (the scenario's end, Ctrl-C or SIGTERM).
 """
 
 from __future__ import annotations

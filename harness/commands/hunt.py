@@ -59,24 +59,24 @@ DEFAULT_BATCH = 4
 DEFAULT_SHRINK_BUDGET = 60
 REPRODUCE_TIMEOUT_S = 180.0  # the counterexample's own run, node start-up included
 
-#: Options a reproducing `fossbot-hil run` repeats when they were given: (dest, flag).
+#: Options a reproducing `fossbot-hil run` repeats when they were given (by dest).
 RUN_OPTIONS = (
-    ("link", "--link"),
-    ("node", "--node"),
-    ("package", "--package"),
-    ("executable", "--executable"),
-    ("workspace", "--workspace"),
-    ("param", "--param"),
-    ("threshold_param", "--threshold-param"),
-    ("scan_topic", "--scan-topic"),
-    ("status_topic", "--status-topic"),
-    ("warning_topic", "--warning-topic"),
-    ("ready_timeout", "--ready-timeout"),
-    ("ros_network", "--ros-network"),
-    ("realtime", "--realtime"),
-    ("status_regex", "--status-regex"),
-    ("warning_when_clear", "--warning-when-clear"),
-    ("timeout", "--timeout"),
+    "link",
+    "node",
+    "package",
+    "executable",
+    "workspace",
+    "param",
+    "threshold_param",
+    "scan_topic",
+    "status_topic",
+    "warning_topic",
+    "ready_timeout",
+    "ros_network",
+    "realtime",
+    "status_regex",
+    "warning_when_clear",
+    "timeout",
 )
 OUTPUTS = (  # what a hunt writes in DIR: an earlier hunt's are removed first
     "hunt.json",
@@ -256,9 +256,10 @@ def _reproduce_command(args: argparse.Namespace, scenario: Path) -> list[str]:
     """`fossbot-hil run SCENARIO` with the node and judging options the hunt was given."""
     command = ["fossbot-hil", "run", str(scenario)]
     typed = getattr(args, "given", frozenset())
-    for dest, flag in RUN_OPTIONS:
+    for dest in RUN_OPTIONS:
         if dest not in typed:
             continue
+        flag = "--" + dest.replace("_", "-")
         value = getattr(args, dest)
         if value is True:
             command.append(flag)

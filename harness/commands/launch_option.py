@@ -1,10 +1,7 @@
 """`run --launch PACKAGE FILE`: the node started by ``ros2 launch``, where that is installed.
 
-Checked before anything starts: the package has that launch file. Where
-``ros2 launch`` is missing (ROS 2's launch is not on the package index),
-what the file says is read anyway and printed, then one line says what to
-do, exit 2. A run without --launch still checks the package's launch files
-against the running node (docs/launch_files.md).
+Where ``ros2 launch`` is missing (it is not on the package index), the file
+is still read and its problems printed before the exit 2 (docs/launch_files.md).
 """
 
 from __future__ import annotations

@@ -1,16 +1,9 @@
 """`fossbot-hil run --watch`: the run command's options, in the edit-run loop.
 
 Everything `run` checks is checked once, before the first run (exit 2 as
-`run`). What is watched: the node's files and the scenario files given by
-path (harness.watch.sources); with nothing to watch (the bundled node and
-shipped scenarios only) the command exits 2. The scenarios are read again
-when one of their files changes. After each run: the verdict cache (for
-the next run's order and for `--failed-first`), and `--out` / `--junit-xml`
-rewritten with that run, once its verdicts are on the screen.
-
-The command runs inside `run`'s fork-server scope, and every run_suite
-opens a nested one, so a fork server started by the first run serves every
-later one: the loop never restarts it.
+`run`); after each run the verdict cache and `--out` / `--junit-xml` are
+rewritten. Inside `run`'s fork-server scope, so a fork server started by
+the first run serves every later one: the loop never restarts it.
 """
 
 from __future__ import annotations
