@@ -14,11 +14,11 @@ import xml.etree.ElementTree as ET
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, replace
 
+from harness.scenario.urdf_chain import Matrix, Vector, rpy_matrix
+
 __all__ = ["Outline", "disc", "overlap", "rectangle", "robot_outlines"]
 
 Point = tuple[float, float]
-Vector = tuple[float, float, float]
-Matrix = tuple[Vector, Vector, Vector]
 _IDENTITY: Matrix = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
 _CIRCLE_POINTS = 32  # points on each end circle of a tilted cylinder
 
@@ -159,18 +159,6 @@ def _floats(text: str | None, default: Vector) -> Vector:
     return (float(parts[0]), float(parts[1]), float(parts[2])) if len(parts) == 3 else default
 
 
-def _rpy(roll: float, pitch: float, yaw: float) -> Matrix:
-    """URDF's fixed-axis roll, pitch, yaw as a rotation matrix (Rz @ Ry @ Rx)."""
-    cr, sr = math.cos(roll), math.sin(roll)
-    cp, sp = math.cos(pitch), math.sin(pitch)
-    cy, sy = math.cos(yaw), math.sin(yaw)
-    return (
-        (cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr),
-        (sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr),
-        (-sp, cp * sr, cp * cr),
-    )
-
-
 def _apply(rotation: Matrix, v: Vector) -> Vector:
     return (
         rotation[0][0] * v[0] + rotation[0][1] * v[1] + rotation[0][2] * v[2],
@@ -196,7 +184,7 @@ def _origin(element: ET.Element) -> Transform:
     if origin is None:
         return (0.0, 0.0, 0.0), _IDENTITY
     xyz = _floats(origin.get("xyz"), (0.0, 0.0, 0.0))
-    return xyz, _rpy(*_floats(origin.get("rpy"), (0.0, 0.0, 0.0)))
+    return xyz, rpy_matrix(*_floats(origin.get("rpy"), (0.0, 0.0, 0.0)))
 
 
 def _shape_outline(shape: ET.Element, pose: Transform, label: str) -> Outline | None:

@@ -26,7 +26,13 @@ from harness.lidar.mount import FORWARD, LidarMount
 from harness.safe_text import shown
 from harness.scenario.model_files import find_model_file, parse_xml, robot_models_dir
 from harness.scenario.schema import DEFAULT_DEVICE_LINK, Scenario
-from harness.scenario.urdf_chain import chain_to_root, joint_origin, joints_by_child, parent_link
+from harness.scenario.urdf_chain import (
+    chain_to_root,
+    joint_origin,
+    joints_by_child,
+    parent_link,
+    rpy_matrix,
+)
 
 __all__ = ["TILT_TOLERANCE_DEG", "lidar_mount", "scenario_mount", "urdf_mount"]
 
@@ -41,23 +47,6 @@ class _Reading:
     problem: str = ""
 
 
-def _rpy(roll: float, pitch: float, yaw: float) -> np.ndarray:
-    """URDF's fixed-axis roll, pitch, yaw as a rotation matrix (Rz @ Ry @ Rx)."""
-    cr, sr = math.cos(roll), math.sin(roll)
-    cp, sp = math.cos(pitch), math.sin(pitch)
-    cy, sy = math.cos(yaw), math.sin(yaw)
-    rz = np.array([[cy, -sy, 0.0], [sy, cy, 0.0], [0.0, 0.0, 1.0]])
-    ry = np.array([[cp, 0.0, sp], [0.0, 1.0, 0.0], [-sp, 0.0, cp]])
-    rx = np.array([[1.0, 0.0, 0.0], [0.0, cr, -sr], [0.0, sr, cr]])
-    return rz @ ry @ rx
-
-
-def _joint_rotation(joint: ET.Element) -> np.ndarray:
-    """The rotation of a joint's child frame in its parent's (its origin's rpy)."""
-    _, rpy = joint_origin(joint)
-    return _rpy(*rpy)
-
-
 def _down_to(
     parents: dict[str, ET.Element], link: str, ancestor: str
 ) -> tuple[np.ndarray, str | None]:
@@ -65,7 +54,7 @@ def _down_to(
     rotation, moving = np.eye(3), None
     while link != ancestor:
         joint = parents[link]
-        rotation = _joint_rotation(joint) @ rotation
+        rotation = np.array(rpy_matrix(*joint_origin(joint)[1])) @ rotation
         if joint.get("type") != "fixed":
             moving = f"{joint.get('type')} joint {joint.get('name')!r}"
         link = parent_link(joint)

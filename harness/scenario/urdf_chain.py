@@ -6,14 +6,16 @@ and refuse the same bad input (a joint origin that is not three numbers).
 
 from __future__ import annotations
 
+import math
 import xml.etree.ElementTree as ET
 
 from harness.errors import ConfigError
 from harness.safe_text import shown
 
-__all__ = ["chain_to_root", "joint_origin", "joints_by_child", "parent_link"]
+__all__ = ["chain_to_root", "joint_origin", "joints_by_child", "parent_link", "rpy_matrix"]
 
-Triple = tuple[float, float, float]
+Triple = Vector = tuple[float, float, float]
+Matrix = tuple[Vector, Vector, Vector]
 
 
 def joints_by_child(root: ET.Element) -> dict[str, ET.Element]:
@@ -53,3 +55,15 @@ def _triple(joint: ET.Element, origin: ET.Element | None, name: str) -> Triple:
         what = shown(joint.get("name", ""), 100)
         raise ConfigError(f"joint {what!r}: {name} is not 3 numbers") from None
     return a, b, c
+
+
+def rpy_matrix(roll: float, pitch: float, yaw: float) -> Matrix:
+    """URDF's fixed-axis roll, pitch, yaw as a rotation matrix (Rz @ Ry @ Rx)."""
+    cr, sr = math.cos(roll), math.sin(roll)
+    cp, sp = math.cos(pitch), math.sin(pitch)
+    cy, sy = math.cos(yaw), math.sin(yaw)
+    return (
+        (cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr),
+        (sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr),
+        (-sp, cp * sr, cp * cr),
+    )
