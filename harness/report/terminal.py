@@ -188,19 +188,14 @@ def gap_line(results: Sequence[RunResult]) -> str:
     return f"{lead}: {low}-{high} s (median {statistics.median(gaps):.1f} s)"
 
 
-def alignment_text(alignment: Alignment, mode: str = "warn") -> tuple[str, str]:
-    """The terminal's line on the board's /scan against the truth, and its style: quiet
-    when aligned or unknown, a warning when misaligned, a failure with `--alignment fail`."""
-    if not alignment.misaligned:
-        return f"alignment: {alignment.text()}", ""
-    if alignment_fails(alignment, mode):
-        return f"alignment: FAILED (--alignment fail): {alignment.text()}", "bold red"
-    return f"alignment: WARNING: {alignment.text()}", "bold yellow"
-
-
 def print_alignment(console: Console, alignment: Alignment, *, mode: str = "warn") -> None:
-    """`run` on a serial link: whether the board's /scan is the truth turned or mirrored."""
-    line, style = alignment_text(alignment, mode)
+    """`run` on a serial link: whether the board's /scan is the truth turned or mirrored;
+    quiet when aligned or unknown, a warning when misaligned, a failure with `--alignment fail`."""
+    line, style = f"alignment: {alignment.text()}", ""
+    if alignment_fails(alignment, mode):
+        line, style = f"alignment: FAILED (--alignment fail): {alignment.text()}", "bold red"
+    elif alignment.misaligned:
+        line, style = f"alignment: WARNING: {alignment.text()}", "bold yellow"
     print_safe(console, line, style=style)
 
 
