@@ -31,10 +31,8 @@ RPLIDAR_NODE_BYTES = 5
 
 
 def percentile(values: Sequence[float], q: float) -> float:
-    """Nearest-rank percentile, `q` in (0, 100]: a value that occurred, never interpolated.
-
-    With fewer than 100 values the 99th percentile is the maximum.
-    """
+    """Nearest-rank percentile, `q` in (0, 100]: a value that occurred, never interpolated
+    (with fewer than 100 values the 99th is the maximum)."""
     if not values:
         raise ValueError("percentile of no values")
     if not 0 < q <= 100:
@@ -44,13 +42,8 @@ def percentile(values: Sequence[float], q: float) -> float:
 
 
 def overhead_ratio(scan_s: float, raycast_s: float, round_trip_s: float) -> float:
-    """Harness time per scan beyond ray casting and one DDS round trip, as a fraction of them.
-
-    ``(scan_s - raycast_s - round_trip_s) / (raycast_s + round_trip_s)``, where
-    `scan_s` is the wall time of one lockstep scan, `raycast_s` the ray casting
-    of that scan alone and `round_trip_s` the median publish-to-answer time.
-    0 means the harness adds nothing to the two costs it cannot avoid.
-    """
+    """Harness time per lockstep scan beyond ray casting and the median DDS round trip, as
+    a fraction of them: 0 means it adds nothing to the two costs it cannot avoid."""
     floor = raycast_s + round_trip_s
     if floor <= 0:
         raise ValueError("ray casting plus round trip must take some time")
@@ -69,11 +62,8 @@ def jitter_p99_ms(starts_s: Sequence[float], period_s: float) -> float | None:
 
 
 def rplidar_revolution_starts(data: bytes) -> list[int]:
-    """Byte offsets of the revolution-start nodes in an RPLIDAR standard scan stream.
-
-    `data` begins with the SCAN reply descriptor; then come 5-byte nodes whose
-    first byte holds the start flag S (bit 0) and its inverse (bit 1).
-    """
+    """Byte offsets of the revolution-start nodes (start flag S set, bit 0, its inverse
+    bit 1 clear) in an RPLIDAR standard scan stream, SCAN reply descriptor first."""
     head = RPLIDAR_SCAN_DESCRIPTOR
     if not data.startswith(head):
         raise ValueError("the stream does not start with the RPLIDAR scan descriptor")

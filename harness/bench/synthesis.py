@@ -18,11 +18,8 @@ HARSH = ("harsh",)
 
 
 def _timed_frames(workload: Workload) -> tuple[int, float, float]:
-    """(scans, wall seconds, simulated seconds) of consuming the frame stream.
-
-    The first scan is taken before the clock starts, with the other stages;
-    building the later runs' worlds is taken out.
-    """
+    """(scans, wall seconds, simulated seconds) of consuming the frame stream: the first
+    scan before the clock starts, as in the other stages; building worlds taken out."""
     scans, last_t, scan_time = 0, 0.0, 0.0
     with prepared_frames(workload) as frames:
         first = next(frames)  # the first world is built before the clock starts

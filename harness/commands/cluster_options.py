@@ -101,11 +101,8 @@ def runs_client(args: argparse.Namespace, console: Console, task_module: str) ->
 
 
 def run_result(future: Any, lost: str, then: str = "") -> Any | None:
-    """A run's result; None when Dask gave up on it (it killed its worker every time).
-
-    Any other loss (the scheduler went away) ends the command: the run is
-    not done, and the message says `lost` "was lost to the Dask cluster".
-    """
+    """A run's result; None when Dask gave up on it (it killed its worker every time). Any
+    other loss (the scheduler went away) ends the command: "`lost` was lost to the ..."."""
     from distributed import KilledWorker
 
     try:

@@ -97,10 +97,8 @@ def _bind_problem(host: str, port: int, err: BaseException) -> str:
 
 
 def _wait_released(host: str, port: int, within: float) -> None:
-    """Until the SDK's listener has really closed (it closes asynchronously), at most `within`.
-
-    A bind with SO_REUSEADDR fails only while something listens on the port.
-    """
+    """Until the SDK's listener (closed asynchronously) is gone, at most `within`: a bind
+    with SO_REUSEADDR fails only while something listens on the port."""
     try:
         family, kind, proto, _, address = socket.getaddrinfo(host, port, type=socket.SOCK_STREAM)[0]
     except OSError:

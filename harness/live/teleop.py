@@ -131,13 +131,9 @@ class TeleopState:
 
 
 class KeyReader:
-    """A terminal's keys one at a time, unechoed, for as long as the `with` lasts.
-
-    cbreak rather than raw: output still turns "\\n" into a new line, so the
-    simulator's prints look as usual. Signal keys are read as keys (as in
-    teleop_twist_keyboard's raw mode): Ctrl-C raises KeyboardInterrupt from
-    `read`, Ctrl-Z and Ctrl-\\ just stop the robot like any other key.
-    """
+    """A terminal's keys one at a time, unechoed, for as long as the `with` lasts: cbreak,
+    not raw, so the simulator's prints look as usual; signal keys read as keys (as in
+    teleop_twist_keyboard), Ctrl-C raising KeyboardInterrupt from `read`."""
 
     def __init__(self, fd: int | None = None, *, escape_wait: float = ESCAPE_WAIT_S) -> None:
         """`fd` defaults to standard input; a ConfigError now if it is not a terminal,
@@ -264,11 +260,8 @@ class KeyboardTeleop:
         self.show(self.state.status())
 
     def poll(self, now: float, timeout: float = 0.0) -> tuple[float, float] | None:
-        """(m/s, rad/s) to send at `now`, or None while the last one sent is fresh.
-
-        Takes every key already typed (waiting at most `timeout` s for the first);
-        a speed key shows the new speeds. Ctrl-C raises KeyboardInterrupt.
-        """
+        """(m/s, rad/s) to send at `now`, or None while the last one sent is fresh; takes
+        every key typed (waiting at most `timeout` s for the first)."""
         typed = False
         key = self.reader.read(timeout)
         while key is not None:

@@ -234,10 +234,8 @@ class ReportFolder:
         alignment: Alignment | None = None,
         alignment_mode: str = "warn",
     ) -> Path:
-        """Write summary.json, junit.xml and index.html; return the index page.
-        `wall_s`: the command's wall time, for the totals; `baseline`: an earlier
-        run to compare with (`--baseline`), in summary.json and on the page;
-        `alignment`: the fit of the board's /scan (`run --alignment`, its mode)."""
+        """Write summary.json, junit.xml and index.html (with the `--baseline` comparison and
+        the board's /scan `alignment` when given); return the index page."""
         from harness.report.html import index_html
         from harness.report.junit import junit_xml
 

@@ -20,11 +20,8 @@ _LIBC = ctypes.CDLL(None)
 
 @contextlib.contextmanager
 def captured_output() -> Iterator[list[str]]:
-    """Send fds 1 and 2 to a temporary file; afterwards the list holds what was written.
-
-    PyBullet's loaders print their warnings and errors there instead of
-    raising them: kept off our stdout, they can still explain a failure.
-    """
+    """Send fds 1 and 2 to a temporary file; afterwards the list holds what was written
+    (PyBullet's loaders print their errors instead of raising them)."""
     lines: list[str] = []
     sys.stdout.flush()
     sys.stderr.flush()
@@ -65,12 +62,8 @@ _SPARE: list[int] = []  # DIRECT clients emptied by `release`, ready for the nex
 
 
 def connect(gui: bool = False) -> int:
-    """A physics client (DIRECT, or the GUI viewer) of the caller's alone, with nothing in it.
-
-    A DIRECT client released by an earlier world is handed out again:
-    emptied by ``resetSimulation``, it is as a new one (each world sets its
-    engine parameters and gravity), and connecting costs 10 ms a world.
-    """
+    """A physics client (DIRECT, or the GUI viewer) of the caller's alone, with nothing in
+    it: a released DIRECT one again, emptied (connecting costs 10 ms a world)."""
     if not gui and _SPARE:
         return _SPARE.pop()
     with captured_output():

@@ -66,11 +66,8 @@ def wrap_angle(angle: float) -> float:
 
 
 def integrate(pose: Pose, linear: float, angular: float, dt: float) -> Pose:
-    """Exact unicycle motion for constant (v, w) over dt: a chord of the arc.
-
-    The chord has length v*dt*sinc(w*dt/2) and leaves at the mean heading,
-    which is the arc formula written so it stays accurate as w -> 0.
-    """
+    """Exact unicycle motion for constant (v, w) over dt: a chord of length
+    v*dt*sinc(w*dt/2) at the mean heading, the arc written to stay accurate as w -> 0."""
     half = angular * dt / 2.0
     chord = linear * dt * (math.sin(half) / half if abs(half) > 1e-12 else 1.0)
     heading = pose.yaw + half
@@ -161,12 +158,9 @@ class MotionScript:
         self.elapsed = 0.0
 
     def observe(self, ahead: float) -> None:
-        """Judge obstacle conditions on a scan whose nearest range ahead is `ahead`.
-
-        Ends every obstacle segment whose condition holds (a segment whose
-        condition already holds when it starts takes no time) and raises
-        ConfigError when one has run for its timeout without its condition.
-        """
+        """Judge obstacle conditions on a scan whose nearest range ahead is `ahead`: end each
+        segment whose condition holds (at once if it held at its start); ConfigError at its
+        timeout."""
         while not self.done and self._planned[self.index] is None:
             segment = self.segments[self.index]
             name, value = _condition(segment)
@@ -240,10 +234,8 @@ class KinematicDriver:
 
 
 class WheelDriver:
-    """Drives the wheel motors and steps the physics at a fixed 240 Hz.
-
-    Scans fall on the physics step nearest their time (within 1/480 s).
-    """
+    """Drives the wheel motors and steps the physics at a fixed 240 Hz (a scan falls on
+    the step nearest its time)."""
 
     def __init__(self, world: RobotWorld, time_step: float) -> None:
         self.world = world

@@ -55,13 +55,9 @@ class Simulation:
             raise
 
     def ticks(self, periods: Iterator[float] | None = None) -> Iterator[SimTick]:
-        """One tick per revolution from t = 0 until the script ends, end pose included.
-
-        `periods` gives the time from each scan to the next (a LIDAR whose
-        rate drifts); by default every revolution takes the spec's scan_time.
-        Obstacle conditions are judged on each tick's scan before it is
-        yielded; a condition that times out raises ConfigError. Runs once.
-        """
+        """One tick per revolution from t = 0 until the script ends, end pose included; runs
+        once. `periods`: the time from each scan to the next, for a LIDAR whose rate drifts
+        (default: the spec's scan_time)."""
         if self._started:
             raise RuntimeError("Simulation.ticks() runs once; build a new Simulation")
         self._started = True

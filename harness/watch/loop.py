@@ -44,13 +44,8 @@ def _changed_names(changes: Changes) -> str:
 
 
 class WatchLoop:
-    """Runs the suite on every change of `sources` until interrupted.
-
-    `load` (re)reads the scenarios; `suite` runs them (on_tick, on_result);
-    `after(results)` keeps a run's judged results (the verdict cache, report
-    files; on Ctrl-C, those judged so far) and returns lines to show;
-    `failed` names the scenarios that failed last.
-    """
+    """Runs the suite on every change of `sources` until interrupted; `after(results)`
+    keeps a run's judged results (on Ctrl-C, those judged so far), returning lines to show."""
 
     def __init__(
         self,

@@ -85,12 +85,8 @@ class VerdictCache:
         return {name for name, verdict in self.verdicts().items() if verdict == FAILED}
 
     def remember(self, results: Sequence[RunResult], *, interrupted: bool = False) -> None:
-        """Keep this run's verdicts, over the earlier ones of the same scenarios.
-
-        Not judged, so not kept: a scenario not run, and, when the run was
-        `interrupted`, the scenario it stopped in. A file that cannot be
-        written is no error: the order is a convenience.
-        """
+        """Keep this run's judged verdicts (not the scenario an `interrupted` run stopped
+        in) over the earlier ones; a file that cannot be written is no error."""
         judged = [r for r in results if not r.not_run]
         if interrupted and judged:
             judged = judged[:-1]
