@@ -42,17 +42,22 @@ HELP = "run one node through every combination of scenarios, faults, seeds and t
 MAX_RUNS = 100_000
 
 
-def _thresholds(text: str) -> list[float]:
+def _numbers(text: str, positive: bool, problem: str) -> list[float]:
+    """A comma list of finite numbers (> 0 if `positive`); `problem` names one that is not."""
     values = []
     for item in name_list(text):
         try:
             value = float(item)
         except ValueError:
             value = math.nan
-        if not (math.isfinite(value) and value > 0):
-            raise argparse.ArgumentTypeError(f"a threshold is metres > 0, got {item[:20]!r}")
+        if not math.isfinite(value) or (positive and value <= 0):
+            raise argparse.ArgumentTypeError(f"{problem}, got {item[:20]!r}")
         values.append(value)
     return values
+
+
+def _thresholds(text: str) -> list[float]:
+    return _numbers(text, True, "a threshold is metres > 0")
 
 
 def _variation(text: str) -> tuple[str, list[float]]:
@@ -64,17 +69,9 @@ def _variation(text: str) -> tuple[str, list[float]]:
     if not sep or name not in VARIATIONS:
         known = ", ".join(VARIATIONS)
         raise argparse.ArgumentTypeError(f"give NAME=LEVEL[,LEVEL] with NAME one of {known}")
-    values = []
-    for item in name_list(levels):
-        try:
-            value = float(item)
-        except ValueError:
-            value = math.nan
-        if not math.isfinite(value) or (name in ("speed", "wall_distance") and value <= 0):
-            kind = "a number > 0" if name in ("speed", "wall_distance") else "a number"
-            raise argparse.ArgumentTypeError(f"{name}: a level is {kind}, got {item[:20]!r}")
-        values.append(value)
-    return name, values
+    positive = name in ("speed", "wall_distance")
+    kind = "a number > 0" if positive else "a number"
+    return name, _numbers(levels, positive, f"{name}: a level is {kind}")
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -228,11 +225,8 @@ def _run_all(
     path: Path,
     columns: tuple[str, ...],
 ) -> ResultsTable:
-    """Run every spec on the cluster, write each row as it finishes, show progress.
-
-    The table is opened (a fresh one emptied) only once the cluster answers,
-    so a mistyped --scheduler costs no earlier results.
-    """
+    """Run every spec on the cluster, write each row as it finishes, show progress; the
+    table is emptied only once the cluster answers (a mistyped --scheduler costs nothing)."""
     from harness.campaign.results import ResultsTable
     from harness.campaign.task import run_one
     from harness.cluster.progress import add_task, task_progress
