@@ -166,11 +166,8 @@ def _children_peak_mb(stages: Mapping[str, StageResult]) -> float:
 
 
 def figures(stages: Mapping[str, StageResult], harness_peak_rss_mb: float) -> dict[str, Any]:
-    """Every named figure; None where the stage that measures it did not run.
-
-    ``peak_rss_mb`` is the harness's own peak plus the most its child
-    processes (node, board driver) held at once in one link stage.
-    """
+    """Every named figure, None where its stage did not run; ``peak_rss_mb`` adds the most
+    the child processes held at once in one link stage."""
     out: dict[str, Any] = {}
     for stage_name, prefix in _THROUGHPUT.items():
         stage = stages.get(stage_name)
@@ -230,16 +227,14 @@ def figures(stages: Mapping[str, StageResult], harness_peak_rss_mb: float) -> di
 
 def check_targets(values: Mapping[str, Any]) -> list[dict[str, Any]]:
     """Each target with the measured value and whether it was met (None: not measured)."""
-    checked = []
-    for target in TARGETS:
-        value = values.get(target.key)
-        checked.append(
-            {
-                "key": target.key,
-                "label": target.label,
-                "target": target.goal,
-                "value": value,
-                "met": None if value is None else bool(target.met(value)),
-            }
-        )
-    return checked
+    return [
+        {
+            "key": target.key,
+            "label": target.label,
+            "target": target.goal,
+            "value": value,
+            "met": None if value is None else bool(target.met(value)),
+        }
+        for target in TARGETS
+        for value in [values.get(target.key)]
+    ]

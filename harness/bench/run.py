@@ -47,17 +47,6 @@ class BenchPlan:
         return 1.0 if self.quick else 30.0
 
     @property
-    def suite_cli(self) -> bool:
-        """Also time the lab trio's CLI in a fresh process (not in quick runs)."""
-        return not self.quick
-
-    @property
-    def suite_student_split(self) -> bool:
-        """Also split the workspace node's suite in this process (not in quick runs:
-        one more suite of student node starts)."""
-        return not self.quick
-
-    @property
     def suite_scenarios(self) -> tuple[str, ...]:
         """The suite stage's scenarios: the lab trio and the whole shipped suite (quick:
         approach_wall alone, for both)."""
@@ -120,9 +109,9 @@ def _measure(name: str, plan: BenchPlan) -> StageResult:
 
         return measure_suite(
             lab_workload(1, plan.suite_scenarios or LAB_TRIO),
-            cli=plan.suite_cli,
+            cli=not plan.quick,  # the lab trio's CLI in a fresh process too
             suite_runs=plan.suite_runs,
-            student_split=plan.suite_student_split,
+            student_split=not plan.quick,  # quick: no more suites of student node starts
             suite=plan.suite_scenarios,
         )
     if name == "grade":

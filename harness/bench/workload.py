@@ -43,18 +43,12 @@ class Workload:
     @property
     def threshold(self) -> float:
         """The one threshold the node is started with (every scenario must share it)."""
-        values = {effective_threshold(s, self.settings) for s in self.scenarios}
-        if len(values) != 1:
-            raise ConfigError(f"bench scenarios need one threshold, got {sorted(values)}")
-        return values.pop()
+        return _one({effective_threshold(s, self.settings) for s in self.scenarios}, "threshold")
 
     @property
     def scan_rate_hz(self) -> float:
         """The LIDAR rate the device emulators are built for (every scenario must share it)."""
-        rates = {s.lidar_spec.rate_hz for s in self.scenarios}
-        if len(rates) != 1:
-            raise ConfigError(f"bench scenarios need one LIDAR rate, got {sorted(rates)}")
-        return rates.pop()
+        return _one({s.lidar_spec.rate_hz for s in self.scenarios}, "LIDAR rate")
 
     def runs(self) -> list[Scenario]:
         """Every scenario run, in order."""
@@ -65,12 +59,16 @@ class Workload:
 
     def oracle(self) -> Oracle:
         """One oracle for the chained stream (same threshold and noise for every run)."""
-        sigmas = {p.noise_sigma for p in self.profiles()}
-        if len(sigmas) != 1:
-            raise ConfigError(f"bench scenarios need one noise sigma, got {sorted(sigmas)}")
-        return Oracle(
-            self.threshold, noise_sigma=sigmas.pop(), status_pattern=self.settings.status_pattern
-        )
+        sigma = _one({p.noise_sigma for p in self.profiles()}, "noise sigma")
+        pattern = self.settings.status_pattern
+        return Oracle(self.threshold, noise_sigma=sigma, status_pattern=pattern)
+
+
+def _one(values: set[float], what: str) -> float:
+    """The one value every scenario of a bench must share (one node serves them all)."""
+    if len(values) != 1:
+        raise ConfigError(f"bench scenarios need one {what}, got {sorted(values)}")
+    return values.pop()
 
 
 def lab_workload(repeats: int = 1, names: Sequence[str] = LAB_TRIO) -> Workload:
