@@ -44,8 +44,14 @@ MAX_MESH_BYTES = 50 << 20  # one mesh file
 MESH_SUFFIXES = (".stl", ".obj", ".dae")  # what PyBullet's mesh loader reads
 SNIFF_BYTES = 64 << 10  # how much of a mesh is read to see what it is
 JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar", "spherical")
-URDF_SHAPES = ("box", "cylinder", "sphere", "capsule", "mesh", "plane")
-SDF_SHAPES = ("box", "cylinder", "sphere", "capsule", "mesh", "plane")
+SHAPES = ("box", "cylinder", "sphere", "capsule", "mesh", "plane")  # URDF's and SDF's
+# The sizes each solid shape must give (name, how many numbers), every one positive.
+_SIZES = {
+    "box": (("size", 3),),
+    "cylinder": (("radius", 1), ("length", 1)),
+    "capsule": (("radius", 1), ("length", 1)),
+    "sphere": (("radius", 1),),
+}
 
 
 def robot_models_dir() -> Path:
@@ -317,25 +323,27 @@ def _check_origin(element: ET.Element, what: str) -> None:
         _attr_numbers(origin, "rpy", 3, f"{what} origin")
 
 
+def _one_shape(geometry: ET.Element, what: str) -> ET.Element:
+    """The one shape a <geometry> must hold, of a kind PyBullet reads."""
+    shapes = list(geometry)
+    if len(shapes) != 1:
+        raise ConfigError(f"{what}: <geometry> needs exactly one shape, got {len(shapes)}")
+    if shapes[0].tag not in SHAPES:
+        raise ConfigError(f"{what}: unknown shape <{shapes[0].tag}> (known: {', '.join(SHAPES)})")
+    return shapes[0]
+
+
 def _urdf_geometry(holder: ET.Element, what: str) -> str | None:
     """Check one <visual>/<collision>; the mesh file name it uses, if any."""
     _check_origin(holder, what)
     geometries = holder.findall("geometry")
     if len(geometries) != 1:
         raise ConfigError(f"{what}: needs one <geometry>, got {len(geometries)}")
-    shapes = list(geometries[0])
-    if len(shapes) != 1:
-        raise ConfigError(f"{what}: <geometry> needs exactly one shape, got {len(shapes)}")
-    shape = shapes[0]
+    shape = _one_shape(geometries[0], what)
     where = f"{what} <{shape.tag}>"
-    if shape.tag == "box":
-        _numbers(shape.get("size"), 3, f"{where} size", positive=True)
-    elif shape.tag in ("cylinder", "capsule"):
-        _numbers(shape.get("radius"), 1, f"{where} radius", positive=True)
-        _numbers(shape.get("length"), 1, f"{where} length", positive=True)
-    elif shape.tag == "sphere":
-        _numbers(shape.get("radius"), 1, f"{where} radius", positive=True)
-    elif shape.tag == "plane":
+    for name, count in _SIZES.get(shape.tag, ()):
+        _numbers(shape.get(name), count, f"{where} {name}", positive=True)
+    if shape.tag == "plane":
         _attr_numbers(shape, "normal", 3, where)
     elif shape.tag == "mesh":
         _attr_numbers(shape, "scale", 3, where)
@@ -343,8 +351,6 @@ def _urdf_geometry(holder: ET.Element, what: str) -> str | None:
         if not filename.strip():
             raise ConfigError(f"{where}: no filename")
         return filename
-    else:
-        raise ConfigError(f"{what}: unknown shape <{shape.tag}> (known: {', '.join(URDF_SHAPES)})")
     return None
 
 
@@ -422,19 +428,11 @@ def _sdf_geometry(holder: ET.Element, what: str) -> str | None:
     geometry = holder.find("geometry")
     if geometry is None:
         raise ConfigError(f"{what}: no <geometry>")
-    shapes = list(geometry)
-    if len(shapes) != 1:
-        raise ConfigError(f"{what}: <geometry> needs exactly one shape, got {len(shapes)}")
-    shape = shapes[0]
+    shape = _one_shape(geometry, what)
     where = f"{what} <{shape.tag}>"
-    if shape.tag == "box":
-        _text_numbers(shape, "size", 3, where, True)
-    elif shape.tag in ("cylinder", "capsule"):
-        _text_numbers(shape, "radius", 1, where, True)
-        _text_numbers(shape, "length", 1, where, True)
-    elif shape.tag == "sphere":
-        _text_numbers(shape, "radius", 1, where, True)
-    elif shape.tag == "plane":
+    for name, count in _SIZES.get(shape.tag, ()):
+        _text_numbers(shape, name, count, where, True)
+    if shape.tag == "plane":
         for tag, count in (("normal", 3), ("size", 2)):
             if shape.find(tag) is not None:
                 _text_numbers(shape, tag, count, where, tag == "size")
@@ -445,8 +443,6 @@ def _sdf_geometry(holder: ET.Element, what: str) -> str | None:
         if not uri:
             raise ConfigError(f"{where}: no <uri>")
         return uri
-    else:
-        raise ConfigError(f"{what}: unknown shape <{shape.tag}> (known: {', '.join(SDF_SHAPES)})")
     return None
 
 
