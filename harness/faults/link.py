@@ -1,14 +1,10 @@
 """Seeded faults of the link between the LIDAR and the node (pure: numpy only).
 
-Scan faults (``harness.faults.sensor``) change what a scan says; link faults change
-how scans travel: late, lost, twice, out of order, at a drifting rate, with
-old stamps, and on a serial line damaged bytes. A scenario names both kinds
-in one ``faults:`` list; this module holds the link kinds, plans each
-scan's delivery, and damages serial bytes.
-
-Each kind draws from its own generator, seeded from the run's seed and the
-kind, with a fixed number of draws per scan (or per byte), so adding a link
-fault never changes the scans, and the same seed gives the same plan.
+Scan faults (``sensor``) change what a scan says; link faults how it travels
+(late, lost, twice, out of order, a drifting rate, old stamps) and, on a
+serial line, its bytes. Each kind draws a fixed number of times per scan (or
+byte) from its own generator, seeded by the run's seed and the kind, so
+adding a link fault never changes the scans, and one seed gives one plan.
 """
 
 from __future__ import annotations

@@ -1,17 +1,13 @@
 """Seeded fault profiles: the simulator's truth in, the emitted Scan out (pure).
 
-The simulator knows the true distance of every beam. Real sensors and their
-drivers add noise, lose returns, report ghosts closer than range_min, and
-disagree on how to write "no return" and "too close". A ``FaultProfile``
-models all of that in one fixed pipeline so a scenario can name what its
-node must survive::
+Real sensors and drivers add noise, lose returns, report ghosts below
+range_min and disagree on how to write "no return" and "too close"; a
+``FaultProfile`` models that in one fixed pipeline::
 
-    truth -> noise -> classify (too close / no return / valid)
-          -> dropouts -> spurious -> convention encoding -> float32 Scan
+    truth -> noise -> classify -> dropouts -> spurious -> convention -> float32 Scan
 
-Every random draw has a fixed size per fault (one number per beam), so the
-stream an ``np.random.Generator`` yields does not depend on what the robot
-sees: same profile + seed gives byte-identical scans.
+Every draw has a fixed size per fault (one number per beam), so one profile
+and seed give byte-identical scans whatever the robot sees.
 """
 
 from __future__ import annotations

@@ -32,12 +32,10 @@ def run_suite(
 ) -> list[RunResult]:
     """Run each scenario through a link of its own, and report the results in order.
 
-    `on_result` gets each once its link is closed; `on_judged` as soon as its
-    ticks are judged (a screen can show it while its node stops); a scenario
-    cut short by Ctrl-C only goes to `on_result`. Links that can overlap start
-    ahead and stop behind (``link_pipeline``); what they share for the run is
-    their class's ``run_session``. Once the software under test fails to come
-    up, the rest are marked not run.
+    `on_result` gets each once its link is closed, `on_judged` as soon as its
+    ticks are judged (a scenario cut short by Ctrl-C only goes to `on_result`).
+    Links that can overlap start ahead and stop behind (``link_pipeline``); once
+    the software under test fails to come up, the rest are marked not run.
     """
     results: list[RunResult] = []
     if not scenarios:

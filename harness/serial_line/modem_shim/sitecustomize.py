@@ -1,21 +1,13 @@
 """Modem lines for pyserial clients on the harness's emulated port (a pty).
 
-A pty has no modem lines: pyserial's ``setDTR``/``setRTS`` there fail with
-ENOTTY, and the RPLIDAR clients drive the A1's motor with DTR. Python runs
-this file at start-up when its folder is on PYTHONPATH (the ``site``
-module's ``sitecustomize`` hook). It imports nothing heavy: it only adds an
-import hook that, once ``serial.serialposix`` has loaded as usual, wraps
-the modem-line calls of its ``Serial``. A wrapped call runs pyserial's own
-code first; only when that fails for want of modem lines (ENOTTY, EINVAL)
-on a port ``FOSSBOT_HIL_MODEM_LINES`` lists does it succeed instead: a DTR
-or RTS change goes to the port's socket as one datagram (b"DTR 1"), and
-reading CTS, DSR, RI or CD gives False (an A1 drives none of them).
-Anything else is pyserial's own behaviour.
-
-``FOSSBOT_HIL_MODEM_LINES`` (read at each call) lists ``PORT=SOCKET``
-items separated by ``os.pathsep``; ``PORT`` alone means the calls succeed
-and go nowhere. Then the next ``sitecustomize`` on ``sys.path`` (Debian's,
-a virtual environment's, the user's own) runs as it would have without us.
+On a pty pyserial's ``setDTR``/``setRTS`` fail with ENOTTY, yet RPLIDAR
+clients drive the A1's motor with DTR. Run at start-up from PYTHONPATH (the
+``sitecustomize`` hook), this only adds an import hook that wraps
+``serial.serialposix.Serial``'s modem-line calls: where pyserial's own code
+fails for want of modem lines on a port ``FOSSBOT_HIL_MODEM_LINES`` lists
+(format: ``harness.serial_line.modem_lines``), a DTR or RTS change goes to
+the port's socket (b"DTR 1") and reading CTS, DSR, RI or CD gives False.
+Then the next ``sitecustomize`` on ``sys.path`` runs as it would have.
 """
 
 from __future__ import annotations
