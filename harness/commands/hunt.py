@@ -232,11 +232,11 @@ def _run_on(
         client.submit(run_candidate, c, run_seed, link_name, options, judged, pure=False)
         for c in candidates
     ]
-    outcomes = []
-    for candidate, future in zip(candidates, futures, strict=True):
-        outcome = run_result(future, "hunt stopped: a run")
-        outcomes.append(Outcome(candidate, None, 0.0, KILLED) if outcome is None else outcome)
-    return outcomes
+    outcomes = [run_result(future, "hunt stopped: a run") for future in futures]
+    return [
+        Outcome(candidate, None, 0.0, KILLED) if outcome is None else outcome
+        for candidate, outcome in zip(candidates, outcomes, strict=True)
+    ]
 
 
 def _clear(out: Path) -> None:
