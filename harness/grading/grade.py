@@ -13,8 +13,10 @@ from __future__ import annotations
 
 import contextlib
 import json
+import os
 import shlex
 import shutil
+import socket
 import sys
 import threading
 import traceback
@@ -30,8 +32,9 @@ from harness.grading.class_table import ERROR, NOT_RUN, PASS, StudentGrade
 from harness.grading.discover import Student
 from harness.grading.hidden import HiddenScenario, scrub_folder
 from harness.grading.plots import PLOT_WAIT_S, plots_drawn, plotter
-from harness.grading.process import TERM_GRACE_S, Finished, StopFlag, run_bounded
+from harness.grading.process import TERM_GRACE_S, Finished, StopFlag, guarded, run_bounded
 from harness.grading.scoring import held_of
+from harness.grading.warm_judge import Slot, close_judges, drop_judge, warm_judge
 from harness.grading.worker import write_job
 from harness.judge.records import RunResult
 from harness.links.base import LinkOptions
@@ -121,10 +124,12 @@ def _shown_name(name: str, config: GradeConfig) -> str:
     return name if hidden is None else hidden.label
 
 
-def student_scrub(student: Student, config: GradeConfig, folder: Path) -> list[tuple[str, str]]:
+def student_scrub(
+    student: Student, config: GradeConfig, folder: Path, also: Sequence[Path] = ()
+) -> list[tuple[str, str]]:
     """What the student's own files must not say, and what they say instead: the
-    instructor's paths (the class folder, --out, the harness, the Python) and the files of
-    the scenarios (a hidden one by its label)."""
+    instructor's paths (the class folder, --out, the harness, the Python, `also`: the
+    warm judge's slot) and the files of the scenarios (a hidden one by its label)."""
     import harness
 
     pairs: list[tuple[str, str]] = []
@@ -133,6 +138,7 @@ def student_scrub(student: Student, config: GradeConfig, folder: Path) -> list[t
         (folder, ""),
         (config.students_dir.parent, ""),
         (Path(harness.__file__).parent.parent, ""),
+        *((path, "") for path in also),
     ):
         pairs += [(f"{where}/", instead), (f"{where.resolve()}/", instead)]
     pairs += [(sys.executable, "python3"), (str(Path(sys.executable).resolve()), "python3")]
@@ -255,9 +261,60 @@ def _artifacts(folder: Path) -> tuple[tuple[str, str], ...]:
 def _run_options(student: Student, config: GradeConfig, folder: Path) -> LinkOptions:
     if student.kind == "script":
         assert student.script is not None
-        command = f"{shlex.quote(sys.executable)} {shlex.quote(str(student.script.resolve()))}"
-        return replace(config.options, node=command, package=None, executable=None)
+        return _script_options(config, student.script.resolve())
     return replace(config.options, node=None, workspace=str(folder / "colcon"))
+
+
+def _script_options(config: GradeConfig, script: Path) -> LinkOptions:
+    command = f"{shlex.quote(sys.executable)} {shlex.quote(str(script))}"
+    return replace(config.options, node=command, package=None, executable=None)
+
+
+def _script_name(student: Student) -> Path:
+    """The node script, relative to the student's folder."""
+    assert student.script is not None
+    return student.script.resolve().relative_to(student.folder.resolve())
+
+
+def _slot(config: GradeConfig) -> Slot:
+    """This worker process's slot for its warm judge, under the grader's folder."""
+    return Slot(config.grader_dir / ".slots" / f"{socket.gethostname()}-{os.getpid()}")
+
+
+def _judge_warm(job: Path, slot: Slot, config: GradeConfig, cancel: StopFlag) -> Finished:
+    """`job` judged by this worker's warm judge (started if need be); a judge stopped
+    on the way (time limit, flood, cancel, crash) is not used again."""
+    command = [sys.executable, "-m", "harness.grading.warm_judge"]
+    command += ["--sandboxed"] if config.sandbox is not None else []
+    argv = _judging_command(command, [slot.node], [slot.root / "out"], config)
+    judge = warm_judge(guarded(argv), slot.root)
+    finished, reusable = judge.judge(
+        job,
+        slot.student / "run.log",
+        timeout=config.student_timeout,
+        max_log_bytes=MAX_RUN_LOG_BYTES,
+        cancel=cancel,
+    )
+    if not reusable:
+        drop_judge(judge)
+    return finished
+
+
+def _map_results(path: Path, moved: Callable[[str], str]) -> None:
+    """The results at `path` with every text `moved` (paths of the slot to the real ones)."""
+
+    def mapped(value: Any) -> Any:
+        if isinstance(value, str):
+            return moved(value)
+        if isinstance(value, list):
+            return [mapped(v) for v in value]
+        if isinstance(value, dict):
+            return {k: mapped(v) for k, v in value.items()}
+        return value
+
+    data = _read_results(path)
+    if data:
+        write_atomically(path, json.dumps(mapped(data), indent=2).encode())
 
 
 def _grade(student: Student, config: GradeConfig, cancel: StopFlag) -> StudentGrade:
@@ -313,29 +370,43 @@ def _grade(student: Student, config: GradeConfig, cancel: StopFlag) -> StudentGr
     if cancel.is_set():
         return without_run("interrupted", build_s)
     options = _run_options(student, config, folder)
+    slot = _slot(config) if student.kind == "script" else None  # a warm judge's
+    copy = None if slot is None else slot.fill(student.folder, config.students_dir.parent)
+    out, own = (folder, grader) if slot is None else (slot.student, slot.grader)
+    judged = options if copy is None else _script_options(config, copy / _script_name(student))
     plots = grader / "plots" if config.defer_plots else None
     job = write_job(
-        grader / "job.json",
+        own / "job.json",
         scenarios=list(config.scenario_refs),
         link=config.link,
-        options=options,
+        options=judged,
         settings=config.settings,
-        results=grader / "results.json",
-        junit=folder / "junit.xml",
-        report=folder / "report",
+        results=own / "results.json",
+        junit=out / "junit.xml",
+        report=out / "report",
         hidden={
             n: {"label": h.label, "show_failure": h.show_failure} for n, h in config.hidden.items()
         },
-        plots=plots,
+        plots=None if plots is None else own / "plots",
     )
-    finished = run_bounded(
-        _judging_command(job, student, config, folder, grader),
-        log=folder / "run.log",
-        timeout=config.student_timeout,
-        max_log_bytes=MAX_RUN_LOG_BYTES,
-        cwd=folder,
-        cancel=cancel,
-    )
+    if slot is None or copy is None:  # a package or workspace: a judging process of its own
+        finished = run_bounded(
+            _judging_command(
+                [sys.executable, "-m", "harness.grading.worker", str(job)],
+                [folder / "colcon"],
+                [folder, grader],
+                config,
+            ),
+            log=folder / "run.log",
+            timeout=config.student_timeout,
+            max_log_bytes=MAX_RUN_LOG_BYTES,
+            cwd=folder,
+            cancel=cancel,
+        )
+    else:
+        finished = _judge_warm(job, slot, config, cancel)
+        slot.move_out(folder, grader)
+        _map_results(grader / "results.json", slot.moved(copy, student.folder, folder, grader))
     if plots is not None and plots.is_dir():  # drawn while the worker's next student runs
         plotter().submit(plots, folder / "report" / "scenarios", grader / "plot-errors.log")
     data = _read_results(grader / "results.json")
@@ -345,7 +416,8 @@ def _grade(student: Student, config: GradeConfig, cancel: StopFlag) -> StudentGr
     first += f" ({refused})" if refused else ""
     if not (folder / "junit.xml").exists():
         _placeholder_junit(config, folder, first or "no results")
-    scrub_folder(folder, student_scrub(student, config, folder))
+    slotted = () if slot is None or copy is None else (copy, slot.student, slot.grader, slot.root)
+    scrub_folder(folder, student_scrub(student, config, folder, slotted))
     return StudentGrade(
         student.name,
         student.kind,
@@ -362,20 +434,18 @@ def _grade(student: Student, config: GradeConfig, cancel: StopFlag) -> StudentGr
 
 
 def _judging_command(
-    job: Path, student: Student, config: GradeConfig, folder: Path, grader: Path
+    command: list[str], node_files: list[Path], outputs: list[Path], config: GradeConfig
 ) -> list[str]:
-    """The worker that runs the student's suite; in its sandbox, the node in a nested one
-    that shows only the node's own files (its script's folder, or its build)."""
-    command = [sys.executable, "-m", "harness.grading.worker", str(job)]
+    """The judging process's `command`; in its sandbox, the node in a nested one that
+    shows only `node_files` (the script's copy in the slot, or the build)."""
     if config.sandbox is None:
         return command
-    node_files = [student.folder] if student.kind == "script" else [folder / "colcon"]
     scenario_files = [Path(ref) for ref in config.scenario_refs if Path(ref).is_absolute()]
     return sandboxed_run(
         command,
         node_files=node_files,
         scenario_files=scenario_files,
-        outputs=[folder, grader],
+        outputs=outputs,
         limits=config.sandbox,
     )
 
@@ -448,9 +518,19 @@ def grade_class(
             stop.set()
             _wait_for_running(list(window.running), client)
         raise
+    finally:
+        _close_judges(client, config)
     if config.defer_plots:
         _wait_for_plots(client)
     return [grades[i] for i in range(len(students))]
+
+
+def _close_judges(client: Any, config: GradeConfig) -> None:
+    """Every worker's warm judge closed, and its slot gone (an external cluster's workers
+    outlive the grading)."""
+    with contextlib.suppress(Exception):
+        client.run(close_judges)
+    shutil.rmtree(config.grader_dir / ".slots", ignore_errors=True)
 
 
 def _wait_for_plots(client: Any) -> None:

@@ -23,11 +23,11 @@ import time
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Protocol
+from typing import Any, Protocol
 
 from harness.nodes.process_group import signal_group, wait_group_gone
 
-__all__ = ["StopFlag", "Finished", "run_bounded"]
+__all__ = ["StopFlag", "Finished", "guarded", "run_bounded", "stop_child"]
 
 MAX_FILE_BYTES = 128 * 1024 * 1024  # any one file a student's build or node writes
 # How often a running child's log size and the cancel flag are looked at: a child
@@ -61,7 +61,7 @@ class Finished:
         return self.returncode == 0 and not (self.timed_out or self.flooded or self.cancelled)
 
 
-def _stop(popen: subprocess.Popen[bytes]) -> None:
+def stop_child(popen: subprocess.Popen[Any]) -> None:
     """SIGTERM the group, then SIGKILL it after a bounded wait; reap the child."""
     for sig, grace in ((signal.SIGTERM, TERM_GRACE_S), (signal.SIGKILL, KILL_WAIT_S)):
         if popen.poll() is not None:
@@ -79,6 +79,12 @@ def _stop(popen: subprocess.Popen[bytes]) -> None:
     wait_group_gone(popen.pid, KILL_WAIT_S)
 
 
+def guarded(argv: Sequence[str], max_file_bytes: int = MAX_FILE_BYTES) -> list[str]:
+    """`argv` started through this module: it dies with the thread that started it, and
+    no file it writes grows past `max_file_bytes`."""
+    return [sys.executable, "-m", "harness.grading.process", str(max_file_bytes), *argv]
+
+
 def run_bounded(
     argv: Sequence[str],
     *,
@@ -91,13 +97,12 @@ def run_bounded(
     max_file_bytes: int = MAX_FILE_BYTES,
 ) -> Finished:
     """Run `argv` with stdout and stderr in `log`; stop it on timeout, flood or cancel."""
-    guarded = [sys.executable, "-m", "harness.grading.process", str(max_file_bytes), *argv]
     started = time.monotonic()
     log.parent.mkdir(parents=True, exist_ok=True)
     with open(log, "ab") as out:
         try:
             popen = subprocess.Popen(
-                guarded,
+                guarded(argv, max_file_bytes),
                 stdin=subprocess.DEVNULL,
                 stdout=out,
                 stderr=subprocess.STDOUT,
@@ -123,10 +128,10 @@ def run_bounded(
             elif cancel is not None and cancel.is_set():
                 cancelled = True
             if timed_out or flooded or cancelled:
-                _stop(popen)
+                stop_child(popen)
                 break
     except BaseException:
-        _stop(popen)
+        stop_child(popen)
         raise
     return Finished(
         popen.returncode,

@@ -13,6 +13,7 @@ account goes to stdout (run.log), as ``fossbot-hil run`` prints it.
 
 from __future__ import annotations
 
+import functools
 import json
 import os
 import signal
@@ -33,6 +34,7 @@ if TYPE_CHECKING:  # imported by the suite: after the node's fork server has sta
 __all__ = [
     "interrupt_on_sigterm",
     "link_options_from",
+    "not_dumpable",
     "result_entry",
     "run_settings_from",
     "warm_node_server",
@@ -178,11 +180,10 @@ class _Suite:
 
         from harness.report.terminal import print_results
         from harness.runner.suite import run_suite
-        from harness.scenario.files import resolve_scenario
 
         job = self.job
         try:
-            chosen = [resolve_scenario(ref) for ref in job["scenarios"]]
+            chosen = [_scenario(ref) for ref in job["scenarios"]]
             self.scenarios.update((s.name, s) for s in chosen)
             run_suite(
                 chosen,
@@ -205,6 +206,15 @@ class _Suite:
         return 0
 
 
+@functools.cache
+def _scenario(ref: str) -> Any:
+    """A scenario read and checked once a process: a warm judge's students share them (a
+    class's scenario files do not change while it is graded; a Scenario is frozen)."""
+    from harness.scenario.files import resolve_scenario
+
+    return resolve_scenario(ref)
+
+
 def _hidden_scenarios(data: dict[str, Any]) -> dict[str, Any]:
     from harness.grading.hidden import HiddenScenario
 
@@ -214,7 +224,7 @@ def _hidden_scenarios(data: dict[str, Any]) -> dict[str, Any]:
     }
 
 
-def _not_dumpable() -> None:
+def not_dumpable() -> None:
     """In a sandbox: the node shares this process's PIDs, so keep it out of this process's
     /proc entries (its open files, its root, its memory: the scenario files)."""
     import ctypes
@@ -251,7 +261,7 @@ def main(argv: list[str]) -> int:
         return 2
     interrupt_on_sigterm()
     if os.environ.get(NODE_SANDBOX_ENV):
-        _not_dumpable()  # before anything is started: the fork server is its child
+        not_dumpable()  # before anything is started: the fork server is its child
     job = json.loads(Path(argv[0]).read_text(encoding="utf-8"))
     warm_node_server(job)
     return run_job(job)

@@ -276,11 +276,11 @@ def shared(module: str) -> ForkServer:
         if server is None:
             if not _SERVERS:
                 atexit.register(close_all)
-            server = _SERVERS[module] = _from_a_lasting_thread(lambda: ForkServer(module))
+            server = _SERVERS[module] = from_a_lasting_thread(lambda: ForkServer(module))
     return server
 
 
-def _from_a_lasting_thread(make: Callable[[], T]) -> T:
+def from_a_lasting_thread(make: Callable[[], T]) -> T:
     """`make()` in the main thread, or in a thread that lasts as long as the process: a
     child's PDEATHSIG fires when the thread that started it ends, and a worker's task
     thread may end before the process does."""

@@ -1,0 +1,311 @@
+"""One judging process a grading worker keeps across its script students, in its sandbox.
+
+A fresh judging process costs each student about a second of CPU before their first
+scan (Python, the runner, the ROS 2 link, the MCAP writer) and its fork server's
+imports after that. So a worker keeps one (``python -m harness.grading.warm_judge``),
+started in a sandbox that shows, besides the system and the scenarios, only the
+worker's *slot*: ``slot/node`` (the current student's files, read-only; the node's
+nested sandbox shows that alone) and ``slot/out`` (the current student's outputs).
+The worker copies a student's files into the slot, hands the judge a job, and moves
+the outputs to the student's folders afterwards.
+
+Between students the judge ends every process left in its PID namespace but its own
+(a node's daemon included: nested namespaces are seen from here), empties its
+/dev/shm (shared with the nodes for DDS) and only then starts the next student's
+fork server, in a fresh nested sandbox (fresh /tmp and home); the worker then
+replaces the slot's files. A student's code never sees another's files or what the
+previous one left. A student who overruns, floods the log or is cancelled takes the
+judge down (stopped as a fresh one is); the next student gets a new judge.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import os
+import select
+import shutil
+import signal
+import subprocess
+import sys
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+__all__ = ["Slot", "WarmJudge", "close_judges", "drop_judge", "end_strays", "warm_judge"]
+
+STRAY_WAIT_S = 5.0  # for what a student left running to be gone once killed
+START_WAIT_S = 30.0  # for a started judge to take its first job (it reads stdin at once)
+DONE = "done"
+
+
+# -- in the sandbox -----------------------------------------------------------
+
+
+def _pids() -> list[int]:
+    return [int(p) for p in os.listdir("/proc") if p.isdigit()]
+
+
+def _alive(pid: int) -> bool:
+    """Running or stopped, not a zombie (a zombie holds nothing and is reaped by its
+    parent, or by the sandbox's init once orphaned)."""
+    try:
+        with open(f"/proc/{pid}/stat", "rb") as stat:
+            state = stat.read().rsplit(b")", 1)[1].split()[0]
+    except (OSError, IndexError):
+        return False
+    return state not in (b"Z", b"X")
+
+
+def _reap_children() -> None:
+    with contextlib.suppress(ChildProcessError):
+        while os.waitpid(-1, os.WNOHANG)[0]:
+            pass
+
+
+def end_strays(wait_s: float = STRAY_WAIT_S) -> bool:
+    """SIGKILL every live process of this PID namespace but its init (1) and us, until
+    none is left; False if some still live after `wait_s` (the judge then exits)."""
+    ends = time.monotonic() + wait_s
+    while True:
+        _reap_children()
+        others = [pid for pid in _pids() if pid not in (1, os.getpid()) and _alive(pid)]
+        if not others:
+            return True
+        if time.monotonic() > ends:
+            return False
+        fds = []
+        for pid in others:
+            with contextlib.suppress(OSError):
+                fds.append(os.pidfd_open(pid))
+                os.kill(pid, signal.SIGKILL)
+        try:  # bounded: the kills take effect, or the loop looks again
+            select.select(fds, [], [], max(0.0, min(0.2, ends - time.monotonic())))
+        finally:
+            for fd in fds:
+                os.close(fd)
+
+
+def _empty(folder: str) -> None:
+    for name in os.listdir(folder):
+        path = os.path.join(folder, name)
+        if os.path.isdir(path) and not os.path.islink(path):
+            shutil.rmtree(path, ignore_errors=True)
+        else:
+            with contextlib.suppress(OSError):
+                os.unlink(path)
+
+
+def _to(fd: int) -> None:
+    """This process's stdout and stderr (and its children's) to `fd`."""
+    sys.stdout.flush()
+    sys.stderr.flush()
+    os.dup2(fd, 1)
+    os.dup2(fd, 2)
+
+
+def serve(sandboxed: bool) -> int:
+    """Judge a job a line on stdin (``{"job", "log"}``), its account in `log`; ``done
+    CODE`` a line on the original stdout once judged and, sandboxed, once nothing of the
+    student is left. Ends with stdin, or when a student's processes cannot be ended."""
+    from harness.grading.worker import interrupt_on_sigterm, not_dumpable, run_job, warm_node_server
+
+    answers = os.fdopen(os.dup(1), "w", buffering=1)
+    quiet = os.open(os.devnull, os.O_WRONLY)
+    _to(quiet)
+    interrupt_on_sigterm()
+    if sandboxed:
+        not_dumpable()
+    warmed = False
+    for line in sys.stdin:
+        request = json.loads(line)
+        job = json.loads(Path(request["job"]).read_text(encoding="utf-8"))
+        log = os.open(request["log"], os.O_WRONLY | os.O_CREAT | os.O_APPEND, 0o644)
+        _to(log)
+        try:
+            if not warmed:
+                warm_node_server(job)
+            code = run_job(job)  # closes the fork server at its end
+        except KeyboardInterrupt:
+            return 1
+        finally:
+            _to(quiet)
+            os.close(log)
+        if sandboxed:
+            if not end_strays():
+                return 1
+            _empty("/dev/shm")
+        warmed = warm_node_server(job)  # the next student's: a fresh nested sandbox
+        answers.write(f"{DONE} {code}\n")
+    return 0
+
+
+# -- in the grading worker ------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Slot:
+    """A worker's folders for the student its judge is on: `node` (their files, read-only
+    in the sandbox), `student` and `grader` (their outputs, moved out once judged)."""
+
+    root: Path
+
+    @property
+    def node(self) -> Path:
+        return self.root / "node"
+
+    @property
+    def student(self) -> Path:
+        return self.root / "out" / "student"
+
+    @property
+    def grader(self) -> Path:
+        return self.root / "out" / "grader"
+
+    def fill(self, files: Path, leave_out: Path) -> Path:
+        """The slot emptied, then `files` (a student's folder, without `leave_out`, the
+        grader's own folder should it be inside) in it: where they now are. Hard links
+        where the file system allows (the sandbox shows them read-only)."""
+        self.empty()
+        for folder in (self.node, self.student, self.grader):
+            folder.mkdir(parents=True, exist_ok=True)
+        copy = self.node / files.name
+        skipped = str(leave_out.resolve())
+
+        def ignored(folder: str, names: list[str]) -> list[str]:
+            return [n for n in names if os.path.join(os.path.realpath(folder), n) == skipped]
+
+        shutil.copytree(files, copy, symlinks=True, ignore=ignored, copy_function=_link_or_copy)
+        return copy
+
+    def move_out(self, student: Path, grader: Path) -> None:
+        """The outputs into the student's and the grader's folders; the slot emptied."""
+        for source, target in ((self.student, student), (self.grader, grader)):
+            for entry in sorted(source.iterdir()) if source.is_dir() else ():
+                shutil.move(str(entry), str(target / entry.name))
+        self.empty()
+
+    def empty(self) -> None:
+        """What the slot holds removed; its folders stay (the judge's sandbox binds them:
+        a folder made anew would not be the one it sees)."""
+        for folder in (self.node, self.student, self.grader):
+            if folder.is_dir():
+                _empty(str(folder))
+
+    def moved(self, copy: Path, files: Path, student: Path, grader: Path) -> Callable[[str], str]:
+        """What turns a text's paths in the slot into the ones outside it."""
+        pairs = ((copy, files), (self.student, student), (self.grader, grader))
+
+        def moved(text: str) -> str:
+            for inside, outside in pairs:
+                text = text.replace(str(inside), str(outside))
+            return text
+
+        return moved
+
+
+def _link_or_copy(source: str, target: str) -> None:
+    try:
+        os.link(source, target, follow_symlinks=False)
+    except OSError:
+        shutil.copy2(source, target)
+
+
+class WarmJudge:
+    """The worker's end of a judge: `argv` started (from a thread that lasts, so its
+    PDEATHSIG fires only with the worker) in the slot, fed one job at a time."""
+
+    def __init__(self, argv: list[str], slot: Path) -> None:
+        from harness.nodes.forkserver import from_a_lasting_thread
+
+        self.argv = argv
+        self.slot = slot
+        self.popen: subprocess.Popen[str] = from_a_lasting_thread(
+            lambda: subprocess.Popen(
+                argv,
+                stdin=subprocess.PIPE,
+                stdout=subprocess.PIPE,
+                stderr=subprocess.DEVNULL,
+                cwd=slot,
+                env={**os.environ, "PYTHONUNBUFFERED": "1"},
+                start_new_session=True,
+                text=True,
+            )
+        )
+
+    def judge(
+        self, job: Path, log: Path, *, timeout: float, max_log_bytes: int, cancel: object
+    ) -> tuple[object, bool]:
+        """Judge `job` (its account in `log`): (Finished, whether this judge can take the
+        next student). Stopped on timeout, flood or `cancel` as a fresh judge is."""
+        from harness.grading.process import POLL_S, Finished, stop_child
+
+        started = time.monotonic()
+        deadline = started + timeout
+        popen = self.popen
+        assert popen.stdin is not None and popen.stdout is not None
+        log.touch()
+        try:
+            popen.stdin.write(json.dumps({"job": str(job), "log": str(log)}) + "\n")
+            popen.stdin.flush()
+        except OSError:
+            return Finished(popen.poll(), 0.0, start_error="the judging process had ended"), False
+        why = ""
+        while not why:
+            left = deadline - time.monotonic()
+            readable, _, _ = select.select([popen.stdout], [], [], max(0.0, min(POLL_S, left)))
+            if readable:
+                answer = popen.stdout.readline().split()
+                if len(answer) == 2 and answer[0] == DONE:
+                    return Finished(int(answer[1]), time.monotonic() - started), True
+                stop_child(popen)  # it said something else, or ended: not reused
+                return Finished(popen.returncode, time.monotonic() - started), False
+            if time.monotonic() >= deadline:
+                why = "timed_out"
+            elif log.stat().st_size > max_log_bytes:
+                why = "flooded"
+            elif cancel is not None and cancel.is_set():  # type: ignore[attr-defined]
+                why = "cancelled"
+        stop_child(popen)
+        return Finished(popen.returncode, time.monotonic() - started, **{why: True}), False
+
+    def close(self) -> None:
+        from harness.grading.process import stop_child
+
+        with contextlib.suppress(OSError):
+            if self.popen.stdin is not None:
+                self.popen.stdin.close()  # it ends with its stdin
+        stop_child(self.popen)
+        shutil.rmtree(self.slot, ignore_errors=True)
+
+
+_JUDGES: list[WarmJudge] = []  # this worker's judge, at most one
+
+
+def warm_judge(argv: list[str], slot: Path) -> WarmJudge:
+    """This worker's judge for `argv` (the same sandbox view), started if need be; one of
+    another view, or one that ended, is closed first."""
+    if _JUDGES and (_JUDGES[0].argv != argv or _JUDGES[0].popen.poll() is not None):
+        _JUDGES.pop().close()
+    if not _JUDGES:
+        _JUDGES.append(WarmJudge(argv, slot))
+    return _JUDGES[0]
+
+
+def drop_judge(judge: WarmJudge) -> None:
+    """`judge` is not to be used again (stopped already)."""
+    if judge in _JUDGES:
+        _JUDGES.remove(judge)
+    judge.close()
+
+
+def close_judges() -> None:
+    """Close this worker's judge (``client.run`` at a class's end: an external cluster's
+    workers outlive the grading)."""
+    while _JUDGES:
+        _JUDGES.pop().close()
+
+
+if __name__ == "__main__":
+    sys.exit(serve("--sandboxed" in sys.argv[1:]))
