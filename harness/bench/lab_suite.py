@@ -66,8 +66,7 @@ def _shipped_suite(
     colcon: str,
     names: Sequence[str] = (),
 ) -> Figures:
-    """The shipped suite (or its scenarios `names`) three ways from spawn to exit (median
-    of `runs`), and two splits."""
+    """The shipped suite (or its scenarios `names`) three ways from spawn to exit, split."""
     workspace = build_lab_workspace(folder, source, colcon)
     shipped = [s for s in shipped_scenarios() if not names or s.name in names]
     bundled = _split("suite", "the bundled node", shipped, LinkOptions())

@@ -48,14 +48,12 @@ class BenchPlan:
 
     @property
     def suite_scenarios(self) -> tuple[str, ...]:
-        """The suite stage's scenarios: the lab trio and the whole shipped suite (quick:
-        approach_wall alone, for both)."""
+        """The suite stage's scenarios (quick: approach_wall alone; else all of them)."""
         return ("approach_wall",) if self.quick else ()
 
     @property
     def suite_runs(self) -> int:
-        """`fossbot-hil run` of the shipped suite, each of its three kinds (bundled node,
-        workspace node, inprocess link): the median of three (quick: one)."""
+        """`fossbot-hil run`s of each of the suite's three kinds (the median kept)."""
         return 1 if self.quick else 3
 
     @property

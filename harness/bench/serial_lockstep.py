@@ -1,10 +1,7 @@
 """Stage 'serial': lockstep through the virtual board, the rplidar link.
 
-The harness plays the FOSSBot's RPLIDAR A1M8 on a pty; the bundled board
-driver (the ``rplidar`` package) reads it and publishes /scan, and the
-reference node answers, each in its own process. Per scan: the revolution
-is encoded and written, the driver's /scan of it is awaited, then the
-node's answers, as in ``fossbot-hil run --link rplidar``.
+The emulated A1M8 on a pty, the bundled board driver and the reference node,
+each in its own process, as ``fossbot-hil run --link rplidar`` runs them.
 """
 
 from __future__ import annotations

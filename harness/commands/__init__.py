@@ -1,10 +1,8 @@
 """The `fossbot-hil` subcommands, one module each.
 
-A command module has ``NAME``, ``HELP`` (its line in ``fossbot-hil
---help``, and its own ``--help``'s description unless it has a longer
-``DESCRIPTION``), ``add_arguments(parser)`` and ``run(args, console) ->
-int``. Add a command by writing a module and naming it in
-``COMMAND_MODULES``; nothing else changes.
+A command module has ``NAME``, ``HELP`` (and a longer ``DESCRIPTION``, if
+any), ``add_arguments(parser)`` and ``run(args, console) -> int``; adding
+one is naming it in ``COMMAND_MODULES``.
 """
 
 from __future__ import annotations

@@ -272,8 +272,7 @@ def _reproduce_command(args: argparse.Namespace, scenario: Path) -> list[str]:
 
 
 def _write_counterexample(out: Path, result: Hunt, run_seed: int, command: list[str]) -> None:
-    """counterexample.yaml (a scenario file with a comment saying where it came from) and
-    reproduce.sh."""
+    """counterexample.yaml (commented with where it came from) and reproduce.sh."""
     import yaml
 
     from harness.hunt.space import robot_footprint, scenario_document

@@ -38,8 +38,7 @@ __all__ = ["watch", "watch_sources"]
 
 
 def watch_sources(args: argparse.Namespace, options: LinkOptions) -> NodeSources:
-    """The node's files and the scenario files given by path; ConfigError when there are
-    none to watch."""
+    """The node's files and the scenario files given by path; ConfigError when none."""
     from harness.watch.sources import node_sources, scenario_sources
 
     sources = node_sources(args.link, options).plus(scenario_sources(args.scenarios))

@@ -260,8 +260,7 @@ EVIDENCE = (("--record", "record"), ("--animation", "animation"))  # option, des
 def _evidence(
     console: Console, args: argparse.Namespace, scenario: Scenario, result: RunResult | None
 ) -> None:
-    """--record and --animation: what the lab asks students to hand in, from the judged
-    session."""
+    """--record and --animation: what the lab asks students to hand in."""
     wanted = [option for option, dest in EVIDENCE if getattr(args, dest)]
     if not wanted:
         return

@@ -177,8 +177,7 @@ def run(args: argparse.Namespace, console: Console) -> int:
 
 
 def _varied(items: list[tuple[str, list[float]]]) -> dict[str, list[float]]:
-    """--vary items by name, in the one order runs are keyed by; a name given twice is a
-    mistake."""
+    """--vary items by name, in the one order runs are keyed by (each name once)."""
     from harness.scenario.variations import ORDER
 
     levels: dict[str, list[float]] = {}

@@ -1,11 +1,8 @@
 """The topics the lab's Gazebo bridge speaks, on the harness's own ROS 2 node.
 
-Besides what the observer already does (``/scan`` and ``/clock`` out, the
-node's status and warning in), the simulator hears ``/cmd_vel``
-(geometry_msgs/Twist) and publishes ``/odom`` (nav_msgs/Odometry, ``odom``
--> ``base_footprint``), and ``/tf`` + ``/tf_static`` wherever tf2_msgs is
-importable (the ROS 2 wheels on the package index have no tf2_msgs: then
-``tf_missing`` says so and ``/odom`` carries the pose alone).
+Beside the observer's topics: ``/cmd_vel`` in, ``/odom`` out, and ``/tf`` and
+``/tf_static`` where tf2_msgs is importable (the ROS 2 wheels on the package
+index have none: then ``tf_missing`` says so and ``/odom`` carries the pose).
 """
 
 from __future__ import annotations

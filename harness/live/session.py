@@ -1,12 +1,9 @@
 """One live session: the world stepped in wall-clock time, its topics, view, keyboard and judge.
 
-The physics advances in slices of 1/60 s of simulation; before each slice
-the command in force is read (the newest /cmd_vel, or a stop once they
-stop coming), after it /clock and /odom go out, and at each LIDAR
-revolution /scan. Each slice then waits until its wall-clock time
-(simulation time / rate), handling the node's answers meanwhile; a machine
-too slow for the rate asked runs slower, and the summary says how fast it
-ran. Ctrl-C (or SIGTERM) ends a session normally.
+The physics advances in slices of 1/60 s, each following the command in
+force and publishing /clock, /odom and (at each revolution) /scan, then
+waiting for its wall-clock time while it hears the node; a machine too slow
+for the rate runs slower, and the summary says so. Ctrl-C ends it normally.
 """
 
 from __future__ import annotations

@@ -1,11 +1,8 @@
 """Write a run as an MCAP file (ROS 2 profile, CDR messages), atomically.
 
-Channels: the injected ``/scan``, ``/clock``, the node's status String and
-warning Bool (under the lab's topic names), the robot's pose and the
-oracle's verdict per tick. When a board's driver republished the scan, the
-scan the node really saw is kept too. Log times are simulated time: a scan
-at its tick's time, an answer at its scan's time plus the wall-clock
-latency it arrived with, so lockstep runs read like real-time ones.
+Log times are simulated time, an answer at its scan's plus the latency it
+came with, so lockstep runs read like real-time ones. Where a board's driver
+republished the scan, the scan the node really saw is kept too.
 """
 
 from __future__ import annotations

@@ -140,8 +140,7 @@ def _fitted(bounds: Sequence[float], width: float, height: float) -> tuple[float
 
 
 def _one_line(text: str, limit: int) -> str:
-    """Text from the node for one line of a frame: bounded, every non-printable
-    character (newlines too) as its escape, at most `limit` characters."""
+    """Text from the node as one line of at most `limit` characters, newlines escaped too."""
     text = visible(clip(text, 4 * limit)).replace("\n", "\\n").replace("\t", "\\t")
     return text if len(text) <= limit else text[: limit - 1] + "…"
 

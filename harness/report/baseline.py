@@ -265,8 +265,7 @@ def compare(baseline: Baseline, entries: Sequence[Mapping[str, Any]]) -> Compari
 
 
 def with_comparison(summary: Mapping[str, Any], comparison: Comparison) -> dict[str, Any]:
-    """`summary` (harness.report.summary.run_summary) with each scenario's `change`
-    and the comparison as `baseline`."""
+    """`summary` with each scenario's `change` and the comparison as `baseline`."""
     entries = [
         {**entry, "change": change.kind}
         for entry, change in zip(summary["scenarios"], comparison.changes, strict=False)

@@ -115,8 +115,7 @@ def _write_recording(path: Path, result: RunResult) -> Path:
 
 
 def prepare_folder(path: str | Path) -> Path:
-    """Create the report folder (and its parents) now, before anything runs: a
-    ConfigError when it cannot be made or written."""
+    """Create the report folder now, before anything runs (a ConfigError if it cannot)."""
     folder = Path(path)
     if folder.exists() and not folder.is_dir():
         raise ConfigError(f"{path}: exists and is not a folder")

@@ -136,8 +136,7 @@ def alignment_fails(alignment: Alignment | None, mode: str = "warn") -> bool:
 
 
 def alignment_entry(alignment: Alignment | None, mode: str = "warn") -> dict[str, Any] | None:
-    """summary.json's `alignment`: the fitted turn and mirror of the board's /scan
-    (None: no board scans on this link); `mode` is `--alignment`'s."""
+    """summary.json's `alignment`: the fitted turn and mirror of the board's /scan, if any."""
     if alignment is None:
         return None
     return {

@@ -169,8 +169,7 @@ def run_notes(results: Sequence[RunResult]) -> list[str]:
 
 
 def node_start_lines(results: Sequence[RunResult]) -> list[str]:
-    """'node: python3 node.py, started by fork ...', once for the run (once per way, if
-    the way changed during it)."""
+    """'node: python3 node.py, started by fork ...', once per way the run started it."""
     ways = dict.fromkeys(r.node_start for r in results if r.node_start)
     return [f"node: {for_terminal(clip(way, 300))}" for way in ways]
 

@@ -1,8 +1,6 @@
 """The truth: a PyBullet world, its LIDAR's ray casts and the scripted robot motion.
 
-``Simulation`` is what the runner uses: one scenario's world, stepped in
-lockstep, yielding each revolution's true ranges. Names load on first use,
-so the pure motion helpers (``harness.sim.motion``) load without pybullet.
+Names load on first use, so the pure ``motion`` loads without pybullet.
 Add a kind of obstacle in ``world``, a kind of motion in ``motion``.
 """
 

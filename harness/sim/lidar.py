@@ -1,14 +1,10 @@
 """The simulated LIDAR: true ranges by ray casting from the LIDAR link.
 
-One ``rayTestBatch`` per revolution: the beam directions are fixed in the
-LIDAR frame, so they are computed once and only rotated into the world each
-scan. The result is the ground truth (metres along each beam, ``inf`` where
-nothing is within ``range_max``); turning it into what a driver publishes
-(range_min handling, noise, NaN/0 conventions) is the fault stage's job.
-
-The whole revolution is cast from one pose: at 5-10 Hz and robot speeds of
-a few tenths of a m/s the robot moves a few centimetres per turn, which the
-lab's nodes cannot tell from a snapshot.
+One ``rayTestBatch`` per revolution, the beam directions fixed in the LIDAR
+frame and only rotated into the world each scan. The result is the ground
+truth; what a driver publishes of it is the fault stage's job. The whole
+revolution is cast from one pose: the robot moves a few centimetres per
+turn, which the lab's nodes cannot tell from a snapshot.
 """
 
 from __future__ import annotations

@@ -234,8 +234,7 @@ class KinematicDriver:
 
 
 class WheelDriver:
-    """Drives the wheel motors and steps the physics at a fixed 240 Hz (a scan falls on
-    the step nearest its time)."""
+    """Drives the wheel motors and steps the physics at a fixed 240 Hz."""
 
     def __init__(self, world: RobotWorld, time_step: float) -> None:
         self.world = world

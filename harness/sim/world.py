@@ -1,14 +1,10 @@
 """The PyBullet world of one scenario: floor, obstacles and the robot.
 
-Each ``World`` owns its own physics client (every call passes
-``physicsClientId``), so several worlds can live in one process, e.g. two
-runs compared for determinism. The world is stepped only at a fixed 240 Hz
-and built in a fixed order, which makes it deterministic.
-
-Collision groups keep the LIDAR honest: the robot and the floor sit in
-groups that the LIDAR's ray mask leaves out, so the sensor never sees its
-own robot (whatever the URDF's collision geometry) nor the floor when the
-robot pitches in wheels mode. Obstacles keep PyBullet's default groups.
+Each ``World`` owns its physics client, so several live in one process (two
+runs compared for determinism); a fixed 240 Hz step and a fixed build order
+make it deterministic. The robot and the floor sit in collision groups the
+LIDAR's ray mask leaves out, so it never sees its own robot (whatever the
+URDF's collision geometry) nor the floor when the robot pitches.
 """
 
 from __future__ import annotations
@@ -230,8 +226,7 @@ class World:
     # -- lookups ----------------------------------------------------------
 
     def resolve(self, ref: str, field: str) -> Path:
-        """A model file, checked by ``scenario.model_files``' rules: next to the scenario
-        file, else in robot_models/."""
+        """A model file beside the scenario file, else in robot_models/, checked."""
         what = f"{self.where}: {field}: cannot load {ref!r}"
         model = find_model_file(ref, [self.scenario.base_dir, robot_models_dir()], what=what)
         check_model_file(model, what=what)

@@ -1,13 +1,8 @@
 """File changes, seen by watchfiles in background threads and queued for the loop.
 
-The watcher threads never stop watching while the loop runs scenarios or a
-build, so a file saved meanwhile is in the queue when the loop asks next:
-nothing saved is lost, and nothing is run twice for one save (watchfiles
-groups the events of one save, debounced). Signals stay the main thread's:
-a thread's watchfiles never sees Ctrl-C, the loop's bounded waits do.
-
-Folders are watched one level deep, except a package's source folder
-(``Watched.recursive``), so a script in a big folder costs one watch.
+The threads watch on while the loop runs scenarios or a build, so nothing
+saved meanwhile is lost, and watchfiles' debouncing runs nothing twice for
+one save. Signals stay the main thread's: its bounded waits see Ctrl-C.
 """
 
 from __future__ import annotations

@@ -1,12 +1,8 @@
 """``colcon build`` of the package under test before a re-run, bounded in time and output.
 
-colcon runs in the workspace as the student would run it (``colcon build
---packages-select P``, with ``--symlink-install`` and ``--merge-install``
-when the workspace was built so: colcon refuses to switch layouts), in its
-own process group, stopped when it takes longer than `BUILD_TIMEOUT_S` or
-when the harness is interrupted. Its whole output goes to
-``W/log/fossbot-hil-watch.log`` (colcon's own log folder); a failed build
-shows the line that says why (as `grade` finds it) and the log's last lines.
+As the student would run it, with the workspace's own install layout
+(colcon refuses to switch), stopped after `BUILD_TIMEOUT_S` or on Ctrl-C;
+a failed build shows the line that says why (as `grade` finds it).
 """
 
 from __future__ import annotations

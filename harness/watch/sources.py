@@ -84,8 +84,7 @@ def needs_build_files(relative: Path) -> bool:
 
 @dataclass(frozen=True)
 class Build:
-    """How to rebuild the package under test: ``colcon build --packages-select`` in its
-    workspace, with the install layout the workspace already has."""
+    """How to rebuild the package under test, in the workspace's own install layout."""
 
     workspace: Path
     package: str
@@ -118,8 +117,7 @@ class Build:
 
 @dataclass(frozen=True)
 class NodeSources:
-    """What to watch for a run: folders and the files in them that count, what they are
-    (for the screen), and the build a change may need."""
+    """What to watch for a run, in words for the screen, and the build a change may need."""
 
     watched: tuple[Watched, ...] = ()
     description: tuple[str, ...] = ()
@@ -241,8 +239,7 @@ def processor_sources(processor: str | None) -> NodeSources:
 
 
 def node_sources(link: str, options: LinkOptions) -> NodeSources:
-    """The files of the node (or processing function) `options` name; empty for the
-    bundled ones. ConfigError, one line, when the named ones cannot be found."""
+    """The files of the node (or processing function) `options` name; none for the bundled."""
     from harness.links.kinds import link_kind
 
     if not link_kind(link).runs_node:
