@@ -60,8 +60,7 @@ def cached_audit(key: str) -> dict[str, Any] | None:
 
 
 def keep_audit(key: str, data: dict[str, Any]) -> None:
-    """Keep the audit's JSON object under `key` (a cache that cannot be written is no
-    error: the next grade audits again)."""
+    """Keep the audit's JSON under `key`; a cache that cannot be written is no error."""
     with contextlib.suppress(OSError):
         _folder().mkdir(parents=True, exist_ok=True)
         write_atomically(_folder() / f"{key}.json", json.dumps(data, indent=2).encode())

@@ -127,8 +127,7 @@ def _unknown(unit: UnitVerdicts, cells: dict[str, str], unjudged: set[str]) -> s
 def kill_matrix(
     scenarios: Sequence[str], units: Sequence[UnitVerdicts], control: UnitVerdicts
 ) -> KillMatrix:
-    """The matrix of `units` (the mutants, in order) over `scenarios`, `control` being the
-    correct node's unit."""
+    """The matrix of `units` (mutants, in order) over `scenarios`; `control`: the correct node."""
     unsound, unjudged = _control_failures(scenarios, control)
     cells: dict[tuple[str, str], str] = {}
     killed_by: dict[str, tuple[str, ...]] = {}

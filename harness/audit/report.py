@@ -88,8 +88,7 @@ def _coverage_lines(coverage: dict[str, Any]) -> list[str]:
 
 
 def print_audit(console: Console, outcome: AuditOutcome) -> None:
-    """The matrix (x killed, . survived, ~ verdict flips with the seed), then survivors,
-    coverage, flips, and the score."""
+    """The matrix (x killed, . survived, ~ flips), survivors, coverage, flips, and the score."""
     matrix = outcome.matrix
     _say(console)
     _say(console, "scenarios: " + ", ".join(f"{i} {s}" for i, s in enumerate(matrix.scenarios, 1)))

@@ -42,8 +42,7 @@ class AuditConfig:
 
     @property
     def unit_timeout(self) -> float:
-        """One unit's bound, counted from its start: generous per scenario run, as each
-        run ends at its own deadlines."""
+        """One unit's bound from its start: generous, as each run ends at its own deadlines."""
         return self.seconds_per_scenario * len(self.scenarios) * len(self.seeds)
 
     def batch_timeout(self, units: int) -> float:

@@ -94,8 +94,7 @@ class UnitClock:
         self._sent = False  # its SIGTERM is on its way to the handler
 
     def install(self) -> None:
-        """SIGTERM raises KeyboardInterrupt in the main thread, except the clock's own
-        signal landing after its unit ended anyway."""
+        """SIGTERM raises KeyboardInterrupt in the main thread, but not the clock's own, late."""
 
         def handler(signum: int, frame: object) -> None:
             with self._lock:

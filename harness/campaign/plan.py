@@ -18,8 +18,7 @@ Variation = tuple[tuple[str, float], ...]  # (name, level) of each generated var
 
 @dataclass(frozen=True)
 class RunSpec:
-    """One run of a campaign: a scenario (perhaps varied) under one fault level, seed and
-    threshold."""
+    """One run of a campaign: a scenario (perhaps varied), one fault level, seed and threshold."""
 
     scenario: str
     faults: str  # a profile list such as "noisy,drop(rate=0.1)", or SCENARIO_FAULTS

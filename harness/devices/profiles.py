@@ -97,8 +97,7 @@ PROFILES: dict[str, DeviceProfile] = {
 
 
 def add_profile(device: DeviceProfile) -> DeviceProfile:
-    """Make a LIDAR model known under its name (once), e.g. one from outside the
-    harness, before a link or `emulate` names it; returns it."""
+    """Make a LIDAR model from outside the harness known by its name (once); returns it."""
     known = PROFILES.get(device.name)
     if known is not None and known != device:
         raise RuntimeError(f"LIDAR device {device.name!r} is defined twice")

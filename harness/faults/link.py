@@ -190,8 +190,7 @@ class LineDrops(RateFault):
 
 @dataclass(frozen=True)
 class LineNoise:
-    """Serial links: with probability `rate` per revolution, `length` random bytes
-    appear at a random place in it (a glitch on the wire)."""
+    """Serial links: with probability `rate` per revolution, `length` random bytes (a glitch)."""
 
     rate: float
     length: int = 16
@@ -285,8 +284,7 @@ class Delivery:
 
     @property
     def may_be_ignored(self) -> bool:
-        """No answer is also right: the node already saw this scan or a newer one,
-        or its stamp is stale; a careful node may skip it."""
+        """No answer is right too: the node saw this scan or a newer one, or its stamp is stale."""
         return self.kind in ("duplicate", "reordered") or self.stamp_age_s > 0
 
     def describe(self) -> str:

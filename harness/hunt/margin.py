@@ -68,8 +68,7 @@ def assess(result: RunResult) -> Assessment:
 
 
 def failure_kinds(failures: tuple[str, ...] | list[str]) -> tuple[str, ...]:
-    """The kinds of a tick's failures, sorted; "answer" for one of no known kind (no
-    status, several, late)."""
+    """A tick's failures' kinds, sorted; "answer" for none known (no status, several, late)."""
     kinds = set()
     for text in failures:
         kind = next((k for words, k in _KINDS if words in text), "answer")

@@ -141,8 +141,7 @@ def _study(optuna: Any, seed: int, restart: int) -> Any:
 def _propose(
     optuna: Any, study: Any, feasible: Feasible, count: int
 ) -> tuple[list[Any], list[Candidate]]:
-    """`count` trials and their runnable candidates; proposals that make no valid
-    scenario are told as failed and skipped."""
+    """`count` trials and their runnable candidates; one that makes no scenario is told failed."""
     trials, candidates = [], []
     for _ in range(count * MAX_PROPOSALS):
         if len(candidates) == count:
@@ -160,8 +159,7 @@ def _propose(
 
 
 def _confirmed(failing: Outcome, run_batch: RunBatch, result: Hunt) -> bool:
-    """Does `failing` fail the same way a second time? A failure that does not is kept
-    as flaky and the search goes on."""
+    """Does `failing` fail the same way again? One that does not is kept as flaky."""
     again = run_batch([failing.candidate])[0]
     result.confirm_runs += 1
     assert failing.assessment is not None
@@ -172,8 +170,7 @@ def _confirmed(failing: Outcome, run_batch: RunBatch, result: Hunt) -> bool:
 
 
 def _shrink(result: Hunt, run_batch: RunBatch, plan: HuntPlan) -> None:
-    """Keep taking the first simpler candidate that fails the same way (module
-    ``harness.hunt.shrink``), within the shrink budget."""
+    """Keep the first simpler candidate that fails the same way (``shrink``), within budget."""
     assert result.found is not None and result.found.assessment is not None
     way = result.found.assessment
     current = result.found

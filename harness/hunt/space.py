@@ -51,8 +51,7 @@ DRIVER_FAULTS = {"zero": "driver_zero", "nan": "driver_nan"}  # rep117 is the de
 
 @dataclass(frozen=True)
 class Candidate:
-    """One point of the space; numbers that do not apply (a size with no obstacle) are
-    kept but ignored."""
+    """One point of the space; numbers that do not apply (a size with no obstacle) are ignored."""
 
     obstacle: str = "none"
     distance: float = 1.0
@@ -170,8 +169,7 @@ def obstacle_entry(candidate: Candidate) -> dict[str, Any] | None:
 
 @functools.cache
 def robot_footprint() -> tuple[Outline, ...]:
-    """The default robot's outline at the origin, read from its URDF as the start check
-    reads it (once a process)."""
+    """The default robot's outline at the origin, as the start check reads it (once a process)."""
     urdf = RobotConfig().urdf
     return tuple(robot_outlines(parse_xml(robot_models_dir() / urdf, f"robot model {urdf!r}")))
 

@@ -47,8 +47,7 @@ class Answers:
     owed_before: bool = False
 
     def clipped(self, limit: int = TEXT_LIMIT) -> Answers:
-        """A copy to keep in a record: each text clipped to `limit` (its length noted)
-        and storable as UTF-8. The oracle judges the answers as they arrived."""
+        """A copy to keep: each text clipped to `limit`, storable (judged as it arrived)."""
 
         def kept(items: list[Received]) -> list[Received]:
             return [

@@ -55,8 +55,7 @@ class Verdict:
     explanation: str
 
     def clipped(self, limit: int = TEXT_LIMIT) -> Verdict:
-        """A copy to keep in a record: the status text, the failures and the explanation
-        clipped to `limit` (their length noted) and storable as UTF-8."""
+        """A copy to keep in a record: its texts clipped to `limit` (length noted), as UTF-8."""
         claim = self.claim
         if claim is not None:
             claim = replace(claim, text=for_storage(claim.text, limit))

@@ -282,8 +282,7 @@ def gaps(coverage: ReadingCoverage) -> list[str]:
 
 
 def other_counts(total: Mapping[str, Any]) -> list[tuple[str, int]]:
-    """The counts of an ``as_dict()`` beside the six cases, each with what it counts in
-    words, for reports."""
+    """An ``as_dict()``'s counts beside the six cases, each with its words, for reports."""
     return [
         (
             f"scans whose nearest valid return lies outside the threshold band, within "

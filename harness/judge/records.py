@@ -85,8 +85,7 @@ class RunResult:
 
     @property
     def first_failure(self) -> str | None:
-        """The explanation a user reads first: the run error or the first failed tick,
-        with what the whole run suggests about its cause."""
+        """The explanation read first: the run error or first failed tick, with the run's hint."""
         failed = self.failed_ticks
         if failed:
             hint = run_hint(

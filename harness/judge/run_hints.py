@@ -102,8 +102,7 @@ def one_scan_late_hint(
 
 
 def _silent(v: Verdict) -> bool:
-    """No status within the deadline, and none came later either (a late one is slow, not
-    silent: no hint about silence fits it)."""
+    """No status by the deadline, nor later (a late one is slow, not silent)."""
     return v.claim is None and any(
         f.startswith(NO_STATUS) and CAME_LATE not in f for f in v.failures
     )

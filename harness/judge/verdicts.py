@@ -36,8 +36,7 @@ class RunVerdict(str, Enum):
 
     @classmethod
     def read(cls, text: object) -> RunVerdict:
-        """A verdict as a table or a worker wrote it (PASSED and FAILED too); anything
-        that says neither a verdict's name is an ERROR."""
+        """A verdict as a table or worker wrote it (PASSED, FAILED too); else an ERROR."""
         word = str(text).strip().upper()
         word = {"PASSED": "PASS", "FAILED": "FAIL"}.get(word, word)
         try:
@@ -47,8 +46,7 @@ class RunVerdict(str, Enum):
 
 
 def verdict_of(result: RunResult) -> RunVerdict:
-    """PASS, FAIL (an answer was wrong, or none came in time), ERROR (the run broke, no
-    answer was wrong) or NOT RUN."""
+    """PASS, FAIL (a wrong or missing answer), ERROR (the run broke, nothing wrong) or NOT RUN."""
     if result.ok:
         return RunVerdict.PASS
     if result.not_run:

@@ -151,8 +151,7 @@ PRESETS: dict[str, LidarSpec] = {
 
 
 def add_preset(spec: LidarSpec) -> LidarSpec:
-    """Make a LIDAR's preset known under its name (once), e.g. a LIDAR from outside
-    the harness, before a scenario names it; returns it."""
+    """Make a LIDAR preset from outside the harness known by its name (once); returns it."""
     known = PRESETS.get(spec.name)
     if known is not None and known != spec:
         raise RuntimeError(f"lidar preset {spec.name!r} is defined twice")

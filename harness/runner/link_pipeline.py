@@ -82,8 +82,7 @@ class LinkPipeline:
                 link.start()
 
     def retire(self, link: Link, closed: Closed) -> None:
-        """Its scenario is over: ask it to stop now; `closed` runs once it is closed,
-        in scenario order (at once when links do not overlap)."""
+        """Its scenario is over: stop it now; `closed` runs once closed, in scenario order."""
         if link is self._running:
             self._running = None
         link.stop()

@@ -48,8 +48,7 @@ def effective_threshold(scenario: Scenario, settings: RunSettings) -> float:
 
 
 def check_settings(scenarios: Sequence[Scenario], settings: RunSettings) -> None:
-    """Every override fits every scenario: checked before the first one runs, so a
-    usage error never comes after some scenarios were judged."""
+    """Every override fits every scenario, checked before the first runs (no usage error midway)."""
     for scenario in scenarios:
         effective_threshold(scenario, settings)
         fault_profile(scenario, settings)

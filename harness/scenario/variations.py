@@ -107,8 +107,7 @@ def varied(scenario: Scenario, levels: Mapping[str, float]) -> Scenario:
 
 
 def _move_obstacles(data: dict[str, Any], scenario: Scenario, distance: float, where: str):
-    """Shift every obstacle along the (varied) start heading so the first one ahead is
-    `distance` away."""
+    """Shift every obstacle along the start heading so the first ahead is `distance` away."""
     start = data["robot"]["start"]
     moved_start = scenario.robot.start.model_copy(update=start)
     robot = scenario.robot.model_copy(update={"start": moved_start})

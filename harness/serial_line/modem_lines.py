@@ -74,8 +74,7 @@ class ModemLines:
         self.rts: bool | None = None
 
     def poll(self) -> list[tuple[str, bool]]:
-        """Drain what the client sent since the last poll: the changes, in order,
-        as ("dtr" or "rts", asserted)."""
+        """The changes the client sent since the last poll, in order: ("dtr" or "rts", asserted)."""
         changes: list[tuple[str, bool]] = []
         while self._sock is not None:
             try:
@@ -90,8 +89,7 @@ class ModemLines:
         return changes
 
     def hang_up(self) -> list[tuple[str, bool]]:
-        """The client closed the port: the lines it set drop, as a tty's do on close
-        (HUPCL). The changes, as ``poll`` gives them."""
+        """The client closed the port: its lines drop, as a tty's do (HUPCL); the changes."""
         changes: list[tuple[str, bool]] = []
         for name in ("dtr", "rts"):
             if getattr(self, name) is not None:

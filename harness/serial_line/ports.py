@@ -213,8 +213,7 @@ class PtyPort(DevicePort):
                 self.on_modem_change(line, asserted)
 
     def client_environment(self, environ: Mapping[str, str] | None = None) -> dict[str, str]:
-        """The variables a pyserial client needs for its DTR/RTS calls on ``slave_path``
-        to succeed and reach this port (merge them into its environment)."""
+        """What a client needs for its DTR/RTS calls on ``slave_path`` to reach this port."""
         return client_environment(self.slave_path, self._channel(), environ)
 
     def client_exports(self) -> str:

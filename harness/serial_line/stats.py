@@ -57,8 +57,7 @@ class ServerCounts:
 
 @dataclass(kw_only=True)
 class ServerStats(ServerCounts):
-    """A snapshot of one server run: its counts, the line's state and the device's
-    counters; pacing figures only in realtime mode."""
+    """A snapshot of one server run: counts, line state, device counters (pacing: realtime only)."""
 
     mode: str
     requests_seen: int | None  # well-formed requests, where the device counts them

@@ -60,8 +60,7 @@ def _channel(port: object, err: OSError) -> str | None:
 
 
 def _send(channel: str, message: bytes) -> None:
-    """One datagram to `channel`, never blocking; lost if nothing listens, like a
-    wire to nothing."""
+    """One datagram to `channel`, never blocking: lost if nothing listens."""
     if not channel:
         return
     import socket
