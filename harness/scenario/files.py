@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import os
 from importlib import resources
 from pathlib import Path
 from typing import Any
@@ -23,6 +22,7 @@ from harness.scenario.checks import (
     check_start_clear,
 )
 from harness.scenario.limits import MAX_FILE_BYTES
+from harness.scenario.model_files import exists
 from harness.scenario.schema import Scenario, first_error
 from harness.scenario.yaml_loader import load_yaml, yaml_problem
 from harness.text_file import read_text_file
@@ -102,23 +102,15 @@ def shipped_scenarios() -> list[Scenario]:
     return sorted((load_scenario_file(p) for p in files), key=lambda s: s.name)
 
 
-def _exists(path: Path) -> bool:
-    """Whether anything is at `path`; a name the OS refuses (too long, a NUL) is nothing."""
-    try:
-        os.stat(path)
-    except (OSError, ValueError):
-        return False
-    return True
-
-
 def resolve_scenario(ref: str) -> Scenario:
     """A shipped scenario name or a path to a scenario file."""
     candidate = Path(ref)
-    if candidate.suffix in SCENARIO_SUFFIXES or _exists(candidate) or "/" in ref:
+    named = candidate.suffix in SCENARIO_SUFFIXES or "/" in ref
+    if named or exists(candidate, follow_symlinks=True):
         return load_scenario_file(candidate)
     for suffix in SCENARIO_SUFFIXES:
         shipped = shipped_dir() / f"{ref}{suffix}"
-        if _exists(shipped):
+        if exists(shipped, follow_symlinks=True):
             return load_scenario_file(shipped)
     known = ", ".join(s.name for s in shipped_scenarios())
     raise ConfigError(f"unknown scenario {ref[:100]!r} (shipped: {known}; or give a .yaml path)")

@@ -34,6 +34,7 @@ __all__ = [
     "ModelFile",
     "ModelParts",
     "check_model_file",
+    "exists",
     "find_model_file",
     "parse_xml",
     "robot_models_dir",
@@ -94,10 +95,10 @@ def _plain_relative(ref: str, what: str) -> PurePosixPath:
     return normal
 
 
-def _exists(path: Path) -> bool:
-    """Whether anything is there; a name the OS refuses (too long) is nothing."""
+def exists(path: Path, *, follow_symlinks: bool = False) -> bool:
+    """Whether anything is there; a name the OS refuses (too long, a NUL) is nothing."""
     try:
-        os.lstat(path)
+        os.stat(path, follow_symlinks=follow_symlinks)
     except (OSError, ValueError):
         return False
     return True
@@ -143,7 +144,7 @@ def find_model_file(ref: str, folders: Sequence[Path | None], *, what: str = "")
             continue
         tried.append(shown(str(folder)))
         candidate = folder / relative
-        if _exists(candidate):
+        if exists(candidate):
             root = folder.resolve()
             return ModelFile(_resolved_inside(candidate, root, label), root)
     raise ConfigError(f"{label}: no such file (looked in {', '.join(tried)})")
@@ -302,7 +303,7 @@ def _check_mesh(filename: str, model: ModelFile, schemes: tuple[str, ...], what:
     folder = model.path.parent
     while _inside(folder, model.root):
         candidate = folder / relative
-        if _exists(candidate):
+        if exists(candidate):
             _sniff_mesh(_resolved_inside(candidate, model.root, label), label)
             return
         if folder.parent == folder:
