@@ -26,6 +26,7 @@ from harness.links.base import LinkOptions
 from harness.runner.plan import plan_one
 from harness.runner.settings import RunSettings
 from harness.scenario.schema import Scenario
+from harness.serial_line.diagnosis import counts_text, diagnose, line_errors
 
 IDLE_WAIT_S = 5.0  # after the last revolution: let the line drain
 STATUS_EVERY_S = 5.0  # without verbose: one status line this often
@@ -80,23 +81,19 @@ class EmulationSummary:
         rate = self.mean_rate_error_pct
         lines = [
             head,
-            "  requests: " + _counts(self.requests_by_command),
+            "  requests: " + counts_text(self.requests_by_command),
             f"  revolutions: {self.revolutions} simulated, {self.revolutions_whole} served whole, "
             f"{self.revolutions_cut} cut short by a request, "
             f"{self.revolutions_idle} found the device idle",
             f"  bytes: {self.bytes_written} to the client ({self.reply_bytes} in answers), "
             f"{self.host_bytes} from it"
             + (f"; line rate error {rate:+.2f} %" if rate is not None else ""),
-            "  errors: " + _counts(self.errors),
+            "  errors: " + counts_text(self.errors),
             "  client: " + _client_text(self),
         ]
         if self.likely and not (self.revolutions_whole or self.revolutions_cut):
             lines.append(f"  likely cause: {self.likely}")
         return lines
-
-
-def _counts(counts: dict[str, int]) -> str:
-    return ", ".join(f"{name} {n}" for name, n in counts.items() if n) or "none"
 
 
 def _client_text(summary: EmulationSummary) -> str:
@@ -196,7 +193,6 @@ def emulate(
     """Serve every revolution of `scenario` in real time until it ends or Ctrl-C stops it."""
     settings = settings or RunSettings()
     from harness.serial_line.device_line import open_device_line
-    from harness.serial_line.diagnosis import diagnose, line_errors
     from harness.serial_line.ports import PtyPort
     from harness.sim.simulation import Simulation
 
