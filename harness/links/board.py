@@ -30,7 +30,6 @@ from typing import TYPE_CHECKING, Any
 
 from harness.devices.profiles import DeviceProfile
 from harness.errors import ConfigError
-from harness.lidar.mount import LidarMount
 from harness.links.base import Link, LinkOptions, add_link
 from harness.links.board_delivery import BoardDelivery
 from harness.links.board_session import BoardSession, board_options, remappable, takes_remaps
@@ -111,16 +110,6 @@ class BoardLink(Link):
     @property
     def server(self) -> Any:
         return self.session.server if self.session is not None else None
-
-    @property
-    def port(self) -> Any:
-        return self.session.port if self.session is not None else None
-
-    @property
-    def mount(self) -> LidarMount:
-        """How the device sits on the robot: one mount for the run (the session's)."""
-        assert self.session is not None, "start() the link first"
-        return self.session.mount
 
     @property
     def observer(self) -> Observer | None:
