@@ -123,22 +123,18 @@ def _check_expanded(root: yaml.Node) -> None:
     sizes: dict[int, tuple[int, int]] = {}  # id(node) -> (values, depth) below and with it
     active: set[int] = set()
 
+    def refused(problem: str, node: yaml.Node) -> yaml.composer.ComposerError:
+        return yaml.composer.ComposerError(None, None, problem, node.start_mark)
+
     def visit(node: yaml.Node) -> tuple[int, int]:
         key = id(node)
         if key in sizes:
             return sizes[key]
         if key in active:
-            raise yaml.composer.ComposerError(
-                None, None, "an alias refers to the value it is inside", node.start_mark
-            )
+            raise refused("an alias refers to the value it is inside", node)
         if isinstance(node, yaml.ScalarNode):
             if len(node.value) > MAX_YAML_SCALAR:
-                raise yaml.composer.ComposerError(
-                    None,
-                    None,
-                    f"a value longer than {MAX_YAML_SCALAR} characters",
-                    node.start_mark,
-                )
+                raise refused(f"a value longer than {MAX_YAML_SCALAR} characters", node)
             sizes[key] = (1, 1)
             return sizes[key]
         active.add(key)
@@ -153,20 +149,11 @@ def _check_expanded(root: yaml.Node) -> None:
             count += child_count
             depth = max(depth, child_depth)
             if count > MAX_YAML_NODES:
-                raise yaml.composer.ComposerError(
-                    None,
-                    None,
-                    f"more than {MAX_YAML_NODES} values once aliases are expanded",
-                    node.start_mark,
-                )
+                raise refused(f"more than {MAX_YAML_NODES} values once aliases are expanded", node)
         active.discard(key)
         if depth + 1 > MAX_YAML_DEPTH:
-            raise yaml.composer.ComposerError(
-                None,
-                None,
-                f"nested deeper than {MAX_YAML_DEPTH} levels once aliases are expanded",
-                node.start_mark,
-            )
+            deeper = f"nested deeper than {MAX_YAML_DEPTH} levels once aliases are expanded"
+            raise refused(deeper, node)
         sizes[key] = (count, depth + 1)
         return sizes[key]
 
