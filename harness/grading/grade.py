@@ -32,7 +32,7 @@ from harness.grading.class_table import ERROR, NOT_RUN, PASS, StudentGrade
 from harness.grading.discover import Student
 from harness.grading.hidden import HiddenScenario, scrub_folder
 from harness.grading.plots import PLOT_WAIT_S, plots_drawn, plotter
-from harness.grading.process import TERM_GRACE_S, Finished, StopFlag, guarded, run_bounded
+from harness.grading.process import TERM_GRACE_S, Finished, StopFlag, guarded
 from harness.grading.scoring import held_of
 from harness.grading.warm_judge import Slot, close_judges, drop_judge, warm_judge
 from harness.grading.worker import write_job
@@ -284,9 +284,15 @@ def _slot(config: GradeConfig) -> Slot:
 def _judge_warm(job: Path, slot: Slot, config: GradeConfig, cancel: StopFlag) -> Finished:
     """`job` judged by this worker's warm judge (started if need be); a judge stopped
     on the way (time limit, flood, cancel, crash) is not used again."""
-    command = [sys.executable, "-m", "harness.grading.warm_judge"]
-    command += ["--sandboxed"] if config.sandbox is not None else []
-    argv = _judging_command(command, [slot.node], [slot.root / "out"], config)
+    argv = [sys.executable, "-m", "harness.grading.warm_judge"]
+    if config.sandbox is not None:  # the node in a nested sandbox that shows slot.node only
+        argv = sandboxed_run(
+            [*argv, "--sandboxed"],
+            node_files=[slot.node],
+            scenario_files=[Path(ref) for ref in config.scenario_refs if Path(ref).is_absolute()],
+            outputs=[slot.root / "out"],
+            limits=config.sandbox,
+        )
     judge = warm_judge(guarded(argv), slot.root)
     finished, reusable = judge.judge(
         job,
@@ -352,11 +358,14 @@ def _grade(student: Student, config: GradeConfig, cancel: StopFlag) -> StudentGr
         return without_run(student.problem)
     if config.sandbox is not None and not config.sandbox_checked and (problem := sandbox_problem()):
         return without_run(f"could not grade: {problem}")  # this worker cannot sandbox
+    slot = _slot(config)  # where the worker's warm judge sees this student
     build_s = None
     if student.kind in ("package", "workspace"):
+        copy = slot.fill(None, config.students_dir.parent)  # built where the judge sees it
+        real = kept = folder / "colcon"
         built = build_student(
             student,
-            folder / "colcon",
+            copy,
             package=config.options.package or "",
             executable=config.options.executable or "",
             log=folder / "build.log",
@@ -366,47 +375,35 @@ def _grade(student: Student, config: GradeConfig, cancel: StopFlag) -> StudentGr
         )
         build_s = built.wall_s
         if not built.ok:
+            slot.move_out(folder, grader, kept)
             return without_run(f"did not build: {built.error}", build_s)
+        judged = replace(config.options, node=None, workspace=str(copy))
+    else:
+        copy = slot.fill(student.folder, config.students_dir.parent)
+        real, kept = student.folder, None
+        judged = _script_options(config, copy / _script_name(student))
     if cancel.is_set():
+        slot.move_out(folder, grader, kept)
         return without_run("interrupted", build_s)
-    options = _run_options(student, config, folder)
-    slot = _slot(config) if student.kind == "script" else None  # a warm judge's
-    copy = None if slot is None else slot.fill(student.folder, config.students_dir.parent)
-    out, own = (folder, grader) if slot is None else (slot.student, slot.grader)
-    judged = options if copy is None else _script_options(config, copy / _script_name(student))
+    options = _run_options(student, config, folder)  # as the messages name them
     plots = grader / "plots" if config.defer_plots else None
     job = write_job(
-        own / "job.json",
+        slot.grader / "job.json",
         scenarios=list(config.scenario_refs),
         link=config.link,
         options=judged,
         settings=config.settings,
-        results=own / "results.json",
-        junit=out / "junit.xml",
-        report=out / "report",
+        results=slot.grader / "results.json",
+        junit=slot.student / "junit.xml",
+        report=slot.student / "report",
         hidden={
             n: {"label": h.label, "show_failure": h.show_failure} for n, h in config.hidden.items()
         },
-        plots=None if plots is None else own / "plots",
+        plots=None if plots is None else slot.grader / "plots",
     )
-    if slot is None or copy is None:  # a package or workspace: a judging process of its own
-        finished = run_bounded(
-            _judging_command(
-                [sys.executable, "-m", "harness.grading.worker", str(job)],
-                [folder / "colcon"],
-                [folder, grader],
-                config,
-            ),
-            log=folder / "run.log",
-            timeout=config.student_timeout,
-            max_log_bytes=MAX_RUN_LOG_BYTES,
-            cwd=folder,
-            cancel=cancel,
-        )
-    else:
-        finished = _judge_warm(job, slot, config, cancel)
-        slot.move_out(folder, grader)
-        _map_results(grader / "results.json", slot.moved(copy, student.folder, folder, grader))
+    finished = _judge_warm(job, slot, config, cancel)
+    slot.move_out(folder, grader, kept)
+    _map_results(grader / "results.json", slot.moved(copy, real, folder, grader))
     if plots is not None and plots.is_dir():  # drawn while the worker's next student runs
         plotter().submit(plots, folder / "report" / "scenarios", grader / "plot-errors.log")
     data = _read_results(grader / "results.json")
@@ -416,8 +413,8 @@ def _grade(student: Student, config: GradeConfig, cancel: StopFlag) -> StudentGr
     first += f" ({refused})" if refused else ""
     if not (folder / "junit.xml").exists():
         _placeholder_junit(config, folder, first or "no results")
-    slotted = () if slot is None or copy is None else (copy, slot.student, slot.grader, slot.root)
-    scrub_folder(folder, student_scrub(student, config, folder, slotted))
+    slotted = (copy if student.kind == "script" else slot.node, slot.student, slot.grader)
+    scrub_folder(folder, student_scrub(student, config, folder, (*slotted, slot.root)))
     return StudentGrade(
         student.name,
         student.kind,
@@ -430,23 +427,6 @@ def _grade(student: Student, config: GradeConfig, cancel: StopFlag) -> StudentGr
         node=node,
         failures=failures,
         notes=_notes(data),
-    )
-
-
-def _judging_command(
-    command: list[str], node_files: list[Path], outputs: list[Path], config: GradeConfig
-) -> list[str]:
-    """The judging process's `command`; in its sandbox, the node in a nested one that
-    shows only `node_files` (the script's copy in the slot, or the build)."""
-    if config.sandbox is None:
-        return command
-    scenario_files = [Path(ref) for ref in config.scenario_refs if Path(ref).is_absolute()]
-    return sandboxed_run(
-        command,
-        node_files=node_files,
-        scenario_files=scenario_files,
-        outputs=outputs,
-        limits=config.sandbox,
     )
 
 

@@ -66,7 +66,14 @@ def _reap_children() -> None:
 
 def end_strays(wait_s: float = STRAY_WAIT_S) -> bool:
     """SIGKILL every live process of this PID namespace but its init (1) and us, until
-    none is left; False if some still live after `wait_s` (the judge then exits)."""
+    none is left; False if some still live after `wait_s` (the judge then exits), or if
+    this is not a sandbox's PID namespace (its init is not bwrap): nothing is killed."""
+    try:
+        with open("/proc/1/comm", encoding="utf-8") as comm:
+            if comm.read().strip() != "bwrap":
+                return False
+    except OSError:
+        return False
     ends = time.monotonic() + wait_s
     while True:
         _reap_children()
@@ -163,13 +170,16 @@ class Slot:
     def grader(self) -> Path:
         return self.root / "out" / "grader"
 
-    def fill(self, files: Path, leave_out: Path) -> Path:
+    def fill(self, files: Path | None, leave_out: Path) -> Path:
         """The slot emptied, then `files` (a student's folder, without `leave_out`, the
         grader's own folder should it be inside) in it: where they now are. Hard links
-        where the file system allows (the sandbox shows them read-only)."""
+        where the file system allows (the sandbox shows them read-only). Without
+        `files`: where a build goes (``node/colcon``)."""
         self.empty()
         for folder in (self.node, self.student, self.grader):
             folder.mkdir(parents=True, exist_ok=True)
+        if files is None:
+            return self.node / "colcon"
         copy = self.node / files.name
         skipped = str(leave_out.resolve())
 
@@ -179,11 +189,14 @@ class Slot:
         shutil.copytree(files, copy, symlinks=True, ignore=ignored, copy_function=_link_or_copy)
         return copy
 
-    def move_out(self, student: Path, grader: Path) -> None:
-        """The outputs into the student's and the grader's folders; the slot emptied."""
+    def move_out(self, student: Path, grader: Path, build: Path | None = None) -> None:
+        """The outputs into the student's and the grader's folders, and the build (the
+        slot's ``node/colcon``) to `build`; the slot emptied."""
         for source, target in ((self.student, student), (self.grader, grader)):
             for entry in sorted(source.iterdir()) if source.is_dir() else ():
                 shutil.move(str(entry), str(target / entry.name))
+        if build is not None and (self.node / "colcon").is_dir():
+            shutil.move(str(self.node / "colcon"), str(build))
         self.empty()
 
     def empty(self) -> None:

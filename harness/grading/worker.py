@@ -1,8 +1,8 @@
-"""One student's scenario suite, in a process of its own: ``python -m harness.grading.worker JOB``.
+"""One student's scenario suite, as a job the judging process runs (harness.grading.warm_judge).
 
 A student's node can crash, hang or flood its output; running their suite
-here means that can only ever end this process, never the grader. JOB is a
-JSON file (written by ``grade``) naming the scenarios, the link, the
+in the judging process means that can only ever end that process, never the
+grader. The job is a JSON file (written by ``grade``) naming the scenarios, the link, the
 LinkOptions and RunSettings fields, and where to write ``results.json``, the
 JUnit XML and the report folder (what ``fossbot-hil run --out`` writes:
 index.html, plots, recordings). ``results.json`` is rewritten (atomically)
@@ -15,9 +15,7 @@ from __future__ import annotations
 
 import functools
 import json
-import os
 import signal
-import sys
 import time
 from dataclasses import asdict, fields
 from pathlib import Path
@@ -26,7 +24,6 @@ from typing import TYPE_CHECKING, Any
 from harness.atomic_write import write_atomically
 from harness.errors import ConfigError
 from harness.links.kinds import ROS2
-from harness.nodes.sandbox_prefix import NODE_SANDBOX_ENV
 
 if TYPE_CHECKING:  # imported by the suite: after the node's fork server has started
     from harness.judge.records import RunResult
@@ -253,19 +250,3 @@ def warm_node_server(job: dict[str, Any]) -> bool:
         return False
     shared(SERVER_MODULE)  # in the sandbox: started in the node's nested one, as later
     return True
-
-
-def main(argv: list[str]) -> int:
-    if len(argv) != 1:
-        print("usage: python -m harness.grading.worker JOB.json", file=sys.stderr)
-        return 2
-    interrupt_on_sigterm()
-    if os.environ.get(NODE_SANDBOX_ENV):
-        not_dumpable()  # before anything is started: the fork server is its child
-    job = json.loads(Path(argv[0]).read_text(encoding="utf-8"))
-    warm_node_server(job)
-    return run_job(job)
-
-
-if __name__ == "__main__":
-    sys.exit(main(sys.argv[1:]))

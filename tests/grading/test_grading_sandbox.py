@@ -106,7 +106,12 @@ def make_course(root: Path, listener: Listener, *, hostile: bool) -> Path:
                 str(root / "class" / "ben" / "lidar_node.py"),
                 str(hidden),
             ],
-            "own": [str(root / "class" / "eve"), str(out / "students" / "eve")],
+            # its own build, and the worker's slot, which holds only eve's while eve runs
+            "own": [
+                str(root / "class" / "eve"),
+                str(out / "students" / "eve"),
+                str(out / "grader" / ".slots"),
+            ],
             "port": listener.port,
             "leftover": LEFTOVER,
             "alloc_mb": 8 * SANDBOX_MB,
