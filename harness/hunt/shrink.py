@@ -36,21 +36,16 @@ def simplifications(candidate: Candidate) -> list[Step]:
         if simpler != candidate and all(simpler != s for _, s in steps):
             steps.append((what, simpler))
 
-    if candidate.fault != "none":
-        offer("no sensor fault", fault="none")
-    if candidate.convention != "rep117":
-        offer("the REP-117 convention (+inf for no return)", convention="rep117")
-    if candidate.obstacle != "none":
-        offer("no obstacle", obstacle="none")
-    if candidate.motion != "still":
-        offer("standing still", motion="still")
+    # A change that leaves the candidate as it is offers nothing (see offer).
+    offer("no sensor fault", fault="none")
+    offer("the REP-117 convention (+inf for no return)", convention="rep117")
+    offer("no obstacle", obstacle="none")
+    offer("standing still", motion="still")
     for duration in DURATIONS:
         if duration < candidate.duration - 1e-9:
             offer(f"{duration:g} s long", duration=duration)
-    if candidate.preset != "gazebo":
-        offer("the gazebo LIDAR preset", preset="gazebo")
-    if candidate.threshold != 0.5:
-        offer("threshold 0.5 m", threshold=0.5)
+    offer("the gazebo LIDAR preset", preset="gazebo")
+    offer("threshold 0.5 m", threshold=0.5)
     if candidate.obstacle != "none":
         for bearing in BEARINGS:
             if abs(candidate.bearing - bearing) > 1e-9 and not _round_angle(candidate.bearing):
