@@ -166,6 +166,19 @@ class Link(ABC):
         self.close()
 
 
+class Part:
+    """A link's attribute that is one of its parts' (``part``: its graph, its exchange)."""
+
+    def __init__(self, part: str) -> None:
+        self.part = part
+
+    def __set_name__(self, owner: type, name: str) -> None:
+        self.name = name
+
+    def __get__(self, link: Any, owner: type | None = None) -> Any:
+        return self if link is None else getattr(getattr(link, self.part), self.name)
+
+
 _REGISTRY: dict[str, type[Link]] = {}
 L = TypeVar("L", bound=type[Link])
 M = TypeVar("M")

@@ -30,7 +30,7 @@ from typing import TYPE_CHECKING, Any
 
 from harness.devices.profiles import DeviceProfile
 from harness.errors import ConfigError
-from harness.links.base import Link, LinkOptions, add_link
+from harness.links.base import Link, LinkOptions, Part, add_link
 from harness.links.board_delivery import BoardDelivery
 from harness.links.board_session import BoardSession, board_options, remappable, takes_remaps
 from harness.links.node_exchange import NodeExchange
@@ -42,10 +42,8 @@ from harness.option_names import worded
 from harness.ros.domain import reserve_domain
 
 if TYPE_CHECKING:
-    from harness.faults.link import LineDamage
-    from harness.judge.answers import Answers, Received
+    from harness.judge.answers import Answers
     from harness.lidar.scan import Scan
-    from harness.ros.observer import Observer
 
 
 class BoardLink(Link):
@@ -97,27 +95,21 @@ class BoardLink(Link):
         self.delivery: BoardDelivery = self.exchange.delivery  # type: ignore[assignment]
         self.delivery.session = session
 
-    # -- the session's parts ------------------------------------------------
-    @property
-    def session(self) -> BoardSession | None:
-        return self.delivery.session
-
-    @property
-    def device(self) -> Any:
-        assert self.session is not None, "start() the link first"
-        return self.session.device
+    # The session's, the graph's and the exchange's, as the runner and the tests read them.
+    session = Part("delivery")
+    observer = Part("graph")
+    node_start = Part("graph")
+    node_gone = Part("graph")
+    damage_line = Part("delivery")
+    warm_up = Part("exchange")
+    send_first = Part("exchange")
+    send = Part("exchange")
+    hold = Part("exchange")
+    settle = Part("exchange")
 
     @property
     def server(self) -> Any:
         return self.session.server if self.session is not None else None
-
-    @property
-    def observer(self) -> Observer | None:
-        return self.graph.observer
-
-    @property
-    def node_start(self) -> str:  # type: ignore[override]
-        return self.graph.node_start
 
     # -- processes and ports ----------------------------------------------
     def start(self) -> None:
@@ -149,7 +141,7 @@ class BoardLink(Link):
     def _device_asked(self) -> bool:
         """Ready needs the driver to have asked for a scan (a device that waits to be asked)."""
         assert self.server is not None
-        return self.profile.streams_unasked or self.device.mode != "idle"
+        return self.profile.streams_unasked or self.session.device.mode != "idle"
 
     def _never_ready(self) -> str | None:
         """A physical board that never answers: what went down the line, what came back,
@@ -184,31 +176,10 @@ class BoardLink(Link):
         line = report.text()
         return f"{ready}: on the line {line}" + (f" ({graph})" if graph else "")
 
-    def node_gone(self, when: str = "") -> str | None:
-        return self.graph.node_gone(when)
-
-    def damage_line(self, damage: LineDamage) -> None:
-        self.delivery.damage_line(damage)
-
     # -- the exchange -------------------------------------------------------
-    def warm_up(self, scan: Scan) -> None:
-        self.exchange.warm_up(scan)
-
-    def send_first(self, scan: Scan, tick: int, *, clock: float | None = None) -> None:
-        self.exchange.send_first(scan, tick, clock=clock)
-
-    def send(self, scan: Scan, tick: int, *, clock: float | None = None) -> None:
-        self.exchange.send(scan, tick, clock=clock)
-
-    def hold(self, seconds: float) -> None:
-        self.exchange.hold(seconds)
-
     def collect(self, scan: Scan, tick: int, *, may_be_ignored: bool = False) -> Answers:
         self._between_scenarios(tick)
         return self.exchange.collect(scan, tick, may_be_ignored=may_be_ignored)
-
-    def settle(self) -> list[Received]:
-        return self.exchange.settle()
 
     def _between_scenarios(self, tick: int) -> None:
         """This scenario's first tick is out (its driver scan came, or it was lost): the

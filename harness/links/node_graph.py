@@ -45,8 +45,6 @@ class GraphHooks:
     # Why it never became ready, where the link knows better (a physical board's line).
     never_ready: Callable[[], str | None] | None = None
     gone: Callable[[str], str | None] | None = None  # what else may stop (a board's software)
-    # Publish /clock (time 0) while waiting for the node (default: no physical board).
-    clock_before_ready: Callable[[], bool] | None = None
 
 
 class NodeGraph:
@@ -155,16 +153,9 @@ class NodeGraph:
             self.observer.inbox.clear()
 
     def _clock_before_ready(self) -> bool:
-        """Publish /clock (time 0) while waiting for the node to come up?
-
-        Yes in a graph the harness made for the node (a use_sim_time node
-        reads time 0 until the first scan's /clock either way, so nothing it
-        is judged on changes; one that waits for a /clock message before
-        subscribing to the scans can start). Not into a physical board's
-        graph, where nothing may be waiting for the harness's time.
-        """
-        if self.hooks.clock_before_ready is not None:
-            return self.hooks.clock_before_ready()
+        """/clock (time 0) while the node comes up, so one that waits for a clock before it
+        subscribes can start (a use_sim_time node reads 0 until the first scan's anyway);
+        never into a physical board's graph."""
         return self.options.port is None
 
     def _reads_scans(self) -> bool:

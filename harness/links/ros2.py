@@ -23,22 +23,18 @@ import time
 from typing import TYPE_CHECKING
 
 from harness.errors import ConfigError
-from harness.links.base import Link, LinkOptions, register
+from harness.links.base import Link, LinkOptions, Part, register
 from harness.links.bounds import CATCH_UP_S, NAMED_WAIT_S
 from harness.links.node_exchange import NodeExchange, ScanDelivery
-from harness.links.node_graph import GraphHooks, NodeGraph
+from harness.links.node_graph import NodeGraph
 from harness.links.node_notes import WiringNotes
 from harness.links.node_start import launch_check, node_command
 from harness.nodes.process import prepare_start
 from harness.ros.domain import reserve_domain
 
 if TYPE_CHECKING:  # numpy and rclpy are imported when the first link starts, after its node
-    from harness.judge.answers import Answers, Received
     from harness.launch_files.run_check import LaunchCheck  # read for --package, --launch
     from harness.lidar.scan import Scan
-    from harness.nodes.process import NodeProcess
-    from harness.ros.domain import DomainReservation
-    from harness.ros.observer import Observer
 
 __all__ = ["CATCH_UP_S", "NAMED_WAIT_S", "Ros2Link", "TopicDelivery"]
 
@@ -69,26 +65,25 @@ class Ros2Link(Link):
     def __init__(self, options: LinkOptions, session: LaunchCheck | None = None) -> None:
         super().__init__(options)
         self.command = node_command(options)  # resolve now: bad input exits 2 early
-        hooks = GraphHooks(clock_before_ready=self._clock_before_ready)
-        self.graph = NodeGraph(options, self.command, WiringNotes(options, session), hooks)
+        self.graph = NodeGraph(options, self.command, WiringNotes(options, session))
         self.exchange = NodeExchange(self.graph, TopicDelivery)
         self.startup_s = 0.0
 
-    @property
-    def observer(self) -> Observer | None:
-        return self.graph.observer
-
-    @property
-    def process(self) -> NodeProcess | None:
-        return self.graph.process
-
-    @property
-    def domain(self) -> DomainReservation | None:
-        return self.graph.domain
-
-    @property
-    def node_start(self) -> str:  # type: ignore[override]
-        return self.graph.node_start
+    # The graph's and the exchange's, as the runner and the tests read them.
+    observer = Part("graph")
+    process = Part("graph")
+    domain = Part("graph")
+    node_start = Part("graph")
+    node_gone = Part("graph")
+    stop = Part("graph")
+    close = Part("graph")
+    stop_note = Part("graph")
+    send_first = Part("exchange")
+    warm_up = Part("exchange")
+    send = Part("exchange")
+    hold = Part("exchange")
+    collect = Part("exchange")
+    settle = Part("exchange")
 
     # -- life cycle -------------------------------------------------------
     @classmethod
@@ -105,11 +100,8 @@ class Ros2Link(Link):
             prepare_start(node_command(options))
 
     def start(self) -> None:
-        """Reserve a domain, start the node and the harness's own ROS node; do not wait.
-
-        A suite starts the next scenarios' links this way while one runs
-        (each in its own domain); `open` then waits for readiness.
-        """
+        """Start the node in a domain of its own without waiting (a suite starts the next
+        scenarios' links while one runs); `open` waits for readiness."""
         self.graph.start(reserve_domain)
 
     def open(self) -> None:
@@ -119,50 +111,9 @@ class Ros2Link(Link):
         self.graph.open()
         self.startup_s = time.perf_counter() - started
 
-    def _clock_before_ready(self) -> bool:
-        """Publish /clock (time 0) while waiting for the node to come up? Not into a
-        physical board's graph (``NodeGraph._clock_before_ready``)."""
-        return self.options.port is None
-
-    def send_first(self, scan: Scan, tick: int, *, clock: float | None = None) -> None:
-        self.exchange.send_first(scan, tick, clock=clock)
-
-    def warm_up(self, scan: Scan) -> None:
-        self.exchange.warm_up(scan)
-
-    def send(self, scan: Scan, tick: int, *, clock: float | None = None) -> None:
-        self.exchange.send(scan, tick, clock=clock)
-
-    def hold(self, seconds: float) -> None:
-        self.exchange.hold(seconds)
-
-    def collect(self, scan: Scan, tick: int, *, may_be_ignored: bool = False) -> Answers:
-        return self.exchange.collect(scan, tick, may_be_ignored=may_be_ignored)
-
-    def settle(self) -> list[Received]:
-        return self.exchange.settle()
-
-    def node_gone(self, when: str = "") -> str | None:
-        """Why the node is no longer running, or None while it runs."""
-        return self.graph.node_gone(when)
-
-    # -- the end ----------------------------------------------------------
-    def stop(self) -> None:
-        """Close the harness's ROS node and ask the node under test to stop; `close` waits."""
-        self.graph.stop()
-
-    def close(self) -> None:
-        self.graph.close()
-
-    def stop_note(self) -> str:
-        return self.graph.stop_note()
-
     def diagnostics(self) -> str:
-        """The node's last output and what the graph showed; then ask the node to stop.
-
-        The runner asks for diagnostics once, when the run is over (before
-        closing the link).
-        """
+        """The node's last output and what the graph showed; then ask the node to stop
+        (the runner asks once, when the run is over)."""
         if self.graph.process is None:
             return ""
         text = self.graph.diagnostics(warmed_up=self.exchange.warmed_up)
