@@ -19,7 +19,7 @@ from pathlib import Path
 from typing import Any
 
 from harness import __version__
-from harness.errors import ConfigError
+from harness.errors import OptionError
 from harness.judge.verdicts import RunVerdict
 
 __all__ = [
@@ -66,6 +66,10 @@ class Baseline:
     entries: tuple[Mapping[str, Any], ...]
 
 
+def _bad(text: str) -> OptionError:
+    return OptionError.saying("baseline", text)  # "--baseline " in the CLI
+
+
 def load_baseline(path: str) -> Baseline:
     """Read and check `path` (a summary.json, or the report folder holding one): a
     ConfigError naming the file when it is missing or not one `run --out` writes."""
@@ -77,39 +81,38 @@ def load_baseline(path: str) -> Baseline:
         text = file.read_text(encoding="utf-8")
     except FileNotFoundError:
         missing = f"a folder without {SUMMARY}" if folder else "no such file"
-        raise ConfigError(f"--baseline {path}: {missing}") from None
+        raise _bad(f"{path}: {missing}") from None
     except (OSError, UnicodeDecodeError) as err:
         reason = getattr(err, "strerror", None) or str(err).splitlines()[0]
-        raise ConfigError(f"--baseline {path}: cannot read it: {reason}") from None
+        raise _bad(f"{path}: cannot read it: {reason}") from None
     try:
         data = json.loads(text)
     except json.JSONDecodeError as err:
-        raise ConfigError(f"--baseline {path}: not JSON ({err.msg}, line {err.lineno})") from None
+        raise _bad(f"{path}: not JSON ({err.msg}, line {err.lineno})") from None
     except (ValueError, RecursionError) as err:  # a number too long, nesting too deep
         reason = str(err).split(":")[0].splitlines()[0]
-        raise ConfigError(f"--baseline {path}: not JSON this harness reads ({reason})") from None
+        raise _bad(f"{path}: not JSON this harness reads ({reason})") from None
     entries = _checked(data, path)
     harness = data.get("harness", "unknown")
     if not isinstance(harness, str):
-        what = f"--baseline {path}: not a fossbot-hil summary.json"
-        raise ConfigError(f"{what} (harness is malformed)")
+        raise _bad(f"{path}: not a fossbot-hil summary.json (harness is malformed)")
     return Baseline(path=path, harness=harness, entries=entries)
 
 
 def _checked(data: object, path: str) -> tuple[Mapping[str, Any], ...]:
     """The scenario entries of a summary.json, each with the fields a comparison reads."""
-    what = f"--baseline {path}: not a fossbot-hil summary.json"
+    what = f"{path}: not a fossbot-hil summary.json"
     if not isinstance(data, dict) or not isinstance(data.get("scenarios"), list):
-        raise ConfigError(f"{what} (no list of scenarios)")
+        raise _bad(f"{what} (no list of scenarios)")
     for i, entry in enumerate(data["scenarios"]):
         if not isinstance(entry, dict):
-            raise ConfigError(f"{what} (scenarios[{i}] is not an object)")
+            raise _bad(f"{what} (scenarios[{i}] is not an object)")
         for name, kind in _FIELDS.items():
             value = entry.get(name)
             if not isinstance(value, kind) or (kind is int and isinstance(value, bool)):
-                raise ConfigError(f"{what} (scenarios[{i}].{name} is missing or malformed)")
+                raise _bad(f"{what} (scenarios[{i}].{name} is missing or malformed)")
         if entry["verdict"] not in VERDICTS:
-            raise ConfigError(f"{what} (scenarios[{i}].verdict {entry['verdict']!r} is unknown)")
+            raise _bad(f"{what} (scenarios[{i}].verdict {entry['verdict']!r} is unknown)")
     return tuple(data["scenarios"])
 
 

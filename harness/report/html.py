@@ -13,6 +13,7 @@ from typing import Any
 from urllib.parse import quote
 
 from harness.judge.reading_coverage import CASE_NAMES, other_counts
+from harness.option_names import worded
 from harness.report.summary import passed_line
 from harness.safe_text import DIAGNOSTICS_LIMIT, TEXT_LIMIT, clip, for_html, visible
 
@@ -119,7 +120,7 @@ def _alignment(alignment: Mapping[str, Any]) -> list[str]:
     fails = " fails" if alignment["fails_run"] else ""
     lead = ""
     if alignment["status"] == "misaligned":
-        lead = "FAILED (--alignment fail): " if fails else "WARNING: "
+        lead = worded("FAILED ({alignment} fail): ") if fails else "WARNING: "
     return [
         "<h2>Alignment of the board's /scan</h2>",
         f'<p class="{kind}{fails}">{_text(lead + alignment["text"])}</p>',

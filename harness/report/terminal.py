@@ -17,6 +17,7 @@ from rich.text import Text
 
 from harness.judge.records import RunResult
 from harness.judge.verdicts import RunVerdict, verdict_of
+from harness.option_names import named, worded
 from harness.report.baseline import KINDS
 from harness.report.console_text import print_safe
 from harness.report.summary import alignment_fails, passed_line
@@ -136,8 +137,10 @@ def print_results(
     console.print(passed_line(passed, total), highlight=False)
     if any(r.warning_rule == "required" for r in results):
         console.print(
-            "judged with --warning-when-clear required: warning False was due on every scan "
-            "with nothing within the threshold",
+            worded(
+                "judged with {warning_when_clear} required: warning False was due on every scan "
+                "with nothing within the threshold"
+            ),
             highlight=False,
         )
     for line in node_start_lines(results):
@@ -192,7 +195,8 @@ def print_alignment(console: Console, alignment: Alignment, *, mode: str = "warn
     quiet when aligned or unknown, a warning when misaligned, a failure with `--alignment fail`."""
     line, style = f"alignment: {alignment.text()}", ""
     if alignment_fails(alignment, mode):
-        line, style = f"alignment: FAILED (--alignment fail): {alignment.text()}", "bold red"
+        failed = f"FAILED ({named('alignment')} fail)"
+        line, style = f"alignment: {failed}: {alignment.text()}", "bold red"
     elif alignment.misaligned:
         line, style = f"alignment: WARNING: {alignment.text()}", "bold yellow"
     print_safe(console, line, style=style)
