@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from harness.ctrl_c import remembered_ctrl_c
-from harness.errors import ConfigError, Interrupted, LinkError
+from harness.errors import ConfigError, Interrupted, LinkError, OptionError
 from harness.judge.records import RunResult, TickRecord
 from harness.lidar.scan import Scan
 from harness.links.base import LinkOptions, create_link
@@ -106,7 +106,7 @@ class LiveSession:
         show: Callable[[str], None] = print,
     ) -> None:
         if not settings.rate > 0 or not math.isfinite(settings.rate):
-            raise ConfigError(f"--rate must be a positive number, got {settings.rate}")
+            raise OptionError.saying("rate", f"must be a positive number, got {settings.rate}")
         self.scenario = scenario
         self.settings = settings
         self.plan = plan_one(scenario, "live", options, settings.run)

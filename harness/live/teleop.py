@@ -19,7 +19,7 @@ import termios
 import time
 from collections.abc import Callable
 
-from harness.errors import ConfigError
+from harness.errors import OptionError
 
 # key -> (x, y, z, th), teleop_twist_keyboard's moveBindings
 MOVE_KEYS: dict[str, tuple[int, int, int, int]] = {
@@ -141,9 +141,10 @@ class KeyReader:
         self.fd = _stdin_fd() if fd is None else fd
         if not os.isatty(self.fd):
             where = "standard input" if self.fd == 0 else f"file descriptor {self.fd}"
-            raise ConfigError(
-                f"--teleop needs a terminal: {where} is not one "
-                "(run fossbot-hil sim --teleop in a terminal, its input not piped or redirected)"
+            raise OptionError(
+                "teleop",
+                f"{{teleop}} needs a terminal: {where} is not one "
+                "(run fossbot-hil sim {teleop} in a terminal, its input not piped or redirected)",
             )
         self.escape_wait = escape_wait
         self._saved: list | None = None
@@ -282,8 +283,8 @@ def _stdin_fd() -> int:
     try:
         return sys.stdin.fileno()
     except (AttributeError, ValueError, OSError) as err:
-        raise ConfigError(
-            "--teleop needs a terminal: standard input has no file descriptor"
+        raise OptionError(
+            "teleop", "{teleop} needs a terminal: standard input has no file descriptor"
         ) from err
 
 

@@ -11,6 +11,7 @@ from pathlib import Path
 
 from harness.errors import ConfigError
 from harness.lidar.scan import Scan, scan_from_message
+from harness.option_names import named
 from harness.record import messages as msg
 from harness.record.writer import METADATA_NAME, RecordTopics
 
@@ -54,7 +55,8 @@ def _choose_topic(path: Path, scan_topics: list[str], topic: str | None) -> str:
         return RecordTopics.scan
     if len(scan_topics) > 1:
         raise ConfigError(
-            f"{path}: several LaserScan topics ({', '.join(scan_topics)}); choose one with --topic"
+            f"{path}: several LaserScan topics ({', '.join(scan_topics)}); "
+            f"choose one with {named('topic')}"
         )
     return scan_topics[0]
 

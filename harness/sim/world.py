@@ -18,7 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
-from harness.errors import ConfigError
+from harness.errors import ConfigError, OptionError
 from harness.safe_text import shown
 from harness.scenario.geometry import cylinder_segments
 from harness.scenario.model_files import check_model_file, find_model_file, robot_models_dir
@@ -58,7 +58,7 @@ class World:
         self.scenario = scenario
         self.where = shown(scenario.source or "<scenario>")
         if gui and sys.platform.startswith("linux") and not os.environ.get("DISPLAY"):
-            raise ConfigError("--gui needs a display")
+            raise OptionError("gui", "{gui} needs a display")
         self.gui = gui
         self.client: int = bullet.connect(gui)
         if self.client < 0:

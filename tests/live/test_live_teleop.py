@@ -15,6 +15,7 @@ from collections.abc import Iterator
 
 import pytest
 
+from harness.cli import build_parser, flag_names
 from harness.errors import ConfigError
 from harness.live.teleop import (
     HELP,
@@ -23,6 +24,7 @@ from harness.live.teleop import (
     KeyReader,
     TeleopState,
 )
+from harness.option_names import speaking
 
 WAIT = 2.0  # s: long enough for a pty under load; only ever spent when a test fails
 QUIET = 0.05  # s: how long "nothing was typed" is watched
@@ -263,7 +265,10 @@ def test_reading_outside_the_with_block_is_a_bug(pty: tuple[int, int]) -> None:
 def test_a_pipe_is_not_a_terminal() -> None:
     read_end, write_end = os.pipe()
     try:
-        with pytest.raises(ConfigError, match=r"^--teleop needs a terminal: file descriptor"):
+        with (
+            speaking(flag_names(build_parser())),  # as the CLI names the option
+            pytest.raises(ConfigError, match=r"^--teleop needs a terminal: file descriptor"),
+        ):
             KeyReader(read_end)
     finally:
         os.close(read_end)

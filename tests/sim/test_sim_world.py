@@ -10,7 +10,9 @@ import numpy as np
 import pytest
 from sim_scenarios import make_scenario
 
+from harness.cli import build_parser, flag_names
 from harness.errors import ConfigError
+from harness.option_names import speaking
 from harness.scenario.files import parse_scenario
 from harness.sim.bullet import pb
 from harness.sim.lidar import LidarModel
@@ -252,7 +254,10 @@ def test_gui_without_display_is_a_config_error(monkeypatch):
     """--gui on a headless machine is the user's to fix, not a crash."""
     monkeypatch.delenv("DISPLAY", raising=False)
     monkeypatch.setattr("sys.platform", "linux")
-    with pytest.raises(ConfigError, match="^--gui needs a display$"):
+    with (
+        speaking(flag_names(build_parser())),  # as the CLI names the option
+        pytest.raises(ConfigError, match="^--gui needs a display$"),
+    ):
         World(make_scenario(), gui=True)
 
 
