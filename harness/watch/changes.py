@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from harness.errors import HarnessError, one_line
+from harness.option_names import named
 from harness.watch.sources import Watched
 
 __all__ = ["ChangeFeed", "Changes"]
@@ -116,7 +117,7 @@ class ChangeFeed:
         """A watcher that failed to start ends the loop (the reason, in one line)."""
         if self._failures:
             self._stop.set()
-            raise HarnessError(f"--watch: {self._failures[0]}")
+            raise HarnessError(f"{named('watch')}: {self._failures[0]}")
 
     def wait(self, timeout: float) -> Changes:
         """Everything that changed since the last call, waiting up to `timeout` seconds for
@@ -132,5 +133,5 @@ class ChangeFeed:
             except queue.Empty:
                 return found
             if isinstance(item, str):
-                raise HarnessError(f"--watch: {item}")
+                raise HarnessError(f"{named('watch')}: {item}")
             found = found | item

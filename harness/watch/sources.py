@@ -16,10 +16,11 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from harness.errors import ConfigError
+from harness.errors import OptionError
 from harness.nodes.command import python_script_of, split_command
 from harness.nodes.package_folder import WORKSPACE_OUTPUTS, find_package
 from harness.nodes.setup_problems import is_python
+from harness.option_names import escaped
 
 if TYPE_CHECKING:
     from harness.links.base import LinkOptions
@@ -156,30 +157,33 @@ def _file_sources(program: Path, shown: str) -> NodeSources:
     return NodeSources((Watched(program.parent, names=frozenset({program.name})),), (shown,))
 
 
-def command_sources(command: str, *, option: str = "--node") -> NodeSources:
+def command_sources(command: str) -> NodeSources:
     """The files a node command line runs: a script and the .py files beside it, or
-    its program when that is a file; ConfigError when the command names none."""
-    argv = split_command(command, option=option)
+    its program when that is a file; OptionError when the command names none."""
+    argv = split_command(command)
     program = argv[0]
+    given = "{node} " + escaped(repr(command))  # --node 'python3 x.py', when worded
     script = python_script_of(argv) if is_python(program) else None
     if script is None and is_python(program):  # -m or -c: no file on the command line
-        raise ConfigError(
-            f"--watch: cannot tell which files {option} {command!r} runs; "
-            f"give the script's path, e.g. {option} 'python3 path/to/node.py'"
+        raise OptionError(
+            "watch",
+            f"{{watch}}: cannot tell which files {given} runs; "
+            "give the script's path, e.g. {node} 'python3 path/to/node.py'",
         )
     if script is None and program.endswith(".py"):
         script = program
     if script is not None:
         path = Path(os.path.expanduser(script))
         if not path.is_file():
-            raise ConfigError(f"--watch: {option} {command!r}: no such script {script}")
+            raise OptionError("watch", f"{{watch}}: {given}: no such script {escaped(script)}")
         return _script_sources(_real(path), path.name)
     if "/" in program and Path(os.path.expanduser(program)).is_file():
         return _file_sources(_real(program), program)
-    raise ConfigError(
-        f"--watch: cannot tell which files {option} {command!r} runs ({program!r} is a "
+    raise OptionError(
+        "watch",
+        f"{{watch}}: cannot tell which files {given} runs ({escaped(repr(program))} is a "
         "program, not a file of yours); give the script's path, or use "
-        "--workspace/--package/--executable"
+        "{workspace}/{package}/{executable}",
     )
 
 
@@ -206,15 +210,18 @@ def package_sources(workspace: str, package: str) -> NodeSources:
     """The package's source folder in `workspace` and how to rebuild it."""
     root = Path(os.path.expanduser(workspace))
     if not (root / "install").is_dir():
-        raise ConfigError(
-            f"--watch: --workspace {workspace} has no install/ folder: give the colcon "
-            "workspace itself (the folder you run colcon build in), built once"
+        raise OptionError(
+            "watch",
+            f"{{watch}}: {{workspace}} {escaped(workspace)} has no install/ folder: give the "
+            "colcon workspace itself (the folder you run colcon build in), built once",
         )
     source = find_package(root, package)
     if source is None:
-        raise ConfigError(
-            f"--watch: no package.xml naming {package} under --workspace {workspace} "
-            "(outside its build/, install/ and log/): its sources are what --watch watches"
+        raise OptionError(
+            "watch",
+            f"{{watch}}: no package.xml naming {escaped(package)} under {{workspace}} "
+            f"{escaped(workspace)} (outside its build/, install/ and log/): its sources are "
+            "what {watch} watches",
         )
     symlinked = symlink_installed(root, package)
     build = Build(_real(root), package, _real(source), symlinked, merge_installed(root))
@@ -234,7 +241,7 @@ def processor_sources(processor: str | None) -> NodeSources:
         return NodeSources()
     path = Path(os.path.expanduser(target))
     if not path.is_file():
-        raise ConfigError(f"--processor {processor!r}: no such file {target}")
+        raise OptionError.saying("processor", f"{processor!r}: no such file {target}")
     return _file_sources(_real(path), target)
 
 
@@ -248,9 +255,10 @@ def node_sources(link: str, options: LinkOptions) -> NodeSources:
         return command_sources(options.node)
     if options.package:
         if options.workspace is None:
-            raise ConfigError(
-                "--watch with --package needs --workspace DIR: the colcon workspace whose "
-                "sources to watch and rebuild"
+            raise OptionError(
+                "watch",
+                "{watch} with {package} needs {workspace} DIR: the colcon workspace whose "
+                "sources to watch and rebuild",
             )
         return package_sources(options.workspace, options.package)
     return NodeSources()

@@ -12,8 +12,10 @@ from pathlib import Path
 
 import pytest
 
+from harness.cli import build_parser, flag_names
 from harness.errors import ConfigError
 from harness.links.base import LinkOptions
+from harness.option_names import speaking
 from harness.watch.sources import (
     Build,
     find_package,
@@ -204,7 +206,7 @@ def test_a_workspace_without_the_sources(
     if layout == "no install":
         (tmp_path / "install").rmdir()
     given = {k: (str(tmp_path) if v == "WS" else v) for k, v in options.items()}
-    with pytest.raises(ConfigError, match=message):
+    with speaking(flag_names(build_parser())), pytest.raises(ConfigError, match=message):
         sources_of(executable="node", **given)
 
 
