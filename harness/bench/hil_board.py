@@ -16,12 +16,12 @@ import tempfile
 from pathlib import Path
 
 from harness.bench.stage import StageResult
-from harness.bench.suite_commands import cli_wall_s
+from harness.bench.suite_commands import cli_args, cli_wall_s
 from harness.errors import HarnessError
 from harness.links.kinds import default_serial_link
 
 QUICK_SUITE = ("approach_wall", "reverse_to_wall")  # short, and one gap between them
-ANSWER_WAIT_S = 5.0  # --timeout, as the whole-run tests give a real-time board
+ANSWER_WAIT_S = 5.0  # the scan timeout, as the whole-run tests give a real-time board
 # The bundled driver as a board's own software ({port}: the emulated device's path);
 # its defaults are the v2 bridge's mapping, as the robot model's mount wants.
 DRIVER = f"{sys.executable} -m harness.board_driver.rplidar_node --ros-args -p port:={{port}}"
@@ -37,9 +37,8 @@ def measure_hil(scenarios: tuple[str, ...] = ()) -> StageResult:
     """One real-time suite over the virtual board (`scenarios`, default every shipped one)."""
     with tempfile.TemporaryDirectory(prefix="fossbot-hil-bench-hil-") as tmp:
         out = Path(tmp) / "report"
-        board = ("--board-command", DRIVER, "--timeout", f"{ANSWER_WAIT_S:g}")
-        link = ("--link", default_serial_link())
-        wall_s = cli_wall_s([*scenarios, *link, *board, "--out", str(out)])
+        link = cli_args(link=default_serial_link(), board_commands=DRIVER, out=str(out))
+        wall_s = cli_wall_s([*scenarios, *link, *cli_args(scan_timeout=f"{ANSWER_WAIT_S:g}")])
         gaps = hil_gaps(out / "summary.json")
     if not gaps:
         raise HarnessError("the real-time suite over the virtual board reported no gap")

@@ -18,7 +18,7 @@ from pathlib import Path
 
 from harness.bench.lab_workspace import build_lab_workspace, colcon_program, lab_package_source
 from harness.bench.stage import StageResult
-from harness.bench.suite_commands import alternate, cli_wall_s
+from harness.bench.suite_commands import alternate, cli_args, cli_wall_s
 from harness.bench.workload import Workload
 from harness.errors import HarnessError
 from harness.links.base import LinkOptions
@@ -79,7 +79,7 @@ def _shipped_suite(
         {
             "suite": [*names],
             "student_suite": [*names, *workspace.run_args()],
-            "inprocess_suite": [*names, "--link", INPROCESS],
+            "inprocess_suite": [*names, *cli_args(link=INPROCESS)],
         },
         runs,
     )

@@ -18,6 +18,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import harness
+from harness.bench.suite_commands import cli_args
 from harness.errors import HarnessError
 from harness.links.base import LinkOptions
 from harness.nodes.process_group import signal_group, wait_group_gone
@@ -46,14 +47,7 @@ class LabWorkspace:
 
     def run_args(self) -> list[str]:
         """The options that make ``fossbot-hil run`` start this workspace's node."""
-        return [
-            "--workspace",
-            str(self.root),
-            "--package",
-            self.package,
-            "--executable",
-            self.executable,
-        ]
+        return cli_args(workspace=str(self.root), package=self.package, executable=self.executable)
 
     def link_options(self) -> LinkOptions:
         """The same node for ``runner.run_suite`` in this process."""

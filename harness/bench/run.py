@@ -17,7 +17,7 @@ from harness.bench import STAGES, machine
 from harness.bench.figures import OVERHEAD_FORMULA, check_targets, figures
 from harness.bench.stage import StageResult
 from harness.bench.workload import LAB_TRIO, Workload, lab_workload
-from harness.errors import ConfigError, HarnessError
+from harness.errors import HarnessError, OptionError
 from harness.links.kinds import INPROCESS, ROS2
 
 
@@ -69,9 +69,10 @@ def parse_stages(text: str | None) -> tuple[str, ...]:
     names = [n.strip() for n in text.split(",") if n.strip()]
     unknown = [n for n in names if n not in STAGES]
     if unknown or not names:
-        raise ConfigError(
-            f"--only {text!r}: unknown stage {', '.join(unknown) or '(none given)'} "
-            f"(known: {', '.join(STAGES)})"
+        raise OptionError.saying(
+            "only",
+            f"{text!r}: unknown stage {', '.join(unknown) or '(none given)'} "
+            f"(known: {', '.join(STAGES)})",
         )
     return tuple(s for s in STAGES if s in names)
 
