@@ -1,23 +1,12 @@
 """How a scan travels: links deliver scans to the software under test and collect its answers.
 
-- ``inprocess``: a processing function, called in a forked child
-  (``processor_child``);
-- ``ros2``: a node in its own process, over a real ROS 2 graph;
-- ``rplidar``, ``ldlidar``: a board's driver reading an emulated device on a
-  serial line (``board``), its nodes answering over ROS 2.
-
-What each link is (runs a node, uses a serial line, which device) is
-declared once, in ``kinds``: a table that imports nothing, from which every
-list of links the commands and the pytest plugin show is derived. Each
-link's class lives in its own module here and registers itself by name with
-``@register``, checked against its row; ``create_link("ros2", options)``
-imports ``harness.links.ros2`` on demand, so the pure parts of the harness
-never import rclpy or pyserial. A new link is a row in ``kinds`` and a new
-module with a ``Link`` subclass (``base``), composing what links share
-(``node_graph``, ``node_exchange``) rather than subclassing another link; a
-new serial LIDAR's module registers its name with its device profile
-(``board.serial_lidar``). One from outside the harness calls ``kinds.declare``.
-"""
+``inprocess`` calls a processing function in a forked child; ``ros2`` drives a node
+over a real ROS 2 graph; ``rplidar`` and ``ldlidar`` feed a board's driver an emulated
+device on a serial line. What each link is lives once, in ``kinds`` (which imports
+nothing); each link's module registers its class by name (``@register``), imported on
+demand by ``create_link``, so the pure parts never import rclpy or pyserial. A new
+link is a row in ``kinds`` and a module composing ``node_graph`` and ``node_exchange``
+(no link subclasses another); a new serial LIDAR's module is ``board.serial_lidar``."""
 
 from harness import lazy_exports
 
@@ -25,7 +14,6 @@ _EXPORTS = {
     "Link": "base",
     "LinkOptions": "base",
     "create_link": "base",
-    "known_links": "base",
     "register": "base",
     "LinkKind": "kinds",
     "declare": "kinds",

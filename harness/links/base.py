@@ -11,7 +11,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, ClassVar, TypeVar
 
 from harness.errors import ConfigError
-from harness.links.kinds import link_kind, link_names
+from harness.links.kinds import link_kind
 from harness.nodes.setup_problems import is_ros_module
 
 if TYPE_CHECKING:  # naming the links and their options needs none of these (nor numpy)
@@ -112,12 +112,9 @@ class Link(ABC):
 
     @abstractmethod
     def collect(self, scan: Scan, tick: int, *, may_be_ignored: bool = False) -> Answers:
-        """Wait (bounded by options.scan_timeout) for the answers to the last scan.
-
-        `may_be_ignored`: silence is a right answer (a duplicate, an old
-        scan), so do not wait beyond the deadline or count it as the node
-        going quiet.
-        """
+        """Wait (bounded by options.scan_timeout) for the answers to the last scan;
+        `may_be_ignored`: silence is right (a duplicate, an old scan), so no catch-up wait
+        and no count toward the node going quiet."""
 
     def exchange(
         self, scan: Scan, tick: int, *, clock: float | None = None, may_be_ignored: bool = False
@@ -214,11 +211,6 @@ def add_link(name: str, link: M) -> M:
 
 def _where(link: Any) -> str:
     return f"{link.__module__}.{getattr(link, '__qualname__', '')}"
-
-
-def known_links() -> list[str]:
-    """Names of the links the harness knows (``kinds``), sorted."""
-    return link_names()
 
 
 def create_link(name: str, options: LinkOptions, session: Any = None) -> Link:

@@ -1,25 +1,13 @@
 """Links through a LIDAR on a serial line: the harness plays the device.
 
-Virtual board (default): a pty pair stands in for the USB cable; the board's
-own software (the bundled LIDAR driver from node/fossbot_lidar_driver, or
-the user's board commands) reads the emulated device and publishes /scan,
-and the node under test answers it, each in its own process. Physical
-board (a port named): the emulator drives a real USB-UART wired to the
-board's LIDAR input in real time, and the harness joins the board's ROS 2
-graph to watch what it publishes.
-
-The device, the line and the board's software live for the whole run
-(``board_session.BoardSession``, the link's ``run_session``); each
-scenario's link uses them, and on the virtual board starts a fresh node
-under test. A ``BoardLink`` composes the node's graph (``node_graph``) and
-the node exchange (``node_exchange``) with the board delivery
-(``board_delivery``): a scan becomes device samples, goes down the line,
-and the driver's /scan for that revolution is what the oracle judges.
-
-Which LIDAR is the device's profile (``harness.devices.profiles``): a
-serial LIDAR's link module registers its name with its profile
-(``serial_lidar``), and the registry's entry makes a ``BoardLink`` with it.
-"""
+Virtual board (default): a pty pair stands in for the USB cable, and the board's own
+software (the bundled driver from node/fossbot_lidar_driver, or the board commands)
+reads the emulated device and publishes /scan, which the node under test answers.
+Physical board (a port named): the emulator drives a real USB-UART in real time and
+the harness joins the board's ROS 2 graph. Device, line and board software live for
+the run (``board_session``); a ``BoardLink`` composes the graph and the exchange with
+the board delivery, and the driver's /scan of each revolution is what is judged.
+A serial LIDAR's module registers its name with its device profile (``serial_lidar``)."""
 
 from __future__ import annotations
 
@@ -126,10 +114,9 @@ class BoardLink(Link):
         self.graph.start(reserve_domain)
 
     def open(self) -> None:
-        """Start (unless started ahead) and wait, bounded, until the node is ready; what
-        the observer heard before (a link started ahead, while the scenario before ran)
-        answers nothing of this scenario's; the device takes this scenario's rate (not
-        at `start`: the scenario before may still run)."""
+        """Start (unless started ahead) and wait, bounded, for readiness; what was heard
+        before answers nothing of this scenario's, and the device takes its rate only now
+        (the scenario before may still have run at `start`)."""
         started = time.perf_counter()
         self.start()
         self.graph.open()
@@ -261,11 +248,10 @@ class SerialLidar:
                 prepare_start(node_command(options))
 
     def links_ahead(self, options: LinkOptions) -> int:
-        """How many links a suite starts beyond the running one: on the virtual board the
-        next, so its node and world are ready before this scenario's last revolution. It
-        hears this scenario's scans on the board's scan topic but answers on topics of its
-        own (``BoardSession.node_topics``), which only its own link hears. None on a
-        physical board, for a node a launch file starts, or for private topic names."""
+        """How many links a suite starts beyond the running one: on the virtual board the next,
+        so its node is ready before this scenario's last revolution; it answers on topics of
+        its own (``BoardSession.node_topics``). None on a physical board, for a launch file's
+        node, or for private topic names."""
         if options.port is not None or not remappable(options.status_topic, options.warning_topic):
             return 0
         try:

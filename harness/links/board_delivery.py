@@ -1,21 +1,13 @@
 """The board delivery: a scan becomes a revolution of an emulated device, down the line.
 
-The board's driver reads the device and publishes the revolution on the scan
-topic; the driver's scan (quantised and re-binned) is what the oracle
-judges, because it is what the node saw. Plugged into a ``NodeExchange``,
-which owns the waits and the answer pairing; this part owns what only a
-line and a device bring: the push, the driver's scan of it, revolutions lost
-(sparse, or damaged on the line), the device's own repeats, the end of the
-idle stream (``board_idle``) and which answer answered which driver scan
-(``board_pairing``).
-
-Which board scan is which revolution: the first scan the board published
-after the write that carried the revolution's last byte (a driver can
-publish a revolution only once it has all of it, and it has published the
-one before by then, when it answers within a revolution's time). Scans of
-revolutions the device sent on its own (repeats between scenarios, or
-when the harness was late) are told apart the same way and not judged.
-"""
+The driver's scan of it (quantised and re-binned) is what the oracle judges: it is
+what the node saw. The ``NodeExchange`` owns the waits and the pairing; this part owns
+what a line and a device bring: the push, lost revolutions (sparse, or damaged), the
+device's repeats, the idle stream's end (``board_idle``) and which answer answered
+which driver scan (``board_pairing``). A revolution's scan is the first the board
+published after the write carrying its last byte (a driver publishes a revolution
+only once it has all of it); repeats the device sent on its own are told apart the
+same way and not judged."""
 
 from __future__ import annotations
 
@@ -89,12 +81,8 @@ class BoardDelivery(ScanDelivery):
         return self.session.server if self.session is not None else None
 
     def damage_line(self, damage: LineDamage) -> None:
-        """Line faults: the device's revolutions reach the driver damaged from the next
-        push on (until this scenario ends); the idle stream before it never is.
-
-        A revolution the driver then publishes no scan of is lost, not a
-        broken link: the node had nothing to answer.
-        """
+        """Line faults: revolutions reach the driver damaged from the next push on (never the
+        idle stream); one the driver then makes no scan of is lost, not a broken link."""
         assert self._server is not None, "open() the link first"
         self._line_damage = damage
         if self.idle.pushed:
@@ -239,12 +227,10 @@ class BoardDelivery(ScanDelivery):
         return heard.source_ns
 
     def copy(self, n: int) -> None:
-        """Each later copy of the first scan is damaged from the line's state before the
-        first copy, by a scratch copy of it, after the stream was ended on a whole start
-        marker (so its bytes are the first's: the first came after the idle stream's),
-        and once the copies are out the line goes on from its state after the first copy
-        (`_after_copies`): what the driver makes of each copy, the line's damage from
-        then on, and its counts do not depend on how many copies it took."""
+        """Each later copy of the first scan is damaged from the line's state before the first
+        copy (a scratch copy of it, the stream aligned so its bytes are the first's), and once
+        the copies are out the line goes on from its state after the first (`_after_copies`):
+        nothing the driver sees or the line counts depends on how many copies it took."""
         assert self._server is not None
         if self._line_damage is None:
             return
@@ -271,12 +257,9 @@ class BoardDelivery(ScanDelivery):
 
     def _push(self, samples: list[Any], tick: int, rate: float) -> int | None:
         """Queue the revolution and wait (bounded) until it went out whole; the system time
-        before its last write, or None (the reason kept in `_delivery_problem`).
-
-        A device the board's driver stopped (a driver restarting: STOP, RESET,
-        ... SCAN) is waited for, as long as a board may take to come up, and
-        the revolution goes out again once it scans.
-        """
+        before its last write, or None (why: `_delivery_problem`). A device the driver stopped
+        (a driver restarting: STOP, RESET, ... SCAN) is waited for as long as a board may take
+        to come up, and the revolution goes again once it scans."""
         assert self._server is not None and self._obs is not None
         server, period = self._server, 1.0 / rate
         push = server.send_revolution(samples, tick, period)
@@ -354,11 +337,10 @@ class BoardDelivery(ScanDelivery):
         ]
 
     def _repeat_from(self) -> int | None:
-        """When the first scan of a revolution the device sent again on its own came (the
-        harness slower than a revolution: real time), or None. The node answers in
-        order: its first answer is this tick's, the next ones the repeats'. With line
-        faults a later scan may be this revolution split or made late instead
-        (`_pair_with_driver_scans`)."""
+        """When the first scan of a revolution the device repeated on its own came (the harness
+        slower than a revolution: real time), or None; the node answers in order, so its
+        first answer is this tick's. With line faults a later scan may be this one split or
+        made late instead."""
         if self._line_damage is not None or self._obs is None:
             return None
         since = self._scans_from
@@ -375,13 +357,11 @@ class BoardDelivery(ScanDelivery):
         return self._statuses() >= max(len(self._driver_scans()), 1) + self._owed
 
     def settle_answers(self) -> None:
-        """The first tick, when the node may still owe answers to idle revolutions: wait
-        (bounded) until it has been quiet for three revolutions, so its answer to this
-        tick, which comes after those, is in (`collect` keeps the last).
-
-        Line faults: more statuses than driver scans heard may mean a late scan's
-        answer overtook the scan on its way to us (two topics, two readers). Wait a
-        moment for it; a node that simply answers twice costs that moment."""
+        """The first tick, while the node may still owe answers to idle revolutions: wait
+        (bounded) until it has been quiet for three revolutions, so its answer to this tick,
+        after those, is in (`collect` keeps the last). Line faults: more statuses than driver
+        scans may mean a late scan's answer overtook the scan (two topics, two readers): wait
+        a moment for it."""
         if self._after_idle and (self.idle.owed or self.exchange.copies > 1):
             # A copy went unanswered: the node was behind, and still answers the idle
             # stream's scans and the copies, in order, after the first status came.

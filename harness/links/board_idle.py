@@ -1,20 +1,12 @@
 """The idle stream's end, before a scenario's first revolution on a serial link.
 
-A board's node hears scans before its scenario's first tick: the device
-streams from the moment the run's session opens, and between scenarios it
-keeps scanning the last world (``board_session.BoardSession.between``). A
-node started ahead of its turn (``board.SerialLidar.links_ahead``) has been
-answering that stream, on topics of its own, for a whole scenario. Before
-the first push the link makes sure the node is answering, lets it answer
-what the stream brought, and forgets those answers, so none is taken for
-the first tick's (``set_aside_answers_to_the_idle_stream`` is the last
-guard, by count, in the first exchange).
-
-In lockstep the idle stream stops (``BoardSession.end_idle``) and the
-driver falls quiet; in real time the device never stops, so there is no
-quiet to wait for: the driver's scans are told apart by source time, as
-within a scenario.
-"""
+The device streams from the session's start and between scenarios, so a node
+(one started ahead has answered it for a whole scenario) hears scans before its
+first tick. Before the first push the link lets the node answer what the stream
+brought and forgets those answers, so none is taken for the first tick's
+(``set_aside_answers_to_the_idle_stream`` is the last guard, by count). In lockstep
+the stream stops and the driver falls quiet; in real time it never stops, so the
+driver's scans are told apart by source time, as within a scenario."""
 
 from __future__ import annotations
 
@@ -54,17 +46,11 @@ class IdleStreamEnd:
         self.quiet_s = 0.0  # three revolutions at the first scan's rate
 
     def end(self, session: BoardSession, rate: float) -> None:
-        """Before the first tick: wait (bounded) until the node answers one of the idle
-        stream's scans, so its subscription has matched the board's publisher and the
-        first scan reaches it; stop the idle stream; let the node answer the last scan
-        it made; forget those answers, so none is taken for the first tick's.
-
-        Unlike the ros2 link's node, a board's has heard scans before the first tick:
-        the device streams from the moment the session opens. A node silent when
-        nothing is in range may answer none of an empty room's: each wait is bounded,
-        and none is made when the board publishes no scan of the stream (a driver
-        skipping sparse revolutions).
-        """
+        """Before the first tick: wait (bounded) until the node answers an idle scan (so its
+        subscription matched and the first scan reaches it), stop the idle stream, let the node
+        answer the last scan it got, and forget those answers. A node silent when nothing is in
+        range may answer none: each wait is bounded, and none is made when the board publishes
+        no scan of the stream (a driver skipping sparse revolutions)."""
         obs = self.exchange.graph.observer
         assert obs is not None
         if self.pushed:
@@ -119,15 +105,10 @@ class IdleStreamEnd:
         obs.inbox.clear()
 
     def _caught_up(self, answered: bool, quiet_s: float) -> None:
-        """Real time: the device streams on (as a real one does), so neither the driver
-        nor the node falls quiet before the first push, and the driver's scans are told
-        apart by source time, as within a scenario. Wait (bounded) until the node has
-        answered after the newest scan the driver published (it answers in order: no
-        older idle scan is left to answer during the first tick), then for its Bool.
-
-        A node that answered none of the stream (silent when nothing is in range)
-        may owe answers still: the first tick waits for it to fall quiet.
-        """
+        """Real time: the device streams on, so nothing falls quiet before the first push. Wait
+        (bounded) until the node answered after the newest driver scan (in order: no idle scan
+        is left to answer during the first tick), then for its Bool; a node that answered none
+        may still owe answers, which the first tick waits out."""
         obs = self.exchange.graph.observer
         assert obs is not None
         self.quiet_s = quiet_s
@@ -183,11 +164,10 @@ class IdleStreamEnd:
 
 
 def set_aside_answers_to_the_idle_stream(answers: Answers, scans: int) -> None:
-    """The first exchange after the idle stream: more statuses than the driver published
-    scans in it means the earliest answer revolutions streamed before (a driver lagging
-    on a loaded machine publishes them late, after the harness stopped waiting for
-    them). The node answers in order, so the last `scans` statuses (and the Bools nearest
-    to them) are this exchange's; the others are kept as late answers of no tick."""
+    """The first exchange after the idle stream: more statuses than driver scans in it means
+    the earliest answer revolutions streamed before (a lagging driver publishes them late).
+    The node answers in order: the last `scans` statuses (and the Bools nearest them) are
+    this exchange's; the others are late answers of no tick."""
     statuses = sorted(answers.statuses, key=lambda r: r.source_ns)
     extra = len(statuses) - max(1, scans)
     if extra > 0:

@@ -21,18 +21,12 @@ __all__ = ["AnswerWindow", "owed_answers", "pair_with_driver_scans"]
 def pair_with_driver_scans(answers: Answers, scans: list[Heard]) -> None:
     """Give each answer the driver scan it answered.
 
-    Usually the driver made one scan of the revolution. When the line made
-    a revolution late (its scan came with the next one) or split one in
-    two, several came, often published back to back, before the node
-    answered any. The node answers scans in order, so the i-th status
-    answers the i-th scan. With as many Bools as statuses the i-th Bool
-    goes with the i-th status too; otherwise (a Bool published only on
-    change) each goes with the status published nearest to it. Nearness
-    alone misleads when callbacks run back to back on a loaded machine:
-    the next scan's Bool can come closer to the previous status than to
-    its own. The newest scan is this tick's; the earlier ones go with their answers into
-    ``answers.earlier``, each judged on its own.
-    """
+    A damaged line may make a revolution late (its scan comes with the next) or split
+    it, so several scans come before the node answers any. The node answers in order:
+    the i-th status answers the i-th scan, and with as many Bools the i-th Bool goes
+    with it; otherwise (Bools on change only) each Bool goes with the nearest status
+    (nearness alone misleads when callbacks run back to back on a loaded machine). The
+    newest scan is this tick's; the earlier go, with their answers, to ``answers.earlier``."""
     if len(scans) < 2:
         return
     seen = [h.value for h in scans if isinstance(h.value, Scan)]
@@ -68,16 +62,12 @@ class AnswerWindow:
 def owed_answers(window: AnswerWindow | None, repeats_before: int, late_before: int) -> int:
     """How many statuses published after this tick's driver scan still answer earlier ones.
 
-    In real time the device repeats a revolution while the harness is late (a
-    node slow on one scan); a node answering in order may answer such a repeat
-    only after the next tick's scan was published, and that answer, newer than
-    the tick's scan, is not the tick's. The scans since the last tick's own
-    (`window`, plus `repeats_before`: repeats heard since) less the statuses
-    heard for them (`late_before`: those published before this tick's scan)
-    is what the node still owes them, at most one a repeat (a tick's own scan
-    left unanswered is the silence watch's, not this); None (no window: the
-    first tick, a lost revolution, a damaged line, copies of the first scan)
-    owes nothing."""
+    In real time the device repeats a revolution while the harness is late, and a node
+    answering in order may answer a repeat only after the next tick's scan came: that
+    answer is not the tick's. The scans since the last tick's own (`window`, plus
+    `repeats_before`) less the statuses heard for them (`late_before`) is what is owed,
+    at most one a repeat. No window (first tick, a lost revolution, a damaged line,
+    copies of the first scan) owes nothing."""
     if window is None:
         return 0
     repeats = window.scans - 1 + repeats_before

@@ -1,22 +1,13 @@
 """One emulated LIDAR for a whole run: the line, the device and the board's software.
 
-A real LIDAR is powered once and streams from its SCAN request until its
-STOP; the board's driver opens it once and reads every scenario without
-reconnecting (the FOSSBot v2's agent waits for bytes with no timeout: a
-device that fell silent would hang it for ever). So on the serial links a
-run has one session: the port (a pty of the virtual board, or the user's
-USB-UART), one ``DeviceServer`` that never falls silent while the device
-scans (``continuous``), and on the virtual board the board's software,
-started before the first scenario and stopped after the last: the bundled
-driver, or the user's own processes (``--board-command``, ``{port}``
-replaced by the emulated device's path) with the run's ROS environment and
-working modem lines (``PtyPort.client_environment``). Scenario boundaries
-are changes of the world the device scans, not restarts of the device:
-between scenarios it streams the last revolution again (``between``).
-
-Each scenario's link (``BoardLink``) uses the session's device and ROS
-domain; on the virtual board it still starts a fresh node under test.
-"""
+A real LIDAR streams from its SCAN until its STOP, and the board's driver reads
+every scenario without reconnecting (the FOSSBot v2's agent waits for bytes with no
+timeout: a silent device would hang it). So a serial run has one session: the port,
+one ``DeviceServer`` that never falls silent while the device scans, and on the
+virtual board the board's software (the bundled driver or the user's board commands)
+started before the first scenario and stopped after the last. Between scenarios the
+device streams the last revolution again (``between``); each scenario's ``BoardLink``
+uses the session's device and domain."""
 
 from __future__ import annotations
 
@@ -93,12 +84,8 @@ def board_options(options: LinkOptions) -> LinkOptions:
 
 
 class BoardSession:
-    """The serial line, its emulated device and the board's software, for a whole run.
-
-    Use as a context manager (or ``open``/``close``). ``options`` are the
-    first scenario's link options: the device's rate changes per scenario
-    (``set_rate``), everything else holds for the run.
-    """
+    """The serial line, its emulated device and the board's software, for a whole run (a
+    context manager); ``options`` are the first scenario's, only the rate changes after."""
 
     def __init__(self, profile: DeviceProfile, options: LinkOptions) -> None:
         self.profile = profile
@@ -232,15 +219,10 @@ class BoardSession:
         ]
 
     def node_topics(self, status: str, warning: str) -> tuple[str, str] | None:
-        """A status and a warning topic of its own for the next node under test, or None
-        for names that are not plain (a private ``~`` name).
-
-        Every scenario's node hears the board's scan topic in the run's domain;
-        the next one is started while this one runs (``BoardLink.links_ahead``).
-        Each answers on its own names under ``OWN_TOPICS`` (hidden, as a
-        leading underscore makes a ROS name), so one node's answers never reach
-        another scenario's judging; messages still name the options' topics.
-        """
+        """A status and a warning topic of its own for the next node under test, or None for
+        names that are not plain (a private ``~`` name). The next node starts while this one
+        runs, both hearing the board's scans: each answers under ``OWN_TOPICS`` (hidden, as a
+        leading underscore makes a name), so no answer reaches another scenario's judging."""
         if not remappable(status, warning):
             return None
         self._nodes += 1

@@ -1,10 +1,7 @@
 """The inprocess link: call a Python processing function directly, no ROS.
 
-The reference solution's pure logic by default, or any
-``fn(scan, threshold) -> (status_text, warning_or_None)`` named as
-``module:function`` or ``path/to/file.py:function``. It runs the whole loop
-in milliseconds, which is how the scenarios themselves are checked.
-"""
+The reference's pure logic by default, or any ``fn(scan, threshold) -> (status_text,
+warning_or_None)`` named as ``module:function`` or ``path/to/file.py:function``."""
 
 from __future__ import annotations
 
@@ -62,14 +59,8 @@ def load_processor(ref: str) -> Processor:
 
 @register("inprocess")
 class InprocessLink(Link):
-    """Feed each scan to a Python function: no ROS, and nothing it does can end the harness.
-
-    The function runs in a child forked when the link opens (see
-    ``harness.links.processor_child``): the scan goes out on `send`, the runner
-    simulates the next one meanwhile, and `collect` waits for the answer
-    within the per-scan deadline. Raising, exiting, hanging or crashing is
-    a problem that ends the run as an ERROR at that tick, never a pass.
-    """
+    """Feed each scan to a Python function in a forked child (``processor_child``): no ROS,
+    and raising, exiting, hanging or crashing ends the run as an ERROR, never a pass."""
 
     def __init__(self, options: LinkOptions) -> None:
         super().__init__(options)

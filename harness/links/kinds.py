@@ -1,18 +1,10 @@
 """What each link is, declared once: a table cheap enough for a command's start.
 
-Every list of links the harness shows or checks (the CLI's ``--link`` help
-and checks, the pytest plugin's ``--hil-link``, the links that run a node
-for ``grade``, ``audit`` and ``hunt``, ``emulate``'s devices, the messages
-that name links) is derived from ``KINDS`` here. Importing the link classes
-to ask them instead would import rclpy, pyserial and numpy (about 0.2 s) in
-every command and in every pytest session's start; this module imports
-nothing. Each class's own ClassVars are checked against its row when it
-registers (``base.register``), so the two cannot disagree.
-
-A link shipped with the harness is a row here and its module in this
-package. A link from elsewhere (a test's LIDAR, a lab's own package)
-calls ``declare`` before it is named, with its module's import path.
-"""
+Every list of links the CLI, the pytest plugin, grade, audit, hunt, emulate and the
+messages show is derived from ``KINDS``; asking the link classes instead would
+import rclpy, pyserial and numpy (about 0.2 s) everywhere. Each class's ClassVars
+are checked against its row when it registers (``base.register``). A link from
+outside the harness calls ``declare`` before it is named."""
 
 from __future__ import annotations
 
@@ -57,11 +49,6 @@ class LinkKind:
     # Started by `ros2 launch` when asked (--launch): the node is the harness's own
     # graph's only software, which a board's driver is not.
     launches: bool = False
-
-    @property
-    def needs_board(self) -> bool:
-        """A board (its driver and the node) reads the scans: every serial link."""
-        return self.serial_line
 
 
 INPROCESS = "inprocess"

@@ -1,27 +1,16 @@
 """One node exchange: a scan goes out, the node's answers to it are waited for and paired.
 
-Lockstep: deliver scan k, then spin until the node's status for it arrives
-or the per-scan deadline passes, counted from when the scan went out.
-Answers are matched to scans by the DDS source timestamp the node's
-publisher put on them, so a message published before scan k was sent can
-never be taken as an answer to scan k.
+Lockstep: deliver scan k, then spin until its status arrives or the per-scan deadline
+(counted from the send) passes. Answers are matched to scans by the DDS source
+timestamp the node's publisher put on them, so a message published before scan k went
+out is never scan k's answer. Whether the node publishes its Bool before or after its
+String is learned as the run goes: Bool first costs no wait; otherwise a short grace
+(a few ms, never the deadline) lets the same callback's Bool arrive.
 
-Whether a node publishes its Bool before or after its String is learned as
-the run goes: a node seen to publish the Bool first costs no wait at all; for
-others a short grace after the String lets the Bool of the same callback
-arrive (bounded, a few ms; never a fixed per-scan wait of the deadline).
-
-The node's first scan is the run's first tick (``send_first``): resent until
-it is answered, since a scan or an answer sent while the graph is still
-matching may be lost, and its answer judged like any other. So the first
-answer a node gives is judged, and a node that publishes only when its
-status changes has nothing to hold back at tick 0.
-
-How a scan reaches the node is the delivery's (``ScanDelivery``): published
-on the scan topic (the ros2 link), or pushed as a revolution to an emulated
-device whose driver publishes it (the board links); the waits, grace,
-catch-up, first-scan resends and answer pairing are the exchange's.
-"""
+The run's first scan (``send_first``) is resent until answered, since a scan or answer
+sent while the graph still matches may be lost, and that answer is judged: a node that
+publishes only on change has nothing to hold back at tick 0. How a scan reaches the
+node is the delivery's (``ScanDelivery``: published, or pushed to a board's device)."""
 
 from __future__ import annotations
 
@@ -51,8 +40,8 @@ if TYPE_CHECKING:
 
 
 class ScanDelivery(Protocol):
-    """How scans reach the node, plugged into a ``NodeExchange``; the bodies here are what
-    a delivery does that has nothing more to do (publishing over ROS 2)."""
+    """How scans reach the node, plugged into a ``NodeExchange``; the bodies here are those
+    of a delivery with nothing more to do (publishing over ROS 2)."""
 
     # A copy of the first scan the node did not answer in time may still be queued in
     # it (a slow first callback), to be answered before the next scan; its first copy's
@@ -64,7 +53,7 @@ class ScanDelivery(Protocol):
         ...
 
     def reached_node(self) -> bool:
-        """Did the scan `deliver` just sent reach the node? (A board may drop one.)"""
+        """Did the scan just delivered reach the node? (A board may drop one.)"""
         return True
 
     def answered(self) -> bool:
@@ -124,33 +113,21 @@ class NodeExchange:
         self.warmed_up = False
         self._first_silence: str | None = None  # why the first scan went unanswered
         self._first_waited = 0.0  # seconds its copies were given
+        self.wait_for = graph.wait_for  # the one bounded wait (``NodeGraph.wait_for``)
         self.delivery = make_delivery(self)
 
     @property
     def options(self) -> LinkOptions:
         return self.graph.options
 
-    def wait_for(self, done: Callable[[], bool], seconds: float) -> str | None:
-        """Spin until `done()`, bounded (``NodeGraph.wait_for``)."""
-        return self.graph.wait_for(done, seconds)
-
-    def heard_status(self) -> bool:
-        """Has a status published since the scan just sent arrived?"""
-        assert self.graph.observer is not None
-        return self.graph.observer.heard_since("status", self.sent_ns)
-
     def send_first(self, scan: Scan, tick: int, *, clock: float | None = None) -> None:
-        """Send the run's first scan until the node answers a copy (bounded by the ready
-        timeout); `collect` then takes that answer as this tick's.
+        """Send the run's first scan until a copy is answered (bounded by the ready timeout);
+        `collect` takes that answer as this tick's.
 
-        Ready means our endpoints matched the node's; whether its endpoints
-        matched ours is known only once an answer came, so a scan or answer
-        sent before may be lost: the scan goes again after WARM_UP_RETRY_S,
-        then twice as long each time (up to FIRST_RETRY_MAX_S), so a node slow
-        on its first scan is not sent many. The node sees nothing but this
-        scan before its first answer, which is judged. A node that dies
-        meanwhile is left for `collect` to report, at this tick.
-        """
+        Ready means our endpoints matched the node's, not yet its ours, so a copy or its
+        answer may be lost: resent after WARM_UP_RETRY_S, doubling up to FIRST_RETRY_MAX_S,
+        so a node slow on its first scan is not sent many. A node that dies meanwhile is
+        left for `collect` to report, at this tick."""
         graph = self.graph
         assert graph.observer is not None
         obs, opts = graph.observer, self.options
@@ -205,14 +182,10 @@ class NodeExchange:
         self.delivery.after_first()
 
     def _await_bool_writer(self) -> None:
-        """Before the first scan, our Bool reader matched to the node's Bool writer, or
-        its first Bool would be dropped as a stranger's.
-
-        A node's writers and readers are announced on two channels in no common
-        order, so ready (its scan reader and status writer matched) can come
-        before its Bool writer is known: wait for the match while the graph shows
-        a Bool writer, and a moment (BOOL_DISCOVERY_S) for one to show at all.
-        """
+        """Before the first scan: our Bool reader matched to the node's Bool writer, or its
+        first Bool would be dropped as a stranger's. Writers and readers are announced in no
+        common order, so ready can come before the Bool writer is known: wait for the match
+        while the graph shows one, and BOOL_DISCOVERY_S for one to show at all."""
         assert self.graph.observer is not None
         obs, topic = self.graph.observer, self.options.warning_topic
         if obs.warning_publishers() > 0:
@@ -226,12 +199,10 @@ class NodeExchange:
             self.wait_for(lambda: obs.warning_publishers() > 0, WARM_UP_RETRY_S)
 
     def _await_first_bool(self, first_ns: int) -> None:
-        """The first scan went out while our Bool reader had matched no Bool writer, and
-        it was answered without a Bool: where the node does have a Bool writer (the
-        graph shows it only now, as a loaded machine's discovery may), the Bool it
-        published before the match reaches us once Fast DDS repairs it. Wait for it,
-        bounded by the per-scan deadline, so tick 0 is judged on the Bool the node
-        published, not on discovery's speed."""
+        """The first scan was answered without a Bool while our reader matched no Bool writer:
+        where the graph shows one only now (slow discovery), Fast DDS repairs the Bool it
+        published before the match. Wait for it, bounded by the deadline, so tick 0 is judged
+        on what the node published, not on discovery's speed."""
         assert self.graph.observer is not None
         obs, topic = self.graph.observer, self.options.warning_topic
         if obs.heard_since("warning", first_ns):
@@ -252,13 +223,9 @@ class NodeExchange:
         )
 
     def warm_up(self, scan: Scan) -> None:
-        """Exchange a scan until the node's answer reaches us, then forget it (the
-        benchmarks' untimed first exchange, and a run whose first scan a node may ignore).
-
-        Our subscriptions matching the node's publishers does not mean its
-        publishers have matched us yet: its first answers could be lost.
-        Also wait (briefly) for its warning publisher, if it has one.
-        """
+        """Exchange a scan until its answer reaches us, then forget it (the benchmarks' untimed
+        first exchange; a run whose first scan a node may ignore). Our subscriptions matching
+        does not mean the node's publishers matched us, so its first answers could be lost."""
         graph = self.graph
         assert graph.observer is not None
         obs, opts = graph.observer, self.options

@@ -1,14 +1,9 @@
 """The node under test and the harness's own ROS node, in one domain, for one scenario.
 
-Every link that runs a node has one: the ros2 link's node reads the scans
-the harness publishes; a board's node reads its driver's, and on a
-physical board the board's software is no process of the harness's at all
-(``runs_node``). The graph reserves its domain, starts the node and the
-harness's node (without waiting: a suite starts the next links while one
-runs), waits bounded until the node is ready, names what can never reach
-the harness, and stops everything it started. Its ``wait_for`` is the one
-bounded wait every exchange spins in, noticing a node that died.
-"""
+Reserves the domain, starts both without waiting (a suite starts the next links while
+one runs), waits bounded for readiness, names what can never reach the harness and
+stops what it started; a physical board's software is none of its processes
+(``runs_node``). Its ``wait_for`` is the one bounded wait every exchange spins in."""
 
 from __future__ import annotations
 
@@ -77,14 +72,10 @@ class NodeGraph:
         self.started, self._start_error = True, err
 
     def start(self, reserve: Callable[[int | None], DomainReservation]) -> None:
-        """Reserve a domain (by `reserve`), start the node and the harness's own ROS node;
-        do not wait.
+        """Reserve a domain (by `reserve`), start the node and the harness's node; do not wait.
 
-        A failure to start is kept and raised by `open`, so a link started
-        ahead reports it when its own scenario comes, as if started then.
-        With no domain free (this machine's other runs hold them all), the
-        link is left unstarted: `open` tries again when its scenario comes.
-        """
+        A failure is kept for `open` to raise, so a link started ahead reports it in its own
+        scenario; with no domain free the link stays unstarted and `open` tries again."""
         if self.started:
             return
         opts = self.options
@@ -187,11 +178,8 @@ class NodeGraph:
         ) + topic_hints(obs.node, opts, reads=reads, publishes=publishes)
 
     def check_types(self, *, named_only: bool = False) -> None:
-        """Fail at once, naming it, when the node publishes what can never reach the harness.
-
-        With `named_only`, a wrong type waits until discovery has told which
-        node owns the endpoint, so the explanation can name it.
-        """
+        """Fail at once, naming it, when the node publishes what can never reach the harness;
+        `named_only`: wait until discovery tells which node owns the endpoint."""
         assert self.observer is not None
         obs = self.observer
         why = start_explanations.unheard(
@@ -246,12 +234,9 @@ class NodeGraph:
     ) -> str | None:
         """Spin until `done()`; None if it came, else "timeout" or why the node is gone.
 
-        The node's liveness is checked once per POLL_S (each check is a few
-        system calls, which cost more than the spin when the answer is
-        already there) and once more when the wait runs out, so a node that
-        died is never reported as a timeout. A spin ends when a message
-        arrives or after `poll`: shorter for what no message announces (the graph).
-        """
+        Liveness is checked once per POLL_S (its system calls cost more than a spin) and
+        when the wait runs out, so a dead node is never reported as a timeout; a spin ends
+        on a message or after `poll` (shorter for the graph, which no message announces)."""
         assert self.observer is not None
         end = time.perf_counter() + seconds
         while not done():
@@ -289,12 +274,8 @@ class NodeGraph:
         return f"stopping node {self.command.description}: {note}" if note else ""
 
     def diagnostics(self, *, warmed_up: bool) -> str:
-        """The node's last output and what the graph showed (`warmed_up`: it answered).
-
-        Its output is taken first, so its shutdown messages do not push out
-        the lines that matter; how the stop went (killed, processes left
-        behind) is `stop_note`, after `close`.
-        """
+        """The node's last output (taken first, before its shutdown messages) and what the
+        graph showed (`warmed_up`: it answered); how the stop went is `stop_note`."""
         assert self.process is not None
         parts = output_notes(self.process)
         parts += self.wiring.graph_notes(

@@ -1,12 +1,7 @@
 """What a run learned about the node under test, for its report: output, wiring, launch files.
 
-A failed scenario's report quotes the node's last output, and every
-report says once how the node is wired when it is not as the lab's: a
-warning published on another topic (and the option or parameter that would
-name it), a wrong message type seen late, what its launch files get wrong.
-These are read from the graph before the node stops, so they are the
-node-side half of a link and hold no lockstep state.
-"""
+Read from the graph before the node stops: the node-side half of a link, with no
+lockstep state."""
 
 from __future__ import annotations
 

@@ -1,12 +1,8 @@
 """How the node under test is started, and the harness's own ROS node beside it.
 
-The options name the node (a command, a package in a workspace, a launch
-file, or the bundled reference), the parameters it is given (the user's,
-plus the threshold), the launch files read for a run, and the topics the
-harness's observer publishes and listens on. Every link that runs a node
-(over ROS 2, or behind a board's driver) starts it this way; a command that
-checks a node before a run (hunt) resolves it here too.
-"""
+Every link that runs a node (over ROS 2, or behind a board's driver) and hunt's
+check of a node resolve it here: command, package, launch file or the reference,
+its parameters (the user's and the threshold) and the observer's topics."""
 
 from __future__ import annotations
 

@@ -1,16 +1,11 @@
 """A processing function in a forked child process, with a deadline on every call.
 
-The inprocess link calls a user's ``fn(scan, threshold)``, often a student's.
-Called in the harness's own process, that function could end the harness
-with exit code 0 (``sys.exit(0)``, ``os._exit(0)``: a false PASS), hang it
-for ever, crash it, or change the scan the oracle then judges. Here it runs
-in a child forked from the harness (so it costs no start-up and sees the
-same modules), in its own process group, with SIGINT ignored (the harness
-stops it) and SIGKILL on the harness's death. Every call is bounded by a
-deadline; whatever the function does becomes an ``Outcome`` with a reason,
-which the link turns into a verdict. Its stdout and stderr are kept as a
-tail for the diagnostics, like a node's.
-"""
+A student's ``fn(scan, threshold)`` called in the harness could exit it with 0 (a
+false PASS), hang it, crash it or change the scan the oracle judges. Here it runs
+in a child forked from the harness (no start-up cost), in its own process group,
+SIGINT ignored and SIGKILL on the harness's death; each call is bounded, and what
+the function does becomes an ``Outcome`` with a reason. Its output is kept as a
+tail for the diagnostics, like a node's."""
 
 from __future__ import annotations
 
@@ -156,11 +151,8 @@ class ProcessorChild:
         self._busy = True
 
     def outcome(self, timeout: float) -> Outcome:
-        """The answer to the last `call`, waiting at most `timeout` seconds.
-
-        A child that does not answer in time is stopped: a function that hangs
-        once holds no state anyone can trust.
-        """
+        """The answer to the last `call` within `timeout` seconds; a child that misses it is
+        stopped (one that hung once holds no state anyone can trust)."""
         if self._conn is None or not self._busy:
             return Outcome(problem=self._gone_reason())
         self._busy = False
@@ -200,11 +192,8 @@ class ProcessorChild:
         return self._output.last_lines(lines) if self._output is not None else ""
 
     def close(self, *, grace: float = 0.0) -> None:
-        """Stop the child and whatever it started, reap it; idempotent.
-
-        After `grace` seconds for it to end by itself, SIGKILL to its group;
-        every wait is bounded (a process stuck in the kernel is given up on).
-        """
+        """Stop the child and what it started, reap it; idempotent. After `grace` seconds,
+        SIGKILL to its group; every wait bounded."""
         if self._conn is not None:
             self._conn.close()
             self._conn = None

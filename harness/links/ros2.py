@@ -1,20 +1,8 @@
 """The ros2 link: a real node in its own process, over a real DDS graph.
 
-The link composes the node's graph (``node_graph``: its domain, its
-process, the harness's node, readiness) and the node exchange
-(``node_exchange``: waits, grace, catch-up, first-scan resends, answer
-pairing) with the simplest delivery: each scan published on the scan topic.
-
-While the node comes up, the harness publishes /clock (time 0), so a node
-that waits for a clock before it subscribes to the scans can start; the
-first scan's /clock is time 0 as well.
-
-A hostile node gets a verdict, not a hang (docs/hostile_nodes.md): a wrong
-message type on a topic is named from the ROS graph at once, a flood of
-messages ends the run, and when the run is over the node is stopped (and
-every process it started) before the diagnostics are written, so they say
-if it had to be killed.
-"""
+It composes the node's graph (``node_graph``) and the exchange (``node_exchange``) with
+the simplest delivery: each scan published on the scan topic. A hostile node gets a
+verdict, not a hang (docs/hostile_nodes.md)."""
 
 from __future__ import annotations
 
@@ -52,7 +40,8 @@ class TopicDelivery(ScanDelivery):
         return self.exchange.graph.observer.publish(scan, clock=clock)
 
     def answered(self) -> bool:
-        return self.exchange.heard_status()
+        assert self.exchange.graph.observer is not None
+        return self.exchange.graph.observer.heard_since("status", self.exchange.sent_ns)
 
 
 @register("ros2")

@@ -1,11 +1,7 @@
 """Why a node did not come up or never answered its first scan, in the node's terms (pure).
 
-A node that is not ready when the bound runs out, that publishes what can
-never reach the harness, or that stays silent on its first scan gets one
-sentence saying what the harness waited for, what was missing and what the
-graph showed. The link gathers the facts from the graph; the words are
-here, so they read the same on every link and are tested without a graph.
-"""
+The link gathers the facts from the graph; the words are here, so they read the
+same on every link and are tested without a graph."""
 
 from __future__ import annotations
 

@@ -1,10 +1,6 @@
 """Which topics a node under test uses instead of the harness's, and what to tell its user.
 
-A node that reads its scans or writes its status on another topic, or did
-not take the topic parameter the harness set, is told so with the option
-that fixes it, read from the ROS graph (rclpy's graph queries, passed in as
-the harness's own node). The ros2 link asks; nothing here waits long.
-"""
+Read from the ROS graph (the harness's own node is passed in); nothing here waits long."""
 
 from __future__ import annotations
 
@@ -73,11 +69,9 @@ def untaken_topic_parameter(
     topic: str,
     ask: Callable[[], tuple[str, list[str]] | str],
 ) -> str | None:
-    """When the harness told the node its topic through `parameter` (a scenario's
-    node_topics) and the node does not declare that parameter: the rest of a note
-    saying so, and naming the node's own parameter for it where one looks like it.
-    None when the harness set no such parameter, or the node declares it. `ask` gives
-    (the node's name, the parameters it declares), or why they are not known."""
+    """The rest of a note when the harness set the node's topic through `parameter` (a
+    scenario's node_topics) and the node does not declare it, naming a parameter of its
+    own that looks like it; else None. `ask` gives (node name, its parameters) or why not."""
     if f"{parameter}:={topic}" not in options.params:
         return None
     asked = ask()

@@ -1,12 +1,7 @@
 """Watchdogs over a node's answers: silence, flood and strangers, judged from counts alone.
 
-They end a run the node under test cannot go on with: it stopped answering
-(or answers too late), it floods a topic, or another node shares the run's
-domain. Each is fed what a link heard, scan by scan, and names the problem
-in the node's terms; none of them waits, spins or imports rclpy, so each is
-tested on its own (tests/test_watchdogs.py) and shared by every link that
-exchanges scans with a node.
-"""
+Each ends a run the node cannot go on with and names the problem in the node's
+terms; none waits, spins or imports rclpy, so each is tested on its own."""
 
 from __future__ import annotations
 
