@@ -1,13 +1,8 @@
 """The environment sourcing a colcon workspace would give, read from its hook files (pure).
 
-``ros2 run`` works in a shell that sourced ``install/setup.bash``, which
-runs each package's ``share/PKG/package.dsv``: lines such as
-``prepend-non-duplicate;PYTHONPATH;lib/python3.11/site-packages`` and
-``source;OTHER.dsv``. A ``--symlink-install`` build adds a hook that puts
-the build folder (linking the sources) on PYTHONPATH; without it the node
-finds no package metadata. Reading the same files gives the same
-environment without a shell.
-"""
+``install/setup.bash`` runs each package's ``share/PKG/package.dsv`` (lines such as
+``prepend-non-duplicate;PYTHONPATH;lib/python3.11/site-packages``); reading them gives
+the same environment without a shell, including a ``--symlink-install`` build's hook."""
 
 from __future__ import annotations
 

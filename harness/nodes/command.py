@@ -1,11 +1,6 @@
-"""Which command starts the node under test, and with which arguments.
-
-A user's command line (split as a shell does, checked before any run), a
-colcon workspace's package/executable as ``ros2 run`` would find it, or the
-bundled reference node (``python -m``, which the fork server may start).
-``ros_arguments`` appends the parameters after ``--ros-args`` (``node_arguments``:
-or as launch arguments, for ``ros2 launch``).
-"""
+"""Which command starts the node under test, and with which arguments: a user's command
+line, a workspace's package/executable as ``ros2 run`` finds it, or the bundled
+reference (``python -m``, which the fork server may start)."""
 
 from __future__ import annotations
 

@@ -1,11 +1,7 @@
 """Stopping a child's whole process group, and waiting (bounded) until it is gone.
 
-Student code runs in children of the harness (a grading worker, a colcon
-build, a processing function), each in a process group of its own, so what
-it starts is stopped with it. SIGKILL is delivered, not instant, and orphans
-are reaped by init, not by us: "stopped" means nothing in the group runs any
-more, which is what these helpers wait for.
-"""
+Student code runs in groups of its own, so what it starts stops with it; SIGKILL is
+delivered, not instant, so "stopped" means nothing in the group runs any more."""
 
 from __future__ import annotations
 
@@ -42,11 +38,8 @@ def group_members(pgid: int) -> list[int]:
 
 
 def wait_group_gone(pgid: int, timeout: float) -> None:
-    """Wait, bounded, until nothing in the group runs.
-
-    Each member is waited on through a pidfd, which becomes readable when it
-    dies, whoever reaps it.
-    """
+    """Wait, bounded, until nothing in the group runs (each member through a pidfd, readable
+    when it dies, whoever reaps it)."""
     deadline = time.monotonic() + timeout
     for pid in group_members(pgid):
         try:

@@ -1,25 +1,13 @@
 """Whether a node command may be started by fork from the warm Python, and how (no rclpy).
 
-A student's node forked from the warm server (``forkserver``, importing
-``warm_python``) must be what its command would have started: the same
-Python, finding every module it imports where a fresh interpreter would.
-So a command is served only when
-
-- it runs a Python script: ``python3 node.py ARGS`` (flags: ``-u`` only), a
-  script whose ``#!`` names a Python (a colcon console script, ``./node.py``);
-- its interpreter, asked once with the node's environment, is the server's
-  Python version and would find every module the server has imported in the
-  same file (the harness's own interpreter, or one with the same rclpy and
-  site packages; a ``yaml.py`` beside the script shadowing the server's is
-  found here too);
-- its environment sets nothing an interpreter reads only as it starts (the
-  ``PYTHON*`` variables but the path and buffering ones, ``LD_PRELOAD``, a
-  ``LD_LIBRARY_PATH`` that adds shared libraries).
-
-Anything else (another interpreter, a compiled node, a shell wrapper) is
-started as the command it is. The interpreter's answer gives the module
-search path the forked node gets, with the script's folder first.
-"""
+A forked node must be what its command would have started: the same Python, finding
+every module where a fresh interpreter would. So only a Python script is served
+(``python3 node.py``, ``-u`` only, or a ``#!`` naming a Python), whose interpreter,
+asked once with the node's environment, is the server's version and finds every
+module the server imported in the same file (a ``yaml.py`` beside the script is seen),
+and whose environment sets nothing read only at start (``PYTHON*`` but path and
+buffering, ``LD_PRELOAD``, a ``LD_LIBRARY_PATH`` adding libraries). Anything else is
+started as its command. The answer gives the forked node's search path, script first."""
 
 from __future__ import annotations
 
@@ -81,10 +69,6 @@ class StartPlan:
     script: str | None = None
     sys_path: tuple[str, ...] = ()
     args: tuple[str, ...] = ()
-
-    @property
-    def forked(self) -> bool:
-        return self.script is not None
 
 
 def script_command(argv: Sequence[str], env: Mapping[str, str]) -> ScriptCommand | str:

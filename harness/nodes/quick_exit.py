@@ -1,10 +1,6 @@
-"""Ending a process as the interpreter would, without its teardown.
-
-The `fossbot-hil` command and a node forked by the node fork server both end
-this way: the exit handlers run and the output is flushed, then the process
-exits at once. Freeing memory would take a quarter of a second with rclpy
-and PyBullet loaded, and nothing is left to write by then.
-"""
+"""Ending a process as the interpreter would, without its teardown: exit handlers run
+and output is flushed, but freeing memory (a quarter of a second with rclpy and
+PyBullet loaded) is skipped."""
 
 from __future__ import annotations
 

@@ -1,12 +1,8 @@
 """Has a process done all the work it was given? Every thread asleep, several looks running.
 
-A node that still has scans queued keeps a thread running or runnable
-(its executor); one that answered all it got sleeps in its wait for the
-next message. Linux tells a thread's state in /proc (R running or
-runnable, D uninterruptible, S sleeping, I idle), so "all asleep, a few
-looks in a row, a few ms apart" says it owes nothing, on a loaded machine
-too, where a process behind is runnable rather than asleep.
-"""
+A node with scans queued keeps a thread runnable; one that answered all sleeps. /proc
+tells each thread's state, and "all asleep, a few looks a few ms apart" holds on a
+loaded machine too, where a process behind is runnable, not asleep."""
 
 from __future__ import annotations
 

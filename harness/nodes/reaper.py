@@ -1,26 +1,16 @@
 """Run one command so that nothing it starts outlives it: a child subreaper.
 
-``harness.nodes.process`` starts every node under test through this small
-program (by path, stdlib only, never imported by the harness). It marks
-itself a child subreaper (``PR_SET_CHILD_SUBREAPER``), so every process the
-node starts stays its descendant even after a double fork and ``setsid``.
-The node runs in its own session. When the harness asks it to stop (SIGTERM,
-SIGINT or SIGHUP; also sent by Linux if the harness dies) it stops the node
-(SIGINT, then SIGTERM, then SIGKILL, each after a bounded wait), kills
-every descendant still running, reaps them all and exits.
+``process`` starts every node through this program (by path, stdlib only, never
+imported). As a child subreaper (``PR_SET_CHILD_SUBREAPER``) it keeps every process
+the node starts as a descendant, even after a double fork and ``setsid``. Asked to
+stop (SIGTERM, SIGINT, SIGHUP; Linux sends one if the harness dies) it stops the node
+(SIGINT, SIGTERM, SIGKILL, each after a bounded wait), kills and reaps every
+descendant left, and exits. The fork server runs the same ``supervise`` in a forked child.
 
-Usage: ``python3 reaper.py STATUS_FD PARENT_PID INT_GRACE TERM_GRACE -- ARGV...``
-
-The node fork server (``forkserver.py``) runs the same supervision
-(``supervise``) in a forked child instead, starting the node by a second
-fork rather than by ``posix_spawn``.
-
-It tells the harness what happens through STATUS_FD, one event a line:
-``started PID``, ``error MESSAGE`` (the command could not be started),
-``exited CODE`` (negative: killed by that signal), ``stopped HOW SECONDS``
-(HOW: ``exited`` if the node had already gone, else the signal that ended
-it), ``leftover PID NAME`` for each process killed after the node, ``done``.
-"""
+Usage: ``python3 reaper.py STATUS_FD PARENT_PID INT_GRACE TERM_GRACE -- ARGV...``;
+STATUS_FD gets one event a line: ``started PID``, ``error MESSAGE``, ``exited CODE``
+(negative: that signal), ``stopped HOW SECONDS`` (``exited``, or the signal that ended
+it), ``leftover PID NAME`` for each process killed after the node, ``done``."""
 
 from __future__ import annotations
 
@@ -152,14 +142,10 @@ class Reaper:
 
 
 def _signal_group(pid: int, sig: int) -> None:
-    """Signal the node's process group (it leads its own session); the node itself too
-    only if it has left that group.
-
-    Never twice to the node: a Python node's exit on a second SIGINT depends on when it
-    comes. Its handler ran for the first; from its interpreter's teardown on, the default
-    action is back, and the second kills it (exit -2, a clean stop judged a crash). A
-    stop preempted between two sends, on a loaded machine, was seen to land there.
-    """
+    """Signal the node's process group (it leads its own session), and the node too only if
+    it left that group. Never twice to the node: a Python node's second SIGINT, once its
+    teardown began, kills it (exit -2, a clean stop judged a crash), as a stop preempted
+    between two sends on a loaded machine was seen to."""
     try:
         in_group = os.getpgid(pid) == pid
     except (ProcessLookupError, PermissionError):
@@ -226,10 +212,7 @@ def _keep_descriptors_from_the_node(status_fd: int) -> None:
 
 def supervise(reaper: Reaper, parent: int, launch: Callable[[], int]) -> int:
     """Become the node's subreaper, start it, relay its exit until asked to stop; stop it.
-
-    `parent` is the process whose death stops everything (PDEATHSIG).
-    Returns this process's exit code.
-    """
+    `parent`'s death stops everything (PDEATHSIG); returns this process's exit code."""
     _keep_descriptors_from_the_node(reaper.status_fd)  # the harness's pipe, the domain lock
     signal.pthread_sigmask(signal.SIG_BLOCK, WATCHED)  # taken by sigwaitinfo, never async
     libc = ctypes.CDLL(None, use_errno=True)

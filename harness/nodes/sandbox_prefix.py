@@ -1,9 +1,5 @@
-"""How a judging process in a sandbox starts its node: the nested sandbox's command.
-
-The grader puts the command (bwrap, its view, the limits) in the judging
-process's environment; the node's reaper and the fork server start under
-it. Outside a sandbox the variable is absent and nodes start as always.
-"""
+"""How a judging process in a sandbox starts its node: the nested sandbox's command, from
+the environment the grader set (absent outside a sandbox)."""
 
 from __future__ import annotations
 

@@ -1,11 +1,7 @@
 """A node that cannot start because of how it was set up, not because of its code (pure).
 
-A student who runs ``--node "python3 my_node.py"`` outside the harness's
-virtual environment gets a Python without rclpy; the node dies on its first
-import. That is a configuration error to fix before anything can be judged,
-so the harness says which interpreter lacks what and which one has it,
-instead of reporting the scenario as an ERROR.
-"""
+A node run with a Python that lacks rclpy dies on its first import: a configuration
+error naming which interpreter lacks what and which has it, not a scenario's ERROR."""
 
 from __future__ import annotations
 

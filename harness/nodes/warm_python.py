@@ -1,15 +1,7 @@
 """What the fork server for students' nodes imports once: rclpy and the messages a lab
-node uses, never a student's code.
-
-Importing this module is the whole of the server's preparation; each node
-forked from it then reads and runs the student's script afresh, so an edit
-is always seen. Its imports are the ones every Lab 07 node makes (rclpy, the
-executors, QoS, LaserScan, String, Bool) and the ones a node often makes
-(numpy, math). The scan of installed distributions that a colcon console
-script does to find its entry point is done once too, so each node finds its
-entry point in the server's warm cache (checked against the files' times,
-so a rebuilt workspace is seen).
-"""
+node uses, never a student's code (each forked node runs its script afresh, so an
+edit is seen). A console script's entry-point scan is done once too, checked against
+the files' times, so a rebuilt workspace is seen."""
 
 from __future__ import annotations
 
