@@ -1,15 +1,10 @@
 """The harness's own DDS participants announce themselves often (pure: no rclpy).
 
-Fast DDS announces a new participant a few times in its first half second,
-then every 3 s. A node that comes up after the harness's participant has
-stopped its first announcements (a fork server still importing, a slow
-student import) was matched only at the next one: 3 s of a scenario's
-start-up spent waiting, now and then. The harness's participants announce
-every 0.25 s instead (``fastdds_harness.xml``, Fast DDS's default-profile
-file, read as a process creates its first participant). The variable is set
-only while the harness creates its own participants, so nodes, boards and
-builds it starts never see it, and a user's own profile file wins.
-"""
+Fast DDS announces a participant a few times in its first half second, then every 3 s,
+so a node that came up later (a fork server still importing) was matched only at the
+next one: 3 s of start-up lost now and then. The harness's participants announce every
+0.25 s (``fastdds_harness.xml``); the variable is set only while the harness creates
+its own, so what it starts never sees it, and a user's profile file wins."""
 
 from __future__ import annotations
 

@@ -1,13 +1,8 @@
 """The scan and the clock as the CDR bytes rmw publishes (pure: no rclpy).
 
-Publishing a message object makes rclpy copy it, field by field, into its C
-struct and then serialize that; publishing bytes hands them to the DDS writer
-as they are (rclpy's raw publish). For the scan, built here with one copy of
-each array, that is about half the cost of a send. The layout is XCDR1,
-little-endian, as rmw_fastrtps writes it: a 4-byte encapsulation header, then
-each field aligned to its size from the end of the header. `tests/ros` checks
-the bytes against rclpy's own serialization.
-"""
+Publishing bytes (rclpy's raw publish) skips the field-by-field copy into the C struct
+and its serialisation: about half the cost of a send. XCDR1 little-endian, as
+rmw_fastrtps writes it; `tests/ros` checks the bytes against rclpy's."""
 
 from __future__ import annotations
 

@@ -1,27 +1,14 @@
 """Reserve a ROS_DOMAIN_ID per run so parallel runs never see each other.
 
-Like ROS 2's domain_coordinator, a reservation is held by an open OS
-resource that the kernel frees when the process dies, so a crashed run
-never leaks an id: here an exclusive ``flock`` on one file per id
-(``harness.holder_lock``, which also writes the holder's pid and command
-line into the file for the message of a run that is refused).
-
-An id given explicitly (``--domain-id``, ``--hil-domain-id``, a board's)
-is reserved too, in the same files (any id 0..232): a second run on this
-machine asking for an id another run holds is refused with a ConfigError
-naming the holder, since the two would judge each other's messages. Like
-an automatic one it is held while the link is open (one scenario); within
-a process it may be taken again (the pytest plugin reserves an id, then
-the link takes it by number). A run started by the process that holds the
-id (a test that reserved a domain for the board it simulates) runs in
-that reservation. The reservation excludes only other fossbot-hil runs on
-this machine: joining a board's graph over the network (``--ros-network
---domain-id 0``) is what an explicit id is for.
-
-Once reserved, the domain's shared-memory ports that a killed process left
-half-made are cleared (``harness.ros.shm_ports``): a participant that met
-one would wait for it forever.
-"""
+As in ROS 2's domain_coordinator, a reservation is an OS resource the kernel frees
+when the process dies (an exclusive ``flock`` on one file per id, ``harness.holder_lock``,
+which names the holder for a refused run), so a crash never leaks an id. An explicit
+id (``--domain-id``, a board's) is reserved in the same files: a second run asking for
+an id another holds is refused with a ConfigError naming the holder, as the two would
+judge each other's messages; within a process it may be taken again (the plugin
+reserves, the link takes it by number). Only other fossbot-hil runs here are excluded:
+joining a board's graph over the network is what an explicit id is for. Once reserved,
+the domain's half-made shared-memory ports are cleared (``shm_ports``)."""
 
 from __future__ import annotations
 
@@ -72,11 +59,8 @@ def lock_file(domain_id: int) -> Path:
 
 
 def _try_lock(domain_id: int) -> HolderLock | None:
-    """The id's lock, or None when another run (or this process) holds it.
-
-    A file another user made without write access for us counts as taken:
-    better one id fewer than a crash.
-    """
+    """The id's lock, or None when another run (or this process) holds it; a file we may not
+    write counts as taken (one id fewer beats a crash)."""
     try:
         return take(lock_file(domain_id), shared=True)
     except (Held, OSError):
@@ -87,13 +71,9 @@ _reservations = 0
 
 
 def reserve_domain(preferred: int | None = None) -> DomainReservation:
-    """A free domain id, or `preferred` (an explicit id) if no other run holds it.
-
-    Each automatic reservation in a process starts one id further on: a
-    domain used a moment ago may still hold what the last run's
-    participants announced, and rediscovery there has been seen to take
-    seconds.
-    """
+    """A free domain id, or `preferred` (an explicit id) if no other run holds it. Each
+    automatic reservation in a process starts one id further on: a domain used a moment
+    ago may still hold the last run's announcements, and rediscovery has taken seconds."""
     global _reservations
     if preferred is not None:
         return _reserve_explicit(preferred)

@@ -1,26 +1,15 @@
 """ROS 2 names the user gives the harness: topic names and parameter names.
 
-A name ROS 2 refuses would otherwise fail deep inside rclpy (a traceback)
-or inside the node under test (which then never comes up); checked here
-it is one usage line. The rules are ROS 2's own: rcl's
-``rcl_validate_topic_name``, rmw's ``rmw_validate_full_topic_name`` and the
-parameter-name grammar of rcl's ``--ros-args -p NAME:=VALUE`` parser
-(its lexer, rcl/src/rcl/lexer.c, included). This module holds the one
-pure-Python copy of them, for machines without rclpy, and its messages;
-where rclpy is installed its validators are asked as well, so ROS 2 has
-the last word. tests/test_ros_names.py proves both agree on generated
-names. rclpy is imported only when a name is checked, never at import.
-
-What the harness accepts (README, "The command line"):
-
-- Topics: absolute (``/scan``) or relative (``scan``), resolved against the
-  root namespace (``/scan``), where the harness's own node lives.
-  Private names (``~/scan``) and substitutions (``{node}/scan``) are
-  refused: they resolve against the node that uses them, and the
-  harness's node is not the node under test.
-- Parameters: what ``-p NAME:=VALUE`` parses: ``node:`` prefix optional,
-  then tokens of letters, digits and ``_`` joined by ``.`` or ``/``.
-"""
+A name ROS 2 refuses would fail deep in rclpy or in the node (which never comes up);
+checked here it is one usage line. The rules are ROS 2's own (rcl's
+``rcl_validate_topic_name``, rmw's ``rmw_validate_full_topic_name``, rcl's ``-p
+NAME:=VALUE`` lexer), copied in pure Python for machines without rclpy; where rclpy is
+installed it is asked too, imported only when a name is checked
+(tests/test_ros_names.py proves both agree). Topics: absolute or relative (resolved
+against the root, where the harness's node lives); private (``~/scan``) and
+substituted (``{node}/scan``) names are refused, as they resolve against the node that
+uses them. Parameters: ``node:`` optional, then tokens of letters, digits and ``_``
+joined by ``.`` or ``/``."""
 
 from __future__ import annotations
 
@@ -61,11 +50,8 @@ class InvalidName(ValueError):
 
 
 def topic_name_problem(name: str) -> tuple[str, int] | None:
-    """rcl_validate_topic_name: (reason, index) when `name` is not a topic name, else None.
-
-    A relative, private or substituted name may pass; it is not expanded
-    (and not checked for length or repeated '/': see full_topic_name_problem).
-    """
+    """rcl_validate_topic_name: (reason, index) when `name` is not a topic name, else None;
+    relative, private and substituted names pass unexpanded (see full_topic_name_problem)."""
     if not name:
         return "topic name must not be empty string", 0
     if name[0] in _DIGITS:
@@ -179,11 +165,8 @@ def _topic_problem(name: str, *, full: bool) -> tuple[str, int] | None:
 
 
 def resolve_topic(name: str) -> str:
-    """`name` as the fully qualified topic the harness uses; InvalidName says why it cannot be.
-
-    Relative names resolve against the root namespace (``scan`` ->
-    ``/scan``); private names and substitutions are refused.
-    """
+    """`name` as the fully qualified topic the harness uses (``scan`` -> ``/scan``);
+    InvalidName says why it cannot be (private names and substitutions are refused)."""
     if not isinstance(name, str):
         raise InvalidName(f"a topic name must be text, got {type(name).__name__}")
     problem = _topic_problem(name, full=False)

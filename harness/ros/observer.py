@@ -1,14 +1,10 @@
 """The harness's own ROS 2 node: publishes /scan and /clock, hears the answers.
 
-It lives in its own rclpy Context (domain id given explicitly), waits by hand
-with bounded waits on a bare rcl wait set over its own subscriptions (no
-executor, no threads: an executor's ``spin_once`` rebuilds its wait set and
-runs its task machinery on every call, the largest harness cost per scan),
-takes the messages itself and stamps everything it hears with the
-publisher's DDS source timestamp, so answers can be matched
-to the scan they belong to. It also reads the ROS graph, to say what a node
-that never connects offers instead (other topic names, other types, QoS).
-"""
+In its own rclpy Context, it waits on a bare rcl wait set over its subscriptions (no
+executor: ``spin_once`` rebuilding its wait set was the largest harness cost a scan)
+and stamps what it hears with the publisher's DDS source timestamp, so answers are
+matched to their scan. It reads the ROS graph too, to say what a node that never
+connects offers instead."""
 
 from __future__ import annotations
 
@@ -154,15 +150,10 @@ class Observer:
         return sent
 
     def spin(self, timeout: float, limit: int = 100) -> int:
-        """Handle what arrived, waiting at most `timeout` seconds for something.
-
-        Takes at most `limit` messages in all (a flooding node cannot keep it
-        here); returns how many it took. What has arrived already is taken
-        without the wait set: a take from an empty reader costs about a
-        microsecond, a wait (even with a zero timeout) about a hundred, and
-        in lockstep the answer has often arrived while the next scan was
-        being simulated.
-        """
+        """Handle what arrived, waiting at most `timeout` seconds for something; at most `limit`
+        messages (a flooding node cannot keep it here); returns how many. What arrived already
+        is taken without the wait set (a take costs about a microsecond, a wait about a
+        hundred, and in lockstep the answer often came while the next scan was simulated)."""
         taken = self.poll(limit)
         if taken or timeout <= 0.0:
             return taken
@@ -221,15 +212,10 @@ class Observer:
         return reads_scans and self.status_sub.get_publisher_count() > 0
 
     def scan_readers_named(self) -> bool:
-        """Has the node that reads our scans been named by discovery?
-
-        Matched means our endpoints matched the node's; the node's own side may
-        match ours later, and a scan sent before that waits for Fast DDS to
-        repair it (0.1-0.4 s, for a node younger than about 0.6 s). An endpoint's
-        node is named once the node's participant has announced its entities
-        to us, which it does once its side has matched ours: measured over
-        many scenarios, a first scan sent after that was never repaired late.
-        """
+        """Has discovery named the node that reads our scans? The node's side may match ours
+        after ours matched, and a scan sent before waits for Fast DDS to repair it (0.1-0.4 s
+        for a young node); a node is named once its participant announced its entities to us,
+        after its side matched: a first scan sent then was never seen repaired late."""
         infos = self.node.get_subscriptions_info_by_topic(self.scan_topic)
         readers = self._others(infos)
         return bool(readers) and all(i.node_name != UNKNOWN_NODE_NAME for i in readers)
@@ -241,15 +227,10 @@ class Observer:
         return self.node.count_subscribers(self.scan_topic) - 1
 
     def strangers(self) -> str:
-        """Who else shares this run's domain, when the graph shows someone: more than one
-        participant publishing the scans, or the status. '' when no one does.
-
-        A node left running by an earlier run (or started by hand with this
-        domain id) reads our scans and answers them, or sends scans of its own
-        to the node: either way the node seems to answer twice. An endpoint's
-        gid starts with its participant's GUID prefix (12 bytes), so endpoints
-        of one node count once whatever their number.
-        """
+        """Who else shares this run's domain: more than one participant publishing the scans or
+        the status ('' when no one does), e.g. a node left by an earlier run, which makes the
+        node seem to answer twice. Endpoints count by participant (their gid's 12-byte GUID
+        prefix), so one node counts once."""
         found = []
         for topic in (self.scan_topic, self.status_topic):
             infos = self.node.get_publishers_info_by_topic(topic)
@@ -291,13 +272,9 @@ class Observer:
         )
 
     def wrong_types(self, *, named_only: bool = False) -> list[str]:
-        """Topics the node under test uses with another message type than the harness.
-
-        DDS connects a publisher and a subscription only if their types are
-        the same, so nothing on such a topic ever crosses: say it, rather
-        than "never ready" or "no answer". With `named_only`, a topic whose
-        endpoints discovery has not tied to a node yet is left for later.
-        """
+        """Topics the node uses with another message type than the harness: DDS never connects
+        them, so say it rather than "never ready" or "no answer". `named_only`: a topic whose
+        endpoints discovery has not tied to a node yet is left for later."""
         checks = [
             self._wrong_type(
                 self.status_topic, STATUS_TYPE, publishers=True, named_only=named_only
@@ -367,11 +344,8 @@ class Observer:
         return not self._closed and self.context.ok()
 
     def close(self) -> None:
-        """Tear down wait set, node and context, in that order; safe to call twice.
-
-        The context must be destroyed too: until then its DDS participant
-        lives on and a later run in the same domain can still see it.
-        """
+        """Tear down wait set, node and context, in that order; safe twice. The context too: until
+        then its participant lives on, seen by a later run in the domain."""
         if self._closed:
             return
         self._closed = True

@@ -1,11 +1,7 @@
 """Which parameters a running node declares, asked over rcl_interfaces' ListParameters.
 
-A launch file sets parameters as overrides; a node sees only those it
-declares, and every ROS 2 node answers ``<node>/list_parameters`` with
-them. The question goes from a short-lived node in the harness's own
-context (its graph, its domain), bounded in time; the answer or the
-reason there was none comes back as plain data.
-"""
+A node sees only the launch file's overrides it declares; the question goes from a
+short-lived node in the harness's context, bounded, and comes back as plain data."""
 
 from __future__ import annotations
 

@@ -1,23 +1,12 @@
 """Fast DDS shared-memory ports left half-made by a killed process (pure: no rclpy).
 
-Fast DDS gives each port of a domain a shared-memory segment,
-``/dev/shm/fastrtps_port<N>``, made by whichever participant needs it first:
-the file is created empty, sized, then marked ready. A process killed
-between those steps (a node or worker SIGKILLed mid-start) leaves the file
-empty or never marked, and from then on every participant of that domain
-that takes the same port waits for it to be marked, forever: its process no
-longer answers SIGINT or SIGTERM. A node "never becomes ready"; a harness
-participant hangs its whole run.
-
-A run clears the half-made ports of the domain it reserved before any
-participant of its own starts there; the next participant that needs such a
-port makes it again. In a domain the harness chose, every port not marked
-ready goes: whatever a run before left there is gone once its reservation
-could be taken, so even a port that was whole is only made again. A domain
-the user named is shared with other programs, which may be making a port
-right now or use another Fast DDS whose mark differs: there only files that
-have stayed empty for `ABANDONED_AFTER_S` go (making one takes microseconds).
-"""
+Each port's segment, ``/dev/shm/fastrtps_port<N>``, is created empty, sized, then
+marked ready; a process killed between those steps leaves one that every participant
+taking the port waits on forever (deaf to SIGINT and SIGTERM). A run clears its
+reserved domain's half-made ports before its own participants start. In a domain the
+harness chose every unmarked port goes (the run before released it); in one the user
+named, other programs may be making a port now or use another mark, so only files
+empty for `ABANDONED_AFTER_S` go (making one takes microseconds)."""
 
 from __future__ import annotations
 
