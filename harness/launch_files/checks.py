@@ -1,14 +1,7 @@
-"""The advice a launch file gets: each note names the file and line, what is wrong and
-what the node or the build has instead (pure).
-
-- a node the build cannot start: its package is not installed, or its
-  executable is not among the package's (``lib/<pkg>/<exe>``);
-- a parameter the running node does not declare: the node never sees it
-  (a launch file sets parameters as overrides, and an override of an
-  undeclared parameter is dropped without a word). The closest declared
-  names the entry does not set already are offered (difflib; two at most,
-  as letters cannot tell 'info' from 'status').
-"""
+"""The advice a launch file gets, each note naming the file and line (pure): a node the
+build cannot start (package not installed, executable not in ``lib/<pkg>/``), or a
+parameter the node does not declare, whose override is dropped without a word (the
+closest declared names offered, two at most: letters cannot tell 'info' from 'status')."""
 
 from __future__ import annotations
 

@@ -36,11 +36,8 @@ class NodeEntry:
 
 @dataclass(frozen=True)
 class LaunchFile:
-    """One launch file: its nodes, the launch arguments it declares, what was not read.
-
-    `shown` is its path as the user knows it (relative to the package or the
-    workspace), never an absolute path of the machine that checked it.
-    """
+    """One launch file: its nodes, the launch arguments it declares, what was not read;
+    `shown` is its path as the user knows it, never the checking machine's absolute path."""
 
     path: Path
     shown: str

@@ -1,11 +1,7 @@
 """Which launch files a package has: its source ``launch/`` folder, else the installed copy.
 
-The source folder is what the student edits, so notes point there; the
-installed copy (``<prefix>/share/<pkg>/launch``) is what ``ros2 launch``
-runs, so a source file missing from it, or different, is said too. Where
-there is no source (a grader's scratch workspace, a sourced install), the
-installed files are read.
-"""
+Notes point at the source (what the student edits); a source file missing from the
+installed copy (what ``ros2 launch`` runs), or different, is said too."""
 
 from __future__ import annotations
 

@@ -1,11 +1,5 @@
-"""The XML and YAML launch formats share one shape: elements with attributes and
-children. This reads nodes, parameters and arguments out of that shape.
-
-``<node pkg= exec= name=>`` with ``<param name= value=/>`` children (a
-``<param name=>`` holding params gives dotted names, ``<param from=>`` is a
-parameter file) and ``<arg name=>``: the XML and YAML readers build the
-same `Element`s, so both formats are read by this one module.
-"""
+"""The XML and YAML launch formats share one shape (elements with attributes and
+children): nodes, parameters and arguments are read out of it here, for both."""
 
 from __future__ import annotations
 

@@ -1,11 +1,8 @@
 """`run --launch PACKAGE FILE`: the node under test started by ``ros2 launch``.
 
-``ros2 launch`` (ros2cli with its launch verb) is not on the package index,
-so it is there only where a ROS 2 installation is sourced. Where it is
-missing, --launch is a usage error that says so and what to do instead.
-The harness's parameters (threshold, topics, use_sim_time) reach the node
-as launch arguments, for those the file declares.
-"""
+``ros2 launch`` is not on the package index, so where no ROS 2 is sourced --launch is
+a usage error saying what to do instead. The harness's parameters reach the node as
+the launch arguments the file declares."""
 
 from __future__ import annotations
 

@@ -1,14 +1,9 @@
 """Reading a Python launch file from its syntax tree (``ast``): the file is never run.
 
-What is read: each ``launch_ros.actions.Node`` (or ``LifecycleNode``) call,
-however it was imported, with its plain-text ``package=``, ``executable=`` and
-``name=``, and the keys of the dictionaries in its ``parameters=`` list
-(nested dictionaries give dotted names, as launch_ros flattens them). A
-name that holds a dictionary or list literal, assigned once and never
-changed, is followed. Everything else the file decides only when it runs
-(a ``LaunchConfiguration``, a call, a parameter file) is said as such, not
-guessed. ``DeclareLaunchArgument`` names are the file's launch arguments.
-"""
+Each ``launch_ros.actions.Node`` (or ``LifecycleNode``) call, however imported, with
+its plain-text package, executable and name and its ``parameters=`` keys (nested
+dicts dotted, as launch_ros flattens them; a name assigned a literal once is
+followed). What the file decides only when run is said as such, not guessed."""
 
 from __future__ import annotations
 

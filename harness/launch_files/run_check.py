@@ -1,11 +1,7 @@
-"""One run's launch-file check: the files read once when the run starts, the running
-node asked once (by the first scenario whose node is up at its end).
+"""One run's launch-file check: files read once at the start, the running node asked once.
 
-A ros2 link holds the run's `LaunchCheck` (its class's ``run_session``) and
-gives each scenario's result ``notes()``: the same notes for every
-scenario, which reports print once. Nothing here fails a scenario: a
-launch file is advice, the node is judged as it ran.
-"""
+The ros2 link's ``run_session`` holds it; every scenario gets the same notes, which
+reports print once. A launch file is advice: nothing here fails a scenario."""
 
 from __future__ import annotations
 
@@ -27,11 +23,8 @@ Asked = tuple[str, list[str]] | str
 
 @dataclass
 class LaunchCheck:
-    """The launch files of the run's package and what they were found to get wrong.
-
-    `executable` names the node the run starts (--package/--executable); with
-    `run --launch` it is None and the launched file's entries are the node's.
-    """
+    """The launch files of the run's package and what they get wrong; `executable` names the
+    node the run starts (None with a launch file: its entries are the node's)."""
 
     package: str
     executable: str | None

@@ -1,8 +1,5 @@
-"""Reading an XML launch file (``<launch>``) with expat, which knows each element's line.
-
-Document type declarations and entities are refused: a launch file needs
-none, and they are how an XML file makes its reader expand it without end.
-"""
+"""Reading an XML launch file (``<launch>``) with expat, which knows each element's line;
+DTDs and entities are refused (a launch file needs none; they make expansion bombs)."""
 
 from __future__ import annotations
 

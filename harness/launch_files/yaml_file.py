@@ -1,10 +1,7 @@
 """Reading a YAML launch file (``launch:``) from PyYAML's composed nodes, which know lines.
 
-The YAML format nests what XML writes as elements: ``- node: {pkg: ...,
-param: [{name: ..., value: ...}]}``. Here it becomes the same `Element`s
-as XML. Only composed (never constructed), with the safe loader; an alias
-used twice is walked once, so no file can make the walk blow up.
-"""
+It becomes the same `Element`s as XML; only composed (never constructed), with the
+safe loader, and an alias used twice is walked once, so no file makes the walk blow up."""
 
 from __future__ import annotations
 

@@ -1,15 +1,5 @@
-"""The fossbot-hil pytest plugin: scenarios as tests, the ``hil`` fixture, board runs.
-
-- ``plugin``: the hooks and fixtures pytest loads (entry point ``fossbot_hil``);
-- ``options``: its options, from the command line, then the ini file, then
-  the default;
-- ``cases``: ``@pytest.mark.hil_scenarios``, one test per scenario and fault
-  profile;
-- ``hil``: the ``hil`` fixture's object, which runs one scenario and judges it;
-- ``result``: what ``hil.run`` returns, with what a failing test needs to say.
-
-docs/pytest.md is the user's guide.
-"""
+"""The fossbot-hil pytest plugin: scenarios as tests, the ``hil`` fixture, board runs
+(docs/pytest.md is the user's guide)."""
 
 from harness import lazy_exports
 

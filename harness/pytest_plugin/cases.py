@@ -1,12 +1,9 @@
 """``@pytest.mark.hil_scenarios``: one test per scenario and fault profile.
 
-``@pytest.mark.hil_scenarios("approach_wall", "out_of_range", faults=["clean", "noisy"])``
-parametrises the test's ``hil_case`` argument with four cases, ids
-``approach_wall-clean`` ... ``out_of_range-noisy``; ``hil.run(hil_case)``
-runs one. No names: every shipped scenario. No ``faults``: each scenario's
-own profile, and the id is the scenario's name. Names and profiles are
-checked at collection, so a typo is one collection error, not N failures.
-"""
+``hil_scenarios("approach_wall", "out_of_range", faults=["clean", "noisy"])`` gives
+``hil_case`` four cases (ids ``approach_wall-clean`` ...); no names: every shipped
+scenario; no ``faults``: each one's own profile. Checked at collection, so a typo is
+one collection error, not N failures."""
 
 from __future__ import annotations
 

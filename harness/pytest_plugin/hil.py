@@ -1,13 +1,9 @@
 """The ``hil`` fixture's object: run one scenario through a link and judge it.
 
-Everything heavy (the runner, PyBullet, rclpy) is imported when a test
-first calls ``hil.run``, never when pytest loads the plugin. A mistake in
-the test's arguments (unknown scenario or fault profile, nonsense
-threshold) fails that test with one line instead of a traceback into the
-harness. Each run that starts a ROS graph holds its own domain id, reserved
-here so the result can name it, and a run on a physical port holds that
-port, so parallel pytest workers and sessions never meet.
-"""
+The runner, PyBullet and rclpy are imported at the first ``hil.run``, never when
+pytest loads the plugin; a bad argument fails the test with one line. Each run holds
+its own domain (reserved here, so the result can name it) and its port, so parallel
+workers and sessions never meet."""
 
 from __future__ import annotations
 
@@ -190,13 +186,9 @@ class Hil:
         warning_when_clear: str | None = None,
         **overrides: Any,
     ) -> HilResult:
-        """Run one scenario (a shipped name, a file, or a ``hil_case``) and judge every tick.
-
-        `threshold`, `faults`, `seed` and `warning_when_clear` ("required" or
-        "optional") override the scenario file's;
-        `overrides` are LinkOptions fields (``node=``, ``params=``,
-        ``scan_timeout=`` ...). Returns the result; it does not assert.
-        """
+        """Run one scenario (a shipped name, a file, or a ``hil_case``) and judge every tick;
+        `threshold`, `faults`, `seed` and `warning_when_clear` override the scenario's,
+        `overrides` are LinkOptions fields. Returns the result; it does not assert."""
         from harness.runner.settings import RunSettings
 
         given = [*overrides, *(["link"] if link is not None else [])]

@@ -1,14 +1,9 @@
 """The pytest plugin's options: command line first, then the ini file, then the default.
 
-Each ``--hil-*`` option is a row of the run request's table
-(harness.run_request) and has an ini twin (``hil_node`` for ``--hil-node``)
-except the port and the domain id, which belong to one machine and one
-board. Values go through the same readers as the ``fossbot-hil`` command,
-and the session's `RunRequest` checks them, so a bad value is one usage
-line naming the option as the user gave it. Nothing here imports numpy,
-rclpy or pybullet until an option is actually given: the plugin is loaded
-into every pytest session of whoever installed the package.
-"""
+Each ``--hil-*`` option is a row of the run request's table with an ini twin (but the
+port and the domain id, which belong to one machine); values are read as the CLI reads
+them and checked by the session's `RunRequest`. Nothing heavy is imported until an
+option is given: the plugin loads into every pytest session of whoever installed it."""
 
 from __future__ import annotations
 

@@ -1,21 +1,10 @@
 """The fossbot-hil pytest plugin (registered by entry point; no conftest needed).
 
-A test asks for ``hil`` and runs scenarios against the node under test::
-
-    def test_wall(hil):
-        result = hil.run("approach_wall", threshold=0.4, faults="noisy")
-        assert result.ok, result.explanation
-
-The node and the link come from ``--hil-*`` options (or ``hil_*`` ini
-keys), mirrored by fixtures a conftest may override: ``hil_node``,
-``hil_link``, ``hil_link_options``. ``@pytest.mark.hil_scenarios(...)``
-parametrises ``hil_case``. Tests marked ``hil`` need a physical board
-(``--hil-port``) and skip, saying why, without one. Under pytest-xdist each
-run reserves its own ROS domain and runs on one port take turns.
-
-This module imports neither rclpy nor pybullet (nor numpy): it is loaded
-into every pytest session of whoever installed the package.
-"""
+A test asks for ``hil``: ``result = hil.run("approach_wall", threshold=0.4)``, then
+``assert result.ok, result.explanation``. The node and the link come from ``--hil-*``
+options or ``hil_*`` ini keys, mirrored by fixtures a conftest may override; tests
+marked ``hil`` need a physical board and skip, saying why, without one. It imports no
+rclpy, pybullet or numpy: it is loaded into every pytest session."""
 
 from __future__ import annotations
 
@@ -67,11 +56,8 @@ class HilBoard:
     link: str  # the device the board expects: rplidar or ldlidar
 
     def run_options(self) -> dict[str, Any]:
-        """Keyword arguments for ``hil.run`` that send the scenario to this board.
-
-        The board runs its own driver and node, so the session's node
-        options (meant for the other tests) are dropped.
-        """
+        """Keyword arguments for ``hil.run`` that send the scenario to this board (the session's
+        node options are dropped: the board runs its own driver and node)."""
         return {
             "link": self.link,
             "port": self.port,
@@ -217,11 +203,8 @@ def hil_case() -> HilCase:
 
 @pytest.fixture
 def hil_board(hil_config: HilConfig) -> Iterator[HilBoard]:
-    """The board named on the command line, held for this test (other workers wait).
-
-    hil tests only run when there is one; the wait for a port another run
-    holds is bounded by --hil-port-wait.
-    """
+    """The board named on the command line, held for this test (other workers wait, bounded
+    by --hil-port-wait); hil tests run only when there is one."""
     if hil_config.port is None:
         pytest.skip(NO_BOARD)
     from harness.errors import ConfigError

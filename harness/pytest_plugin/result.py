@@ -1,12 +1,8 @@
-"""What ``hil.run`` returns: a RunResult with the reading a failing test needs.
+"""What ``hil.run`` returns: a RunResult with the reading a failing test needs (pure).
 
-``assert result.ok, result.explanation`` prints the oracle's explanation of
-the first failed tick, how many more failed, why the run ended early, and
-the node's last stderr lines when it crashed or went quiet. The short
-``repr`` is what a bare ``assert result.ok`` shows. Both are bounded, with
-every non-printable character a node wrote shown as its escape
-(harness.safe_text). Pure: no rclpy here.
-"""
+``assert result.ok, result.explanation`` prints the first failed tick's explanation,
+how many more failed, why the run ended and the node's last stderr when it crashed or
+went quiet; the short ``repr`` serves a bare assert. Both bounded and escaped."""
 
 from __future__ import annotations
 
