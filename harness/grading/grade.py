@@ -509,7 +509,7 @@ def _close_judges(client: Any, config: GradeConfig) -> None:
     """Every worker's warm judge closed, and its slot gone (an external cluster's workers
     outlive the grading)."""
     with contextlib.suppress(Exception):
-        client.run(close_judges)
+        client.run(close_judges, str(config.grader_dir))
     shutil.rmtree(config.grader_dir / ".slots", ignore_errors=True)
 
 

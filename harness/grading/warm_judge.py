@@ -118,14 +118,18 @@ def serve(sandboxed: bool) -> int:
     student is left. Ends with stdin, or when a student's processes cannot be ended."""
     from harness.grading.worker import interrupt_on_sigterm, not_dumpable, run_job, warm_node_server
 
+    # The jobs and answers on fds of their own (not inherited): what the judge starts
+    # (a node's reaper) gets /dev/null as its stdin and the job's log as its output.
+    jobs = os.fdopen(os.dup(0), "r")
     answers = os.fdopen(os.dup(1), "w", buffering=1)
+    os.dup2(os.open(os.devnull, os.O_RDONLY), 0)
     quiet = os.open(os.devnull, os.O_WRONLY)
     _to(quiet)
     interrupt_on_sigterm()
     if sandboxed:
         not_dumpable()
     warmed = False
-    for line in sys.stdin:
+    for line in jobs:
         request = json.loads(line)
         job = json.loads(Path(request["job"]).read_text(encoding="utf-8"))
         log = os.open(request["log"], os.O_WRONLY | os.O_CREAT | os.O_APPEND, 0o644)
@@ -313,11 +317,12 @@ def drop_judge(judge: WarmJudge) -> None:
     judge.close()
 
 
-def close_judges() -> None:
-    """Close this worker's judge (``client.run`` at a class's end: an external cluster's
-    workers outlive the grading)."""
-    while _JUDGES:
-        _JUDGES.pop().close()
+def close_judges(under: str) -> None:
+    """Close this worker's judge if its slot is `under` (a class's grader folder):
+    ``client.run`` at a class's end, since an external cluster's workers outlive the
+    grading (and may serve another grading meanwhile)."""
+    for judge in [j for j in _JUDGES if j.slot.is_relative_to(under)]:
+        drop_judge(judge)
 
 
 if __name__ == "__main__":
