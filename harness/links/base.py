@@ -75,8 +75,7 @@ class Link(ABC):
 
     @classmethod
     def run_session(cls, options: LinkOptions) -> AbstractContextManager[Any]:
-        """What every scenario's link of one run shares (given to ``create_link``), as a
-        context manager for the whole run; None for links that share nothing."""
+        """What a run's links share (given to ``create_link``), as a context manager for the run."""
         return nullcontext(None)
 
     # A suite may start the next scenarios' links while one runs (`start`)
@@ -86,24 +85,21 @@ class Link(ABC):
 
     @classmethod  # noqa: B027 - optional hook
     def prepare(cls, options: LinkOptions) -> None:
-        """Get ready for links with these options while the caller does other work
-        (e.g. start a helper process); optional, and never required."""
+        """Get ready for links with these options while the caller does other work (optional)."""
 
     def start(self) -> None:  # noqa: B027 - optional hook
         """Begin bringing the software under test up, without waiting for it."""
 
     def open(self) -> None:  # noqa: B027 - optional hook
-        """Bring the software under test up (unless `start` did) and wait, bounded,
-        until it is ready."""
+        """Bring the software under test up (unless `start` did); wait, bounded, for readiness."""
 
     def warm_up(self, scan: Scan) -> None:  # noqa: B027 - optional hook
         """Make sure answers to `scan` can reach us (answers discarded): an untimed first
         exchange for the benchmarks, and before a run whose first scan may be ignored."""
 
     def send_first(self, scan: Scan, tick: int, *, clock: float | None = None) -> None:
-        """Deliver the run's first scan, as `send` does; its answers are collected and
-        judged like any other's. A link whose software may miss a scan sent while it
-        comes up (a ROS graph still matching) resends it until answered, bounded."""
+        """Deliver the run's first scan, judged like any other; a link whose software may miss a
+        scan while it comes up (a ROS graph still matching) resends it until answered, bounded."""
         self.send(scan, tick, clock=clock)
 
     @abstractmethod
@@ -140,9 +136,8 @@ class Link(ABC):
         return ""
 
     def notices(self) -> list[str]:
-        """After the run, before `diagnostics`: notes on how the software under test is
-        wired that hold for the whole run (e.g. its warning on another topic, and the
-        option that names it); reports print each once."""
+        """After the run, before `diagnostics`: notes on how the software is wired, true for the
+        whole run (e.g. its warning on another topic); reports print each once."""
         return []
 
     def stop(self) -> None:  # noqa: B027 - optional hook

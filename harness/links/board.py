@@ -62,18 +62,23 @@ class BoardLink(Link):
         self._gap_measured = False
         self.startup_s = 0.0
         self.command = node_command(options)  # resolve now: bad input exits 2 early
-        # The node's status and warning topics, its own in the run's domain (remapped),
-        # or None: the options' (no session shared, a physical board, a launch file).
+        # The node answers on status and warning topics of its own in the run's domain
+        # (remapped), or on the options' (no session shared, a physical board, a launch file).
         own: tuple[str, str] | None = None
         if session is not None and not self.physical and takes_remaps(self.command):
             own = session.node_topics(options.status_topic, options.warning_topic)
+        remaps: tuple[str, ...] = ()
+        listen = None
+        if own is not None:
+            status, warning = own
+            remaps = ("-r", f"{options.status_topic}:={status}")
+            remaps += ("-r", f"{options.warning_topic}:={warning}")
+            listen = replace(options, status_topic=status, warning_topic=warning)
         hooks = GraphHooks(
             publishes_scans=False,  # the board's driver publishes /scan; the harness listens
             runs_node=not self.physical,  # a physical board's software runs its nodes
-            remaps=_remaps(options, own),
-            listen=None
-            if own is None
-            else replace(options, status_topic=own[0], warning_topic=own[1]),
+            remaps=remaps,
+            listen=listen,
             ready=self._device_asked,
             never_ready=self._never_ready,
             gone=lambda when: self.session.gone(when) if self.session is not None else None,
@@ -131,8 +136,7 @@ class BoardLink(Link):
         return self.profile.streams_unasked or self.session.device.mode != "idle"
 
     def _never_ready(self) -> str | None:
-        """A physical board that never answers: what went down the line, what came back,
-        and why (None: as for any node)."""
+        """A physical board that never answers: what went down the line and came back, and why."""
         if not self.physical or self.server is None:
             return None
         assert self.session is not None
@@ -169,9 +173,8 @@ class BoardLink(Link):
         return self.exchange.collect(scan, tick, may_be_ignored=may_be_ignored)
 
     def _between_scenarios(self, tick: int) -> None:
-        """This scenario's first tick is out (its driver scan came, or it was lost): the
-        gap since the scenario before's last tick ended (``gap_s``; its ticks at the
-        end that the board made no scan of belong to it, not to the gap)."""
+        """The first tick is out: the gap since the scenario before's last tick (``gap_s``;
+        its trailing ticks the board made no scan of are its own, not the gap's)."""
         if tick < 0 or self._gap_measured or self.session is None:
             return
         self._gap_measured = True
@@ -212,18 +215,9 @@ class BoardLink(Link):
         return "\n".join(n for n in notes if n)
 
 
-def _remaps(options: LinkOptions, own: tuple[str, str] | None) -> tuple[str, ...]:
-    """The node answers on its own topics where it has them (`links_ahead`)."""
-    if own is None:
-        return ()
-    status, warning = own
-    return ("-r", f"{options.status_topic}:={status}", "-r", f"{options.warning_topic}:={warning}")
-
-
 class SerialLidar:
-    """A serial LIDAR's link as the registry and the runner see a link class: its name,
-    what it is, the run's session and the links it makes (a ``BoardLink`` with its
-    device profile)."""
+    """A serial LIDAR's link as the registry and the runner see a link class: makes
+    ``BoardLink``s with its device profile."""
 
     serial_line = BoardLink.serial_line
     sets_node_topics = BoardLink.sets_node_topics

@@ -43,8 +43,7 @@ SPARSE_WAIT_S = 0.25  # at least this long for the board's scan of such a revolu
 
 
 class BoardDelivery(ScanDelivery):
-    """Push each scan as a revolution to the session's device; pair the node's answers
-    with the driver's scans of it."""
+    """Push each scan as a revolution to the device; pair the answers with its driver scans."""
 
     # A revolution the node did not answer in time never reached it (its subscription
     # was still matching), and the device must not be kept waiting while the node
@@ -120,8 +119,8 @@ class BoardDelivery(ScanDelivery):
         self._server.align_stream()
 
     def unanswerable(self) -> Answers | None:
-        """The node never got this revolution: nothing to wait for. What it publishes
-        meanwhile is sorted by the next exchange, by send time."""
+        """The node never got this revolution: nothing to wait for (what it publishes meanwhile
+        the next exchange sorts by send time)."""
         if self._lost is not None:
             if self.session is not None:
                 self.session.last_tick_at = time.perf_counter()
@@ -136,8 +135,7 @@ class BoardDelivery(ScanDelivery):
         self._repeat_at = self._repeat_from()
         if self._owed:  # the first statuses answer scans before this tick's (owed_answers)
             answers.keep_only(sorted(answers.statuses, key=lambda r: r.source_ns)[self._owed :])
-        sent_ns = self.exchange.sent_ns
-        statuses = sum(1 for h in heard if h.kind == "status" and h.source_ns >= sent_ns)
+        statuses = self._statuses()
         after = sum(1 for h in heard if h.kind == "scan" and h.source_ns > self._scans_from)
         # Owed answers that never came (a node that skips a repeat) are not carried on.
         plain = self._line_damage is None and self.exchange.copies == 1
@@ -145,8 +143,8 @@ class BoardDelivery(ScanDelivery):
         self._window = AnswerWindow(1 + after, max(0, statuses - self._owed)) if plain else None
 
     def collected(self, answers: Answers) -> Answers:
-        """Each answer with the driver scan it answered; what the device's repeats and
-        the idle stream drew answers no tick."""
+        """Each answer with the driver scan it answered; answers the repeats and the idle stream
+        drew answer no tick."""
         if self._after_idle:
             self._after_idle = False
             set_aside_answers_to_the_idle_stream(answers, len(self._heard_scans))
@@ -313,9 +311,8 @@ class BoardDelivery(ScanDelivery):
         return time.time_ns()
 
     def _not_this_revolution(self, written_ns: int) -> int:
-        """Driver scans of revolutions the device sent on its own (a repeat while the
-        harness was late) came before this one's: answers to them answer no tick. How
-        many came."""
+        """How many driver scans of revolutions the device sent on its own (a repeat while the
+        harness was late) came before this one's: their answers answer no tick."""
         assert self._obs is not None
         others = sorted(
             h.source_ns
@@ -349,8 +346,7 @@ class BoardDelivery(ScanDelivery):
 
     def _statuses(self) -> int:
         assert self._obs is not None
-        since = self.exchange.sent_ns
-        return sum(1 for h in self._obs.inbox if h.kind == "status" and h.source_ns >= since)
+        return self._obs.statuses_since(self.exchange.sent_ns)
 
     def answered(self) -> bool:
         """One status for each driver scan this exchange brought (usually one)."""
@@ -372,9 +368,8 @@ class BoardDelivery(ScanDelivery):
             )
 
     def settled(self) -> None:
-        """While the last scan's trailing answers are awaited, the device may repeat its
-        revolution on its own: the answers to those repeats answer no tick (as in
-        `collect`), never the last tick twice."""
+        """The device may repeat its last revolution while the trailing answers are awaited:
+        answers to those repeats answer no tick, never the last tick twice."""
         repeat = self._repeat_from()
         if repeat is not None:
             self.exchange.sends = [*self.exchange.sends, (None, repeat)]

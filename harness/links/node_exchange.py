@@ -169,7 +169,7 @@ class NodeExchange:
             # or their answers would be taken for that scan's.
             took = time.perf_counter() - first_at
             self.wait_for(
-                lambda: self._statuses_since(first_ns) >= copies,
+                lambda: obs.statuses_since(first_ns) >= copies,
                 min(max(WARM_UP_RETRY_S, copies * took), opts.ready_timeout),
             )
         self.wait_for(
@@ -215,12 +215,6 @@ class NodeExchange:
         if obs.warning_publishers() == 0 and not bool_writers:
             return  # no Bool writer in sight, even now (another type is named elsewhere)
         self.wait_for(lambda: obs.heard_since("warning", first_ns), self.options.scan_timeout)
-
-    def _statuses_since(self, source_ns: int) -> int:
-        assert self.graph.observer is not None
-        return sum(
-            1 for h in self.graph.observer.inbox if h.kind == "status" and h.source_ns >= source_ns
-        )
 
     def warm_up(self, scan: Scan) -> None:
         """Exchange a scan until its answer reaches us, then forget it (the benchmarks' untimed

@@ -77,9 +77,8 @@ class WiringNotes:
         return check.notes(lambda: ask_parameters(observer, self.options))
 
     def _topics(self, observer: Observer | None, warmed_up: bool) -> list[str]:
-        """A warning that never came on the warning topic: on which topic the node
-        publishes its Bool instead, and the option that names it (else the graph).
-        Taken once, before the diagnostics stop the node; they repeat it."""
+        """On which topic the node publishes its Bool instead of the warning topic, and the option
+        that names it (else the graph); taken once, before the diagnostics stop the node."""
         if self._topic_notes is not None:
             return list(self._topic_notes)
         self._topic_notes = notes = []

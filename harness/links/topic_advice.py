@@ -24,9 +24,8 @@ LOOK_EVERY_S = 0.05  # a graph query costs more than a spin
 
 
 def topics_elsewhere(node: Any, type_name: str, topic: str, *, publishers: bool) -> list[str]:
-    """Topics other than `topic` that a node other than `node` (the harness's) publishes
-    (or subscribes to) as `type_name`: where a node with another topic name sends (or
-    reads) it."""
+    """Topics other than `topic` that a node other than the harness's `node` publishes (or
+    subscribes to) as `type_name`: where a node with another topic name sends (or reads) it."""
     me = (node.get_name(), node.get_namespace())
     found = []
     for name, types in node.get_topic_names_and_types():
@@ -95,9 +94,8 @@ def untaken_topic_parameter(
 
 
 class ElsewhereWatch:
-    """While a link waits for its node to be ready: has the graph shown the node on another
-    scan or status topic (the one it reads or writes instead of the harness's) for
-    ELSEWHERE_GRACE_S? Then waiting longer tells nothing more."""
+    """While a link waits for readiness: has the graph shown the node on another scan or
+    status topic for ELSEWHERE_GRACE_S? Then waiting longer tells nothing more."""
 
     def __init__(
         self,

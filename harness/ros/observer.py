@@ -68,10 +68,8 @@ class Observer:
         os.environ.update(discovery_environment(network=network))
         self.context = Context()
         self._closed = False
-        # The harness handles SIGINT/SIGTERM itself (stop the node, report);
-        # rclpy's own handlers would shut the context down under our feet.
-        # args=[]: not sys.argv, where the user's NAME:=VALUE items would be
-        # taken for remappings of the harness's own node.
+        # Signals are the harness's (rclpy's handlers would shut the context down under us);
+        # args=[]: the user's NAME:=VALUE items in sys.argv would remap the harness's node.
         with harness_announcements():  # a node that comes up late is matched at once
             rclpy.init(
                 args=[],
@@ -79,12 +77,9 @@ class Observer:
                 domain_id=domain_id,
                 signal_handler_options=SignalHandlerOptions.NO,
             )
-            # No /rosout: the harness logs nothing there, and a suite has several
-            # of these nodes at once (one per domain), whose rosout publishers
-            # would clash by name within this process. No parameter services:
-            # nobody sets the harness's parameters, and their dozen endpoints are
-            # that many more for a starting node to discover before it is
-            # matched both ways.
+            # No /rosout (a suite has one of these nodes per domain, whose rosout publishers
+            # would clash by name in this process) and no parameter services (a dozen more
+            # endpoints for a starting node to discover before it is matched both ways).
             self.node = rclpy.create_node(
                 "fossbot_hil",
                 context=self.context,
@@ -93,8 +88,7 @@ class Observer:
             )
         self.scan_topic, self.status_topic = scan_topic, status_topic
         self.warning_topic = warning_topic
-        # Either we publish the scans (ros2 link) or a board's driver does and
-        # we listen to what the node under test receives (serial links).
+        # We publish the scans (ros2), or a board's driver does and we hear them (serial).
         self.scan_pub = (
             self.node.create_publisher(LaserScan, scan_topic, QOS) if publish_scans else None
         )
@@ -194,6 +188,10 @@ class Observer:
     def heard_since(self, kind: str, source_ns: int) -> bool:
         """Has a message of `kind` published at or after `source_ns` arrived?"""
         return self.latest.get(kind, 0) >= source_ns
+
+    def statuses_since(self, source_ns: int) -> int:
+        """Statuses in the inbox published at or after `source_ns`."""
+        return sum(1 for h in self.inbox if h.kind == "status" and h.source_ns >= source_ns)
 
     def warning_publishers(self) -> int:
         """Publishers of the node's warning topic matched to our subscription."""

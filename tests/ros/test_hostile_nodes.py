@@ -287,18 +287,18 @@ def test_a_node_waiting_for_clock_before_it_subscribes_starts_and_passes(pids: P
     assert survivors(pids) == []
 
 
-class ClockOnlyWhenReady(Ros2Link):
+def clock_only_when_ready(options: LinkOptions) -> Ros2Link:
     """The ros2 link as into a physical board's graph: no /clock before the node is ready."""
-
-    def _clock_before_ready(self) -> bool:
-        return False
+    link = Ros2Link(options)
+    link.graph._clock_before_ready = lambda: False  # type: ignore[method-assign]
+    return link
 
 
 def test_never_ready_says_clock_comes_only_once_the_node_is_ready(pids: Path) -> None:
     """No /clock before it is ready: the clock-waiting node never subscribes, and is told why."""
     # Long enough for the node to publish its status topic on a loaded machine (tests in parallel).
     options = LinkOptions(node=node("waits_for_clock", pids), ready_timeout=6.0)
-    link = ClockOnlyWhenReady(options)
+    link = clock_only_when_ready(options)
     try:
         with pytest.raises(LinkError) as never:
             link.open()
