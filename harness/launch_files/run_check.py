@@ -42,9 +42,8 @@ class LaunchCheck:
         launched: str | None = None,
         passed: Sequence[str] = (),
     ) -> LaunchCheck | None:
-        """Read the package's launch files, or with `run --launch` the one it starts
-        (`launched`, a file name), whose launch arguments must take the `passed`
-        parameter names; None when there is nothing to check."""
+        """The package's launch files, or the one `run --launch` starts (`launched`), whose
+        arguments must take the `passed` parameters; None when there is nothing to check."""
         space = workspace_of(workspace)
         where = "the workspace" if workspace is not None else "AMENT_PREFIX_PATH"
         found = package_launch_files(package, space)

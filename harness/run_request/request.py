@@ -178,10 +178,8 @@ class RunRequest:
 
 
 def check_port(path: str, key: str = "port") -> None:
-    """A port the user named must be a device (a tty), not a file or a folder or nothing.
-
-    Checked before the port is locked or opened, so a typo leaves nothing behind.
-    """
+    """A port the user named must be a device (a tty), checked before it is locked or opened,
+    so a typo leaves nothing behind."""
     shown = literal(path, 200)[1:-1]
     if not path.strip():
         raise OptionError(key, f"{{{key}}} must not be empty")
