@@ -89,10 +89,8 @@ def add_options(parser: pytest.Parser) -> None:
             kwargs.update(action="append", default=[])
         group.addoption(opt.row.hil_flag, dest="hil_" + opt.name, **kwargs)
         if opt.row.ini:
-            if opt.row.repeat:
-                parser.addini(opt.row.ini_key, f"default for {opt.row.hil_flag}", type="linelist")
-            else:
-                parser.addini(opt.row.ini_key, f"default for {opt.row.hil_flag}", type="string")
+            kind = "linelist" if opt.row.repeat else "string"
+            parser.addini(opt.row.ini_key, f"default for {opt.row.hil_flag}", type=kind)
 
 
 @dataclass(frozen=True)
