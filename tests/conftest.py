@@ -34,6 +34,17 @@ def _own_cache_folder(tmp_path_factory: pytest.TempPathFactory) -> Iterator[None
         yield
 
 
+@pytest.fixture(autouse=True, scope="session")
+def _cli_names() -> Iterator[None]:
+    """Lower layers' messages name options as the CLI does (--port, --lidar-mount), the
+    way `fossbot-hil` speaks them; a test of another caller speaks its own."""
+    from harness.cli import build_parser, flag_names
+    from harness.option_names import speaking
+
+    with speaking(flag_names(build_parser())):
+        yield
+
+
 @pytest.hookimpl(optionalhook=True)  # pytest-xdist's hook
 def pytest_xdist_auto_num_workers(config: pytest.Config) -> int:
     """`-n auto`: one worker more than cores. About a third of the suite's time is

@@ -27,7 +27,7 @@ class Mutant:
 
     name: str  # snake_case; the name in the CLI, the kill matrix and --json
     mistake: str  # one line: what the node does wrong, in a student's terms
-    caught_by: str  # one line: the kind of scenario that kills it
+    caught_by: str  # one line: the kind of scenario that kills it (options as {key})
     # Seconds a scenario of its suite takes, measured with the shipped suite on 2 busy
     # cores, each scenario ended at its first failed tick (what batches balance): a
     # mistake whose runs wait out deadlines costs many quick ones, and goes first.
@@ -169,7 +169,7 @@ MUTANTS: tuple[Mutant, ...] = (
     Mutant(
         "scan_topic_ignored",
         "subscribes to /scan whatever the lidar_topic parameter says",
-        "a run with another scan topic (--param lidar_topic:=... --scan-topic ...)",
+        "a run with another scan topic ({params} lidar_topic:=... {scan_topic} ...)",
     ),
 )
 

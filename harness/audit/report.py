@@ -11,6 +11,7 @@ from harness.audit.matrix import KillMatrix
 from harness.audit.mutants import mutant_named
 from harness.audit.suite_audit import AuditOutcome
 from harness.judge.reading_coverage import CASE_NAMES, CASES, other_counts
+from harness.option_names import worded
 
 __all__ = ["LEGEND", "audit_json", "exit_code", "print_audit", "score_line"]
 
@@ -109,7 +110,7 @@ def print_audit(console: Console, outcome: AuditOutcome) -> None:
         _say(console, "mistakes no scenario catches, and what would catch them:")
         for name in matrix.survivors:
             mutant = mutant_named(name)
-            _say(console, f"  {name}: {mutant.mistake}; caught by {mutant.caught_by}")
+            _say(console, f"  {name}: {mutant.mistake}; caught by {worded(mutant.caught_by)}")
     if matrix.flips:
         _say(console)
         _say(console, "verdicts that changed with the seed:")

@@ -12,7 +12,7 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 from harness.atomic_write import write_atomically
-from harness.errors import ConfigError
+from harness.errors import OptionError
 
 WHOLE = {"seed", "ticks", "failed_ticks"}
 TEXT = {"key", "scenario", "faults", "verdict", "first_failure", "worker"}  # others: numbers
@@ -21,7 +21,7 @@ TEXT = {"key", "scenario", "faults", "verdict", "first_failure", "worker"}  # ot
 def check_parquet_available() -> None:
     """Refuse --parquet before a campaign starts, naming the extra to install."""
     if importlib.util.find_spec("pyarrow") is None:
-        raise ConfigError("--parquet needs pyarrow: pip install 'fossbot-hil[parquet]'")
+        raise OptionError("parquet", "{parquet} needs pyarrow: pip install 'fossbot-hil[parquet]'")
 
 
 def _typed(column: str, text: str) -> object:

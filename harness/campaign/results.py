@@ -14,7 +14,8 @@ import os
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
-from harness.errors import ConfigError
+from harness.errors import OptionError
+from harness.option_names import escaped
 
 COLUMNS = (
     "key",
@@ -56,9 +57,11 @@ def read_rows(path: Path) -> list[dict[str, str]]:
 def check_columns(path: Path, columns: Sequence[str]) -> None:
     """Resuming needs the table's own columns (the same generated variations)."""
     if read_header(path) != tuple(columns):
-        raise ConfigError(
-            f"--resume: {path} has the columns {', '.join(read_header(path))[:300]}; "
-            f"this sweep writes {', '.join(columns)} (another --vary? use another --out)"
+        found = f"{path} has the columns {', '.join(read_header(path))[:300]}"
+        raise OptionError(
+            "resume",
+            f"{{resume}}: {escaped(found)}; this sweep writes {escaped(', '.join(columns))}"
+            " (another {vary}? use another {out})",
         )
 
 

@@ -22,6 +22,7 @@ import numpy as np
 
 from harness.lidar.mount import FORWARD, LidarMount
 from harness.lidar.scan import Scan
+from harness.option_names import named
 
 if TYPE_CHECKING:
     from harness.judge.records import RunResult
@@ -136,7 +137,7 @@ def likely_fix(rotation_deg: float, mirrored: bool, mount: LidarMount | None = N
         board_mount = LidarMount(_normalised(rotation_deg - yaw), not mount.mirrored)
     return (
         f"{_describe(mirrored, rotation_deg)}: {driver}, or if the board is right, "
-        f"run with --lidar-mount {board_mount.option_text()}"
+        f"run with {named('lidar_mount')} {board_mount.option_text()}"
     )
 
 

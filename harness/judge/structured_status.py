@@ -18,6 +18,7 @@ from dataclasses import dataclass
 
 from harness.judge.status_numbers import Number, find_numbers
 from harness.judge.structured_text import Field, Printed, Shape, Structure, structure_of
+from harness.option_names import named
 
 __all__ = ["KeyedClaim", "read_structured"]
 
@@ -309,13 +310,14 @@ def _unreadable(keyed: list[_Keyed], why: str) -> str:
             found.append((at, group, keyed[at].field.key[-1]))
     if not any(group == "distance" for _, group, _ in found):
         return (
-            f"{why}; a --status-regex with named groups (?P<distance>...) and optionally"
+            f"{why}; a {named('status_regex')} with named groups (?P<distance>...) and optionally"
             " (?P<angle>...) and (?P<obstacle>...) reads a status written another way"
             " (docs/oracle.md)"
         )
     pieces = [_piece(key, group) for _, group, key in sorted(found)]
     rx = "(?is)" + pieces[0] + "".join(f"(?:.*?{p})?" for p in pieces[1:])
-    return f"{why}; if the node is right, say how to read it: --status-regex {shlex.quote(rx)}"
+    option = named("status_regex")
+    return f"{why}; if the node is right, say how to read it: {option} {shlex.quote(rx)}"
 
 
 def _piece(key: str, group: str) -> str:

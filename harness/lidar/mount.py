@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from harness.errors import ConfigError
+from harness.errors import OptionError
 
 __all__ = ["FORWARD", "LidarMount", "parse_mount"]
 
@@ -49,7 +49,7 @@ FORWARD = LidarMount()  # a generic mount: zero straight ahead, clockwise
 
 def parse_mount(text: str) -> LidarMount | None:
     """`--lidar-mount`: 'model' (None: what the robot model says), 'forward', or
-    'DEG[,mirrored]' (the device's zero, CCW from forward). ConfigError when neither."""
+    'DEG[,mirrored]' (the device's zero, CCW from forward). OptionError when neither."""
     value = text.strip().lower()
     if value == MODEL_WORD:
         return None
@@ -57,16 +57,17 @@ def parse_mount(text: str) -> LidarMount | None:
         return FORWARD
     yaw_text, _, flag = value.partition(",")
     if flag not in ("", "mirrored"):
-        raise ConfigError(
-            f"--lidar-mount {text[:40]!r}: after the angle only ',mirrored' may follow"
+        raise OptionError.saying(
+            "lidar_mount", f"{text[:40]!r}: after the angle only ',mirrored' may follow"
         )
     try:
         yaw = float(yaw_text)
     except ValueError:
         yaw = float("nan")
     if not -360.0 <= yaw <= 360.0:  # also refuses nan and inf
-        raise ConfigError(
-            f"--lidar-mount {text[:40]!r}: give model, forward, or the angle of the device's zero "
-            "in degrees (-360..360, counter-clockwise from forward), e.g. -90 or 180,mirrored"
+        raise OptionError.saying(
+            "lidar_mount",
+            f"{text[:40]!r}: give model, forward, or the angle of the device's zero in degrees "
+            "(-360..360, counter-clockwise from forward), e.g. -90 or 180,mirrored",
         )
     return LidarMount(yaw_deg=yaw + 0.0, mirrored=flag == "mirrored")

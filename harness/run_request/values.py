@@ -131,12 +131,8 @@ def link(value: object) -> str:
 
 def lidar_mount(value: object) -> Any:
     """How the device sits on the robot (harness.lidar.mount); a parsed mount stays one."""
-    from harness.errors import ConfigError
     from harness.lidar.mount import LidarMount, parse_mount
 
     if isinstance(value, LidarMount) or value is None:
         return value
-    try:
-        return parse_mount(str(value))
-    except ConfigError as err:
-        raise OptionError("lidar_mount", escaped(str(err).removeprefix("--lidar-mount "))) from None
+    return parse_mount(str(value))  # an OptionError naming {lidar_mount}

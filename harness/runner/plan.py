@@ -17,6 +17,7 @@ from harness.faults.sensor import FaultProfile
 from harness.judge.oracle import Oracle
 from harness.judge.records import RunResult
 from harness.links.base import LinkOptions, link_class
+from harness.option_names import named
 from harness.runner.settings import (
     RunSettings,
     effective_seed,
@@ -178,6 +179,6 @@ def run_mount(scenarios: Sequence[Scenario], options: LinkOptions) -> LinkOption
             raise ConfigError(
                 f"{scenario.source}: its robot model mounts the LIDAR {other.describe()}, but "
                 f"{first.source}'s {mount.describe()}; one device serves the whole run: "
-                "run them apart, or give --lidar-mount"
+                f"run them apart, or give {named('lidar_mount')}"
             )
     return replace(options, lidar_mount=mount)

@@ -18,6 +18,7 @@ from harness.faults.link import NO_LINK_FAULTS, LinkFaults
 from harness.judge.oracle import Oracle
 from harness.judge.records import RunResult, TickRecord
 from harness.links.base import Link, LinkOptions
+from harness.option_names import named
 from harness.record import RecordedScans
 from harness.runner.frames import Frame, check_link_faults, judge_frames
 from harness.runner.scenario_run import with_link
@@ -39,7 +40,8 @@ def replay_threshold(recording: RecordedScans, threshold: float | None) -> float
     recorded = _recorded_float(recording, "threshold")
     if recorded is None or recorded <= 0:
         raise ConfigError(
-            f"{recording.source}: the recording does not say its threshold; give --threshold M"
+            f"{recording.source}: the recording does not say its threshold; "
+            f"give {named('threshold')} M"
         )
     return recorded
 

@@ -8,6 +8,7 @@ from typing import Any
 
 from harness.errors import ConfigError
 from harness.faults.sensor import FaultProfile, build_profile
+from harness.option_names import named
 from harness.scenario.checks import check_run_length, threshold_problem
 from harness.scenario.schema import Scenario
 
@@ -69,4 +70,4 @@ def fault_profile(scenario: Scenario, settings: RunSettings) -> FaultProfile:
 
 def faults_origin(scenario: Scenario, settings: RunSettings) -> str:
     """Where the run's faults were named, for error messages."""
-    return "--faults" if settings.faults is not None else scenario.source
+    return named("faults") if settings.faults is not None else scenario.source

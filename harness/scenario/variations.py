@@ -13,6 +13,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from harness.errors import ConfigError
+from harness.option_names import named
 from harness.safe_text import shown
 from harness.scenario.files import checked_scenario
 from harness.scenario.footprint import Outline
@@ -103,7 +104,7 @@ def varied(scenario: Scenario, levels: Mapping[str, float]) -> Scenario:
     try:
         return checked_scenario(data, source=scenario.source or scenario.name)
     except ConfigError as err:
-        raise ConfigError(f"--vary {label}: {err}") from None
+        raise ConfigError(f"{named('vary')} {label}: {err}") from None
 
 
 def _move_obstacles(data: dict[str, Any], scenario: Scenario, distance: float, where: str):
@@ -114,7 +115,7 @@ def _move_obstacles(data: dict[str, Any], scenario: Scenario, distance: float, w
     now = ahead_distance(scenario.model_copy(update={"robot": robot}))
     if now is None:
         raise ConfigError(
-            f"--vary wall_distance: {where} has no wall, box or cylinder straight ahead "
+            f"{named('vary')} wall_distance: {where} has no wall, box or cylinder straight ahead "
             "of its start"
         )
     shift = distance - now

@@ -2,26 +2,16 @@
 
 from __future__ import annotations
 
-from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
 
-from harness.cli import build_parser, flag_names
 from harness.judge.records import RunResult
 from harness.links.base import LinkOptions
-from harness.option_names import speaking
 from harness.runner.suite import run_suite
 from harness.scenario.files import resolve_scenario
 
 STUDENTS = Path(__file__).parents[1] / "student_functions.py"
-
-
-@pytest.fixture(scope="module", autouse=True)
-def _cli_names() -> Iterator[None]:
-    """The report's texts name options as the CLI does (--baseline, --alignment)."""
-    with speaking(flag_names(build_parser())):
-        yield
 
 
 @pytest.fixture(scope="session")
