@@ -84,8 +84,8 @@ class BoardLink(Link):
             gone=lambda when: self.session.gone(when) if self.session is not None else None,
         )
         self.graph = NodeGraph(options, self.command, WiringNotes(options, None), hooks)
-        self.exchange = NodeExchange(self.graph, lambda ex: BoardDelivery(ex, profile))
-        self.delivery: BoardDelivery = self.exchange.delivery  # type: ignore[assignment]
+        self.node_exchange = NodeExchange(self.graph, lambda ex: BoardDelivery(ex, profile))
+        self.delivery: BoardDelivery = self.node_exchange.delivery  # type: ignore[assignment]
         self.delivery.session = session
 
     # The session's, the graph's and the exchange's, as the runner and the tests read them.
@@ -94,11 +94,11 @@ class BoardLink(Link):
     node_start = Part("graph")
     node_gone = Part("graph")
     damage_line = Part("delivery")
-    warm_up = Part("exchange")
-    send_first = Part("exchange")
-    send = Part("exchange")
-    hold = Part("exchange")
-    settle = Part("exchange")
+    warm_up = Part("node_exchange")
+    send_first = Part("node_exchange")
+    send = Part("node_exchange")
+    hold = Part("node_exchange")
+    settle = Part("node_exchange")
 
     @property
     def server(self) -> Any:
@@ -170,7 +170,7 @@ class BoardLink(Link):
     # -- the exchange -------------------------------------------------------
     def collect(self, scan: Scan, tick: int, *, may_be_ignored: bool = False) -> Answers:
         self._between_scenarios(tick)
-        return self.exchange.collect(scan, tick, may_be_ignored=may_be_ignored)
+        return self.node_exchange.collect(scan, tick, may_be_ignored=may_be_ignored)
 
     def _between_scenarios(self, tick: int) -> None:
         """The first tick is out: the gap since the scenario before's last tick (``gap_s``;
@@ -185,14 +185,14 @@ class BoardLink(Link):
     def diagnostics(self) -> str:
         parts = []
         if not self.physical and self.graph.process is not None:
-            parts.append(self.graph.diagnostics(warmed_up=self.exchange.warmed_up))
+            parts.append(self.graph.diagnostics(warmed_up=self.node_exchange.warmed_up))
             self.stop()
         if self.session is not None:
             parts.append(self.session.diagnostics())
         return "\n".join(p for p in parts if p)
 
     def notices(self) -> list[str]:
-        return self.graph.notices(warmed_up=self.exchange.warmed_up)
+        return self.graph.notices(warmed_up=self.node_exchange.warmed_up)
 
     def stop(self) -> None:
         """The scenario is over: the device streams on (the run's session), the node stops."""

@@ -55,10 +55,11 @@ class Ros2Link(Link):
         super().__init__(options)
         self.command = node_command(options)  # resolve now: bad input exits 2 early
         self.graph = NodeGraph(options, self.command, WiringNotes(options, session))
-        self.exchange = NodeExchange(self.graph, TopicDelivery)
+        self.node_exchange = NodeExchange(self.graph, TopicDelivery)
         self.startup_s = 0.0
 
-    # The graph's and the exchange's, as the runner and the tests read them.
+    # The graph's and the exchange's, as the runner and the tests read them (`exchange`,
+    # send then collect, is the base class's: the part is `node_exchange`).
     observer = Part("graph")
     process = Part("graph")
     domain = Part("graph")
@@ -67,12 +68,12 @@ class Ros2Link(Link):
     stop = Part("graph")
     close = Part("graph")
     stop_note = Part("graph")
-    send_first = Part("exchange")
-    warm_up = Part("exchange")
-    send = Part("exchange")
-    hold = Part("exchange")
-    collect = Part("exchange")
-    settle = Part("exchange")
+    send_first = Part("node_exchange")
+    warm_up = Part("node_exchange")
+    send = Part("node_exchange")
+    hold = Part("node_exchange")
+    collect = Part("node_exchange")
+    settle = Part("node_exchange")
 
     # -- life cycle -------------------------------------------------------
     @classmethod
@@ -105,9 +106,9 @@ class Ros2Link(Link):
         (the runner asks once, when the run is over)."""
         if self.graph.process is None:
             return ""
-        text = self.graph.diagnostics(warmed_up=self.exchange.warmed_up)
+        text = self.graph.diagnostics(warmed_up=self.node_exchange.warmed_up)
         self.stop()
         return text
 
     def notices(self) -> list[str]:
-        return self.graph.notices(warmed_up=self.exchange.warmed_up)
+        return self.graph.notices(warmed_up=self.node_exchange.warmed_up)

@@ -62,10 +62,12 @@ def test_both_links_compose_the_one_exchange_with_their_delivery() -> None:
     from harness.links.ros2 import TopicDelivery
 
     ros2, board = link_class("ros2")(LinkOptions()), link_class("rplidar")(LinkOptions())
-    assert type(ros2.exchange) is type(board.exchange) is NodeExchange
-    assert isinstance(ros2.exchange.delivery, TopicDelivery)
-    assert isinstance(board.exchange.delivery, BoardDelivery)
-    assert ros2.exchange.delivery.copies_queue and not board.exchange.delivery.copies_queue
+    assert type(ros2.node_exchange) is type(board.node_exchange) is NodeExchange
+    assert isinstance(ros2.node_exchange.delivery, TopicDelivery)
+    assert isinstance(board.node_exchange.delivery, BoardDelivery)
+    assert (
+        ros2.node_exchange.delivery.copies_queue and not board.node_exchange.delivery.copies_queue
+    )
 
 
 def test_the_board_session_reads_the_bounds_not_the_ros2_link() -> None:
