@@ -43,6 +43,11 @@ def speaking(names: Names) -> Iterator[None]:
         speak(before)
 
 
+def spoken() -> dict[str, str]:
+    """The names this process speaks now (to hand on to its workers)."""
+    return dict(_spoken)
+
+
 def named(key: str) -> str:
     """The caller's name for option `key` ("--port" in the CLI, "--hil-port" in pytest)."""
     return _spoken.get(key, key)

@@ -25,7 +25,7 @@ from pathlib import Path
 
 import harness
 from harness.bench.stage import StageResult
-from harness.bench.suite_commands import _fossbot_hil, cli_wall_s
+from harness.bench.suite_commands import COMMAND_FLAGS, _fossbot_hil, cli_args, cli_wall_s
 from harness.cluster.client import default_workers
 from harness.errors import HarnessError
 
@@ -54,8 +54,11 @@ def make_class(folder: Path, students: int) -> list[Path]:
 
 def grade_wall_s(classroom: Path, out: Path, scenarios: tuple[str, ...]) -> float:
     """`fossbot-hil grade CLASS --no-audit` from spawn to exit; every student must pass."""
-    argv = [*_fossbot_hil(), "grade", str(classroom), "--out", str(out), "--no-audit"]
-    argv += [f"--scenario={','.join(scenarios)}"] if scenarios else []
+    argv = [*_fossbot_hil(), "grade", str(classroom), *cli_args(out=str(out))]
+    argv += [
+        COMMAND_FLAGS["no_audit"],
+        *(cli_args(scenario=",".join(scenarios)) if scenarios else []),
+    ]
     started = time.perf_counter()
     try:
         done = subprocess.run(argv, capture_output=True, timeout=GRADE_TIMEOUT_S, check=False)
@@ -97,7 +100,9 @@ def measure_grade(
                 grades[n].append(grade_wall_s(classes[n], Path(tmp) / f"grades{n}", scenarios))
 
         def run_each() -> None:
-            run_walls.append([cli_wall_s(["--node", f"python3 {s}", *scenarios]) for s in largest])
+            run_walls.append(
+                [cli_wall_s([*cli_args(node=f"python3 {s}"), *scenarios]) for s in largest]
+            )
 
         steps = (grade_each, run_each) if runs else (grade_each,)
         rounds = rounds if runs else 1

@@ -19,15 +19,16 @@ from harness.errors import HarnessError
 from harness.run_request.table import option
 
 CLI_TIMEOUT_S = 120.0  # the shipped suite takes 2-12 s here; a hung run ends the stage
-RUN_FLAGS = {"out": "--out"}  # `run`'s own flags the bench gives (not run options)
+# The commands' own flags the bench gives (not run options): `run`'s and `grade`'s.
+COMMAND_FLAGS = {"out": "--out", "no_audit": "--no-audit", "scenario": "--scenario"}
 
 
 def cli_args(**given: str) -> list[str]:
     """Options by key as `fossbot-hil run` takes them: a run option's flag as the run
-    request's table spells it, `run`'s own as RUN_FLAGS does."""
+    request's table spells it, `run`'s own as COMMAND_FLAGS does."""
     args: list[str] = []
     for key, value in given.items():
-        flag = RUN_FLAGS.get(key) or option(key).cli
+        flag = COMMAND_FLAGS.get(key) or option(key).cli
         assert flag is not None, f"{key}: not an option of fossbot-hil run"
         args += [flag, value]
     return args

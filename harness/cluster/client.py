@@ -7,7 +7,8 @@ import os
 from collections.abc import Iterator, Sequence
 from typing import Any
 
-from harness.errors import ConfigError, one_line
+from harness.errors import OptionError, one_line
+from harness.option_names import spoken
 
 CONNECT_TIMEOUT_S = 10  # for an external scheduler to answer
 WORKER_WAIT_S = 30.0  # for an external cluster without workers to get one (--worker-wait)
@@ -32,7 +33,7 @@ def default_workers() -> int:
 def check_cluster_options(scheduler: str | None, workers: int | None) -> None:
     """--scheduler and --workers: one cluster or the other (checked before a command starts)."""
     if scheduler is not None and workers is not None:
-        raise ConfigError("--workers sizes the embedded cluster; not with --scheduler")
+        raise OptionError("workers", "{workers} sizes the embedded cluster; not with {scheduler}")
 
 
 @contextlib.contextmanager
@@ -61,9 +62,12 @@ def open_client(
         try:
             client = Client(scheduler, timeout=CONNECT_TIMEOUT_S)
         except Exception as err:  # noqa: BLE001 - anything here is the address's fault
-            raise ConfigError(f"--scheduler {scheduler}: cannot connect: {_said(err)}") from None
+            raise OptionError.saying(
+                "scheduler", f"{scheduler}: cannot connect: {_said(err)}"
+            ) from None
         with client:
             _wait_for_a_worker(client, scheduler, worker_wait)
+            _speak_on_workers(client)
             yield client
         return
     count = workers if workers is not None else default_workers()
@@ -81,7 +85,15 @@ def open_client(
             silence_logs=40,  # errors only: the command reports progress itself
         )
     with cluster, Client(cluster) as client:
+        _speak_on_workers(client)
         yield client
+
+
+def _speak_on_workers(client: Any) -> None:
+    """The workers word options as this process's caller does (worker_names)."""
+    from harness.cluster.worker_names import OptionNames
+
+    client.register_plugin(OptionNames(spoken()), name=OptionNames.name)
 
 
 def _warm_worker_start(preload: Sequence[str]) -> None:
@@ -110,14 +122,14 @@ def check_scheduler(address: str) -> None:
     try:
         info = asyncio.run(asyncio.wait_for(identity(), CONNECT_TIMEOUT_S))
     except (TimeoutError, asyncio.TimeoutError):
-        raise ConfigError(
-            f"--scheduler {address}: cannot connect: "
-            f"no Dask scheduler answered within {CONNECT_TIMEOUT_S} s"
+        raise OptionError.saying(
+            "scheduler",
+            f"{address}: cannot connect: no Dask scheduler answered within {CONNECT_TIMEOUT_S} s",
         ) from None
     except Exception as err:  # noqa: BLE001 - a bad address, a refusal, another protocol
-        raise ConfigError(f"--scheduler {address}: cannot connect: {_said(err)}") from None
+        raise OptionError.saying("scheduler", f"{address}: cannot connect: {_said(err)}") from None
     if not isinstance(info, dict) or info.get("type") != "Scheduler":
-        raise ConfigError(f"--scheduler {address}: answers, but not as a Dask scheduler")
+        raise OptionError.saying("scheduler", f"{address}: answers, but not as a Dask scheduler")
 
 
 def _wait_for_a_worker(client: Any, address: str, wait_s: float) -> None:
@@ -127,9 +139,10 @@ def _wait_for_a_worker(client: Any, address: str, wait_s: float) -> None:
     try:
         client.wait_for_workers(1, timeout=wait_s)
     except (TimeoutError, OSError):
-        raise ConfigError(
-            f"--scheduler {address}: no worker joined within {wait_s:g} s "
-            f"(start one: dask worker {address} --nthreads 1)"
+        raise OptionError.saying(
+            "scheduler",
+            f"{address}: no worker joined within {wait_s:g} s "
+            f"(start one: dask worker {address} --nthreads 1)",
         ) from None
 
 

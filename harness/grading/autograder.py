@@ -31,6 +31,7 @@ from typing import TYPE_CHECKING
 from harness.errors import ConfigError, one_line
 from harness.grading import LAB_EXECUTABLE, LAB_PACKAGE
 from harness.grading.student_text import for_students
+from harness.run_request.table import option
 
 if TYPE_CHECKING:
     from harness.grading.scoring import ScorePlan
@@ -96,7 +97,7 @@ def node_options(
     student = student_in(hand_in(submission, work), "submission")
     if student.kind == "script" and student.script is not None:
         command = f"{shlex.quote(sys.executable)} {shlex.quote(str(student.script.resolve()))}"
-        return ["--node", command]
+        return [option("node").cli, command]
     if student.kind in ("package", "workspace"):
         built = build_student(
             student,
@@ -108,14 +109,8 @@ def node_options(
         )
         if not built.ok:
             raise NotGraded(f"did not build: {built.error}")
-        return [
-            "--workspace",
-            str(built.workspace),
-            "--package",
-            package,
-            "--executable",
-            executable,
-        ]
+        given = {"workspace": str(built.workspace), "package": package, "executable": executable}
+        return [arg for key, value in given.items() for arg in (option(key).cli, value)]
     raise NotGraded(student.problem or "no node found")
 
 

@@ -42,6 +42,7 @@ from pydantic import (
 )
 
 from harness.errors import ConfigError
+from harness.option_names import named
 from harness.run_request import OPTIONS, OptionError, RunOption
 from harness.run_request.table import names
 from harness.scenario.files import SCENARIO_SUFFIXES
@@ -215,7 +216,7 @@ def load_grading_file(path: str | Path) -> GradingFile:
     """The grading file at `path`, validated, its scenario files made absolute; ConfigError
     (exit 2) naming the file and the first problem."""
     path = Path(path)
-    name = f"--grading {path}"
+    name = f"{named('grading')} {path}"
     text = read_text_file(path, limit=MAX_GRADING_FILE_BYTES, name=name, kind="grading file")
     try:
         raw = load_yaml(text)

@@ -22,6 +22,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from harness.errors import ConfigError
+from harness.option_names import named
 from harness.text_file import read_text_file
 
 __all__ = ["Roster", "RosterEntry", "load_roster"]
@@ -61,8 +62,9 @@ def _column(header: list[str], names: tuple[str, ...]) -> int | None:
     return None
 
 
-def parse_roster(text: str, source: str = "--roster") -> Roster:
+def parse_roster(text: str, source: str | None = None) -> Roster:
     """The roster in CSV `text`; ConfigError naming the line for anything ambiguous."""
+    source = source or named("roster")
     rows = list(csv.reader(io.StringIO(text.lstrip("\ufeff"))))  # Excel writes a BOM
     rows = [r for r in rows if any(cell.strip() for cell in r)]
     if not rows:
@@ -101,6 +103,6 @@ def parse_roster(text: str, source: str = "--roster") -> Roster:
 
 def load_roster(path: str | Path) -> Roster:
     """The roster file at `path`; ConfigError (exit 2) when it cannot be read or is ambiguous."""
-    source = f"--roster {path}"
+    source = f"{named('roster')} {path}"
     text = read_text_file(path, limit=MAX_ROSTER_BYTES, name=source, kind="roster (CSV)")
     return parse_roster(text, source)

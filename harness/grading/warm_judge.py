@@ -117,6 +117,10 @@ def serve(sandboxed: bool) -> int:
     CODE`` a line on the original stdout once judged and, sandboxed, once nothing of the
     student is left. Ends with stdin, or when a student's processes cannot be ended."""
     from harness.grading.worker import interrupt_on_sigterm, not_dumpable, run_job, warm_node_server
+    from harness.option_names import speak
+    from harness.run_request.table import names
+
+    speak(names("grading"))  # a student's problems name the options as the grading file does
 
     # The jobs and answers on fds of their own (not inherited): what the judge starts
     # (a node's reaper) gets /dev/null as its stdin and the job's log as its output.

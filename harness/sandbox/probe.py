@@ -12,13 +12,14 @@ import shutil
 import socket
 import subprocess
 
+from harness.option_names import named
 from harness.sandbox.bwrap import bwrap_argv
 from harness.sandbox.views import node_view, run_view
 
 __all__ = ["sandbox_problem", "NO_SANDBOX_HINT"]
 
 PROBE_TIMEOUT_S = 20.0
-NO_SANDBOX_HINT = "or grade with --no-sandbox (student code then runs with your rights)"
+NO_SANDBOX_HINT = "or grade with {no_sandbox} (student code then runs with your rights)"
 MISSING = (
     "grade runs each student's build and node in a bubblewrap sandbox, and bwrap is not "
     "installed{where}: install the bubblewrap package (apt install bubblewrap; dnf install "
@@ -36,7 +37,7 @@ def sandbox_problem() -> str | None:
     where = f" on {socket.gethostname()}"
     bwrap = shutil.which("bwrap")
     if bwrap is None:
-        return MISSING.format(where=where)
+        return MISSING.format(where=where, no_sandbox=named("no_sandbox"))
     inner = bwrap_argv(node_view([]), ["true"], bwrap=bwrap)
     outer = bwrap_argv(run_view([], [], []), inner, bwrap=bwrap)
     try:
@@ -48,8 +49,8 @@ def sandbox_problem() -> str | None:
             timeout=PROBE_TIMEOUT_S,
         )
     except (OSError, subprocess.TimeoutExpired) as err:
-        return REFUSED.format(where=where, said=str(err))
+        return REFUSED.format(where=where, said=str(err), no_sandbox=named("no_sandbox"))
     if done.returncode != 0:
         said = (done.stderr.strip().splitlines() or [f"exit code {done.returncode}"])[-1]
-        return REFUSED.format(where=where, said=said)
+        return REFUSED.format(where=where, said=said, no_sandbox=named("no_sandbox"))
     return None
