@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import io
 import math
+import threading
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -196,121 +197,148 @@ def _unwrapped_gaps(t: np.ndarray, angle: np.ndarray) -> tuple[np.ndarray, np.nd
     return np.insert(t, jumps, np.nan), np.insert(angle, jumps, np.nan)
 
 
+class _Canvas:
+    """One figure per process, its artists' data replaced for each plot: building the
+    figure, its axes and their ticks anew cost two thirds of every plot's time. Every
+    property a plot sets is set for each plot, so a PNG depends on its series only."""
+
+    def __init__(self) -> None:
+        from matplotlib.figure import Figure  # lazy: matplotlib takes a while to import
+
+        # Fixed margins, not a layout engine: "constrained" measured every text to place
+        # the axes and cost 40 % of the plot's time, paid for every scenario of every report.
+        self.fig = fig = Figure(figsize=(WIDTH_IN, HEIGHT_IN), dpi=DPI)
+        self.axes = top, middle, bottom = fig.subplots(
+            3, 1, sharex=True, gridspec_kw={"height_ratios": [3, 2, 1], **MARGINS}
+        )
+        self.title = fig.suptitle("", fontsize=10, **AS_WRITTEN)  # a name may hold "$"
+        self.failed = [self._spans(ax, FAILED_COLOUR) for ax in self.axes]
+        for ax in self.axes:
+            ax.grid(True, lw=0.4, alpha=0.5)
+            ax.tick_params(labelsize=8)
+        self.band = self._spans(bottom, "#dddddd")
+        orange, marker = "#e07b00", {"ms": 2.5, "color": "#e07b00"}
+        off_scale = {"ms": 4, "color": orange, "clip_on": False}
+        # Each line with its legend entry; an entry is shown while its line has data.
+        (self.nearest,) = top.plot([], [], color="#1f5fa8", lw=1.4)
+        self.threshold = top.axhline(0.0, color="#555555", ls="--", lw=1)
+        (self.claimed,) = top.plot([], [], "o", **marker)
+        (self.above,) = top.plot([], [], "^", **off_scale)
+        (self.gone,) = top.plot([], [], "x", ms=4, color="#777777", clip_on=False)
+        (self.failed_key,) = top.plot([], [], "s", color=FAILED_COLOUR)
+        top.set_ylabel("range, m", fontsize=8)
+        self.note = top.text(0.5, 0.5, "", transform=top.transAxes, ha="center", va="center")
+        self.note.set_fontsize(9)
+        (self.angle,) = middle.plot([], [], color="#1f5fa8", lw=1.4)
+        (self.angle_claimed,) = middle.plot([], [], "o", **marker)
+        (self.angle_off,) = middle.plot([], [], "^", **off_scale)
+        middle.set_ylim(-4.0, 4.0)
+        middle.set_yticks([-math.pi, 0, math.pi], ["-pi", "0", "pi"])
+        middle.set_ylabel("angle, rad", fontsize=8)
+        (self.expected,) = bottom.step([], [], where="mid", color="#2e8b57", lw=3, alpha=0.45)
+        (self.got,) = bottom.plot([], [], "o", ms=2.5, color="#222222")
+        (self.band_key,) = bottom.plot([], [], "s", color="#dddddd")
+        bottom.set_ylim(-0.3, 1.3)
+        bottom.set_yticks([0, 1], ["False", "True"])
+        bottom.set_ylabel("warning", fontsize=8)
+        bottom.set_xlabel("simulated time, s", fontsize=8)
+        self.keys = [
+            (self.nearest, "nearest valid return (seen)"),
+            (self.threshold, "threshold"),
+            (self.claimed, "node's distance"),
+            (self.above, "node's distance off the scale (or inf/nan)"),
+            (self.gone, "scan not delivered (link fault)"),
+            (self.failed_key, "failed tick"),
+            (self.angle, "expected angle"),
+            (self.angle_claimed, "node's angle"),
+            (self.angle_off, "node's angle beyond 2 pi (degrees?) or inf/nan"),
+            (self.expected, "warning expected"),
+            (self.got, "warning received"),
+            (self.band_key, "warning either accepted"),
+        ]
+        self.legends: dict[tuple[str, ...], Any] = {}  # one per set of entries shown
+
+    @staticmethod
+    def _spans(ax: Any, colour: str) -> Any:
+        """Bars the full height of `ax` (x in data, y in axes units), drawn by `draw`."""
+        return ax.broken_barh([], (0, 1), transform=ax.get_xaxis_transform(), color=colour, lw=0)
+
+    def _legend(self, shown: set[Any]) -> Any:
+        from matplotlib.legend import Legend
+
+        keys = [(line, label) for line, label in self.keys if line in shown]
+        labels = tuple(label for _, label in keys)
+        if labels not in self.legends:
+            style = {"loc": "lower center", "ncols": 4, "fontsize": 7, "frameon": False}
+            self.legends[labels] = Legend(self.fig, [k for k, _ in keys], list(labels), **style)
+        return self.legends[labels]
+
+    def draw(self, series: PlotSeries) -> bytes:
+        """The PNG bytes of `series` (deterministic: no software or date in the metadata)."""
+        top, middle, bottom = self.axes
+        t = series.t
+        self.title.set_text(series.title)
+        step = float(np.median(np.diff(t))) if t.size > 1 else 0.1
+        failed = _bars(_spans(t, series.failed))
+        for bars in self.failed:
+            bars.set_verts(failed)
+        band = _spans(t, np.isnan(series.warning_expected))
+        self.band.set_verts(_bars(band))
+
+        finite = np.concatenate([series.nearest[np.isfinite(series.nearest)], [series.threshold]])
+        ceiling = 1.15 * float(finite.max())
+        top.set_ylim(0, ceiling)
+        self.nearest.set_data(t, series.nearest)
+        self.threshold.set_ydata([series.threshold] * 2)
+        shown = np.isfinite(series.claimed) & (series.claimed <= ceiling)
+        above = (np.isfinite(series.claimed) & ~shown) | series.claimed_nonfinite
+        self.claimed.set_data(t[shown], series.claimed[shown])
+        self.above.set_data(t[above], np.full(int(above.sum()), ceiling * 0.985))
+        gone = series.not_delivered
+        self.gone.set_data(t[gone], np.zeros(int(gone.sum())))
+        self.angle.set_data(*_unwrapped_gaps(t, series.angle_expected))
+        self.angle_claimed.set_data(t, series.angle_claimed)
+        off = series.angle_off
+        self.angle_off.set_data(t[off], np.full(int(off.sum()), 3.9))
+        self.expected.set_data(t, series.warning_expected)
+        self.got.set_data(t, series.warning_got)
+
+        always = {self.nearest, self.threshold, self.claimed, self.angle, self.angle_claimed}
+        optional = {self.above: above, self.gone: gone, self.angle_off: off}
+        shown_keys = always | {self.expected, self.got}
+        shown_keys |= {line for line, mask in optional.items() if mask.any()}
+        if series.failed.any():
+            shown_keys.add(self.failed_key)
+        if band:
+            shown_keys.add(self.band_key)
+        self.fig.legends[:] = [self._legend(shown_keys)]
+        bottom.set_xlim(*((t[0] - step, t[-1] + step) if t.size else _EMPTY_XLIM))
+        note = "no ticks" if not t.size else ""
+        if t.size and np.isnan(series.nearest).all():
+            note = "no valid return in any scan: nothing in range"
+        self.note.set_text(note)
+
+        out = io.BytesIO()
+        self.fig.savefig(out, format="png", metadata={"Software": None})
+        return out.getvalue()
+
+
+def _bars(spans: list[tuple[float, float]]) -> list[list[tuple[float, float]]]:
+    """`spans` ((x, width) pairs) as the corners of full-height bars (y in axes units)."""
+    return [[(x, 0), (x, 1), (x + w, 1), (x + w, 0)] for x, w in spans]
+
+
+_EMPTY_XLIM = (-0.055, 0.055)  # what autoscaling gave a run without ticks
+_canvas: list[_Canvas] = []  # built by the first plot of the process
+_drawing = threading.Lock()  # one figure: one plot at a time
+
+
 def render_plot(series: PlotSeries) -> bytes:
     """The PNG bytes (deterministic: no software or date in the metadata)."""
-    from matplotlib.figure import Figure  # lazy: matplotlib takes a while to import
-
-    # Fixed margins, not a layout engine: "constrained" measured every text to place the
-    # axes and cost 40 % of the plot's time, paid for every scenario of every report.
-    fig = Figure(figsize=(WIDTH_IN, HEIGHT_IN), dpi=DPI)
-    top, middle, bottom = fig.subplots(
-        3,
-        1,
-        sharex=True,
-        gridspec_kw={"height_ratios": [3, 2, 1], **MARGINS},
-        squeeze=True,
-    )
-    fig.suptitle(series.title, fontsize=10, **AS_WRITTEN)  # a name may hold "$"
-    t = series.t
-    failed_spans = _spans(t, series.failed)
-    band_spans = _spans(t, np.isnan(series.warning_expected))
-    for ax in (top, middle, bottom):
-        if failed_spans:
-            ax.broken_barh(
-                failed_spans, (0, 1), transform=ax.get_xaxis_transform(), color=FAILED_COLOUR, lw=0
-            )
-        ax.grid(True, lw=0.4, alpha=0.5)
-        ax.tick_params(labelsize=8)
-
-    # Top: distances.
-    finite = np.concatenate([series.nearest[np.isfinite(series.nearest)], [series.threshold]])
-    ceiling = 1.15 * float(finite.max())
-    top.set_ylim(0, ceiling)
-    top.plot(t, series.nearest, color="#1f5fa8", lw=1.4, label="nearest valid return (seen)")
-    top.axhline(series.threshold, color="#555555", ls="--", lw=1, label="threshold")
-    shown = np.isfinite(series.claimed) & (series.claimed <= ceiling)
-    above = (np.isfinite(series.claimed) & ~shown) | series.claimed_nonfinite
-    top.plot(t[shown], series.claimed[shown], "o", ms=2.5, color="#e07b00", label="node's distance")
-    if above.any():
-        top.plot(
-            t[above],
-            np.full(int(above.sum()), ceiling * 0.985),
-            "^",
-            ms=4,
-            color="#e07b00",
-            clip_on=False,
-            label="node's distance off the scale (or inf/nan)",
-        )
-    gone = series.not_delivered
-    if gone.any():
-        top.plot(
-            t[gone],
-            np.zeros(int(gone.sum())),
-            "x",
-            ms=4,
-            color="#777777",
-            clip_on=False,
-            label="scan not delivered (link fault)",
-        )
-    if series.failed.any():
-        top.plot([], [], "s", color=FAILED_COLOUR, label="failed tick")
-    top.set_ylabel("range, m", fontsize=8)
-
-    # Middle: the angle of the nearest return.
-    middle.plot(
-        *_unwrapped_gaps(t, series.angle_expected), color="#1f5fa8", lw=1.4, label="expected angle"
-    )
-    middle.plot(t, series.angle_claimed, "o", ms=2.5, color="#e07b00", label="node's angle")
-    off = series.angle_off
-    if off.any():
-        middle.plot(
-            t[off],
-            np.full(int(off.sum()), 3.9),
-            "^",
-            ms=4,
-            color="#e07b00",
-            clip_on=False,
-            label="node's angle beyond 2 pi (degrees?) or inf/nan",
-        )
-    middle.set_ylim(-4.0, 4.0)
-    middle.set_yticks([-math.pi, 0, math.pi], ["-pi", "0", "pi"])
-    middle.set_ylabel("angle, rad", fontsize=8)
-
-    # Bottom: the warning Bool.
-    for x, width in band_spans:
-        bottom.axvspan(x, x + width, color="#dddddd", lw=0)
-    expected = series.warning_expected
-    bottom.step(t, expected, where="mid", color="#2e8b57", lw=3, alpha=0.45, label="expected")
-    bottom.plot(t, series.warning_got, "o", ms=2.5, color="#222222", label="received")
-    if band_spans:
-        bottom.plot([], [], "s", color="#dddddd", label="either accepted")
-    bottom.set_ylim(-0.3, 1.3)
-    bottom.set_yticks([0, 1], ["False", "True"])
-    bottom.set_ylabel("warning", fontsize=8)
-    bottom.set_xlabel("simulated time, s", fontsize=8)
-    handles, labels = top.get_legend_handles_labels()
-    turned, turned_labels = middle.get_legend_handles_labels()
-    more, more_labels = bottom.get_legend_handles_labels()
-    fig.legend(
-        handles + turned + more,
-        labels + turned_labels + [f"warning {x}" for x in more_labels],
-        loc="lower center",
-        ncols=4,
-        fontsize=7,
-        frameon=False,
-    )
-    if t.size:
-        step = float(np.median(np.diff(t))) if t.size > 1 else 0.1
-        bottom.set_xlim(t[0] - step, t[-1] + step)
-    note = "no ticks" if not t.size else ""
-    if t.size and np.isnan(series.nearest).all():
-        note = "no valid return in any scan: nothing in range"
-    if note:
-        top.text(0.5, 0.5, note, transform=top.transAxes, ha="center", va="center", fontsize=9)
-
-    out = io.BytesIO()
-    fig.savefig(out, format="png", metadata={"Software": None})
-    return out.getvalue()
+    with _drawing:
+        if not _canvas:
+            _canvas.append(_Canvas())
+        return _canvas[0].draw(series)
 
 
 def write_plot(path: Path, result: RunResult) -> Path:
