@@ -203,11 +203,13 @@ class _Canvas:
     property a plot sets is set for each plot, so a PNG depends on its series only."""
 
     def __init__(self) -> None:
+        from matplotlib.backends.backend_agg import FigureCanvasAgg
         from matplotlib.figure import Figure  # lazy: matplotlib takes a while to import
 
         # Fixed margins, not a layout engine: "constrained" measured every text to place
         # the axes and cost 40 % of the plot's time, paid for every scenario of every report.
         self.fig = fig = Figure(figsize=(WIDTH_IN, HEIGHT_IN), dpi=DPI)
+        self.canvas = FigureCanvasAgg(fig)
         self.axes = top, middle, bottom = fig.subplots(
             3, 1, sharex=True, gridspec_kw={"height_ratios": [3, 2, 1], **MARGINS}
         )
@@ -217,8 +219,8 @@ class _Canvas:
             ax.grid(True, lw=0.4, alpha=0.5)
             ax.tick_params(labelsize=8)
         self.band = self._spans(bottom, "#dddddd")
-        orange, marker = "#e07b00", {"ms": 2.5, "color": "#e07b00"}
-        off_scale = {"ms": 4, "color": orange, "clip_on": False}
+        marker = {"ms": 2.5, "color": "#e07b00"}
+        off_scale = {"ms": 4, "color": "#e07b00", "clip_on": False}
         # Each line with its legend entry; an entry is shown while its line has data.
         (self.nearest,) = top.plot([], [], color="#1f5fa8", lw=1.4)
         self.threshold = top.axhline(0.0, color="#555555", ls="--", lw=1)
@@ -227,8 +229,8 @@ class _Canvas:
         (self.gone,) = top.plot([], [], "x", ms=4, color="#777777", clip_on=False)
         (self.failed_key,) = top.plot([], [], "s", color=FAILED_COLOUR)
         top.set_ylabel("range, m", fontsize=8)
-        self.note = top.text(0.5, 0.5, "", transform=top.transAxes, ha="center", va="center")
-        self.note.set_fontsize(9)
+        centred = {"ha": "center", "va": "center", "fontsize": 9}
+        self.note = top.text(0.5, 0.5, "", transform=top.transAxes, **centred)
         (self.angle,) = middle.plot([], [], color="#1f5fa8", lw=1.4)
         (self.angle_claimed,) = middle.plot([], [], "o", **marker)
         (self.angle_off,) = middle.plot([], [], "^", **off_scale)
@@ -256,25 +258,38 @@ class _Canvas:
             (self.got, "warning received"),
             (self.band_key, "warning either accepted"),
         ]
-        self.legends: dict[tuple[str, ...], Any] = {}  # one per set of entries shown
+        # The figure without its axes and title, one per set of legend entries shown: the
+        # legend is the same picture each time and took a quarter of the plot's time.
+        self.backgrounds: dict[tuple[str, ...], Any] = {}
 
     @staticmethod
     def _spans(ax: Any, colour: str) -> Any:
         """Bars the full height of `ax` (x in data, y in axes units), drawn by `draw`."""
         return ax.broken_barh([], (0, 1), transform=ax.get_xaxis_transform(), color=colour, lw=0)
 
-    def _legend(self, shown: set[Any]) -> Any:
+    def _background(self, shown: set[Any]) -> Any:
+        """The figure's pixels with only the legend of the `shown` lines drawn."""
         from matplotlib.legend import Legend
 
         keys = [(line, label) for line, label in self.keys if line in shown]
         labels = tuple(label for _, label in keys)
-        if labels not in self.legends:
+        if labels not in self.backgrounds:
             style = {"loc": "lower center", "ncols": 4, "fontsize": 7, "frameon": False}
-            self.legends[labels] = Legend(self.fig, [k for k, _ in keys], list(labels), **style)
-        return self.legends[labels]
+            self.fig.legends[:] = [Legend(self.fig, [k for k, _ in keys], list(labels), **style)]
+            try:
+                for artist in (*self.axes, self.title):
+                    artist.set_visible(False)
+                self.canvas.draw()
+                self.backgrounds[labels] = self.canvas.copy_from_bbox(self.fig.bbox)
+            finally:
+                for artist in (*self.axes, self.title):
+                    artist.set_visible(True)
+        return self.backgrounds[labels]
 
     def draw(self, series: PlotSeries) -> bytes:
         """The PNG bytes of `series` (deterministic: no software or date in the metadata)."""
+        from matplotlib.image import imsave
+
         top, middle, bottom = self.axes
         t = series.t
         self.title.set_text(series.title)
@@ -311,15 +326,19 @@ class _Canvas:
             shown_keys.add(self.failed_key)
         if band:
             shown_keys.add(self.band_key)
-        self.fig.legends[:] = [self._legend(shown_keys)]
+        background = self._background(shown_keys)
         bottom.set_xlim(*((t[0] - step, t[-1] + step) if t.size else _EMPTY_XLIM))
         note = "no ticks" if not t.size else ""
         if t.size and np.isnan(series.nearest).all():
             note = "no valid return in any scan: nothing in range"
         self.note.set_text(note)
 
+        self.canvas.restore_region(background)
+        renderer = self.canvas.get_renderer()
+        for artist in (*self.axes, self.title):  # drawn as Figure.draw orders them
+            artist.draw(renderer)
         out = io.BytesIO()
-        self.fig.savefig(out, format="png", metadata={"Software": None})
+        imsave(out, self.canvas.buffer_rgba(), format="png", dpi=DPI, metadata={"Software": None})
         return out.getvalue()
 
 

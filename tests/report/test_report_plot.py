@@ -76,14 +76,16 @@ def test_series_use_the_scan_the_node_saw() -> None:
     assert s.failed.tolist() == [False, True]
 
 
-def test_plot_is_a_small_deterministic_png(passing: RunResult) -> None:
-    """A real PNG of a readable size, a few tens of kB, the same bytes every time."""
+def test_plot_is_a_small_deterministic_png(passing: RunResult, failing: RunResult) -> None:
+    """A real PNG of a readable size, a few tens of kB, the same bytes every time, whatever
+    the process drew before (its one figure is redrawn for each plot)."""
     png = render_plot(plot_series(passing))
     assert png[:8] == b"\x89PNG\r\n\x1a\n"
     width, height = struct.unpack(">II", png[16:24])
     assert 600 <= width <= 1000 and 300 <= height <= 600
     assert 10_000 < len(png) < 100_000
     assert b"Software" not in png and b"matplotlib" not in png
+    assert render_plot(plot_series(failing)) != png  # other data, other legend entries
     assert render_plot(plot_series(passing)) == png
 
 
