@@ -232,10 +232,17 @@ warning_rule = row_type("warning_when_clear")
 
 def request_of(args: argparse.Namespace, *, check: bool = True) -> RunRequest:
     """The run request the command line makes (each of the table's options the command
-    has), checked unless `check` is False; ConfigError naming the flags."""
+    has), the grading file's values (``args.under``, by key) under what the user typed,
+    checked unless `check` is False; ConfigError naming the flags."""
     present = [row for row in OPTIONS if row.cli is not None and hasattr(args, row.dest)]
     typed = getattr(args, "given", frozenset())
-    values = {row.key: getattr(args, row.dest) for row in present}
+    under = getattr(args, "under", {})
+    values = {
+        row.key: under[row.key]
+        if row.key in under and row.dest not in typed
+        else getattr(args, row.dest)
+        for row in present
+    }
     if values.get("launch") is not None:
         values["launch"] = tuple(values["launch"])
     try:
@@ -376,10 +383,11 @@ def check_link_options(args: argparse.Namespace) -> LinkOptions:
 
 def check_status_regex(args: argparse.Namespace) -> None:
     """A bad regex is a usage error now, not a failure on every tick."""
-    if args.status_regex:
+    pattern = request_of(args, check=False).status_regex
+    if pattern:
         from harness.judge.status import parse_status
 
-        parse_status("", args.status_regex)
+        parse_status("", pattern)
 
 
 def check_output_file(option: str, path: str | None) -> None:

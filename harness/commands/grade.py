@@ -29,6 +29,7 @@ from harness.commands.arguments import (
     given,
     judging_settings,
     link_options,
+    request_of,
 )
 from harness.commands.cluster_options import add_cluster_options, describe_cluster, workers
 from harness.commands.sandbox_options import add_sandbox_options, check_workers, sandbox_limits
@@ -45,6 +46,7 @@ if TYPE_CHECKING:  # imported when grading starts (the parser is built for any c
     from harness.grading.grading_file import GradebookSettings, GradingFile
     from harness.grading.roster import Roster
     from harness.grading.scoring import ScorePlan
+    from harness.run_request import RunRequest
     from harness.scenario.schema import Scenario
 
 NAME = "grade"
@@ -148,15 +150,15 @@ def _adapt_node_options(parser: argparse.ArgumentParser) -> None:
             group.title = "each student's node"
 
 
-def check_grading_options(args: argparse.Namespace) -> None:
+def check_grading_options(args: argparse.Namespace, request: RunRequest) -> None:
     """Options `run` takes that make no sense for a class are mistakes, not ignored."""
     for name, why in NOT_FOR_GRADING.items():
         if getattr(args, name):
             raise ConfigError(f"--{name.replace('_', '-')} does not apply to grade: {why}")
-    if args.link not in NODE_LINKS:
+    if request.link not in NODE_LINKS:
         known = ", ".join(NODE_LINKS)
-        raise ConfigError(f"--link {args.link}: grade runs students' nodes (use {known})")
-    if not args.package or not args.executable:
+        raise ConfigError(f"--link {request.link}: grade runs students' nodes (use {known})")
+    if not request.package or not request.executable:
         raise ConfigError("--package and --executable must name the lab's node")
 
 
@@ -185,8 +187,9 @@ def _distinct(scenarios: list[Scenario]) -> list[Scenario]:
 
 
 def apply_grading_file(args: argparse.Namespace) -> GradingFile | None:
-    """The grading file of --grading, its options set on `args` where the user typed none;
-    None without one. Its scenarios replace --scenario (both given: a usage error)."""
+    """The grading file of --grading, its options under the typed ones (``args.under``, which
+    `request_of` reads); None without one. Its scenarios replace --scenario (both given: a
+    usage error)."""
     from harness.grading.grading_file import load_grading_file
 
     if not args.grading:
@@ -197,7 +200,7 @@ def apply_grading_file(args: argparse.Namespace) -> GradingFile | None:
             f"--scenario and --grading {args.grading}: the grading file lists the scenarios "
             "(give one of them)"
         )
-    grading.apply_to(args, typed=getattr(args, "given", frozenset()))
+    args.under = grading.request_values()
     return grading
 
 
@@ -304,7 +307,8 @@ def run(args: argparse.Namespace, console: Console) -> int:
     from harness.runner.settings import check_settings
 
     grading = apply_grading_file(args)  # its options count as typed where none was
-    check_grading_options(args)
+    request = request_of(args, check=False)
+    check_grading_options(args, request)
     check_cluster_options(args.scheduler, args.workers)
     options = link_options(args)  # topics and parameters: refused now, before any folder
     scenarios, plan = graded_scenarios(args, grading)
@@ -350,7 +354,7 @@ def run(args: argparse.Namespace, console: Console) -> int:
         config = GradeConfig(
             scenarios=names,
             scenario_refs=tuple(s.source or s.name for s in scenarios),
-            link=args.link,
+            link=request.link,
             options=options,
             settings=settings,
             students_dir=out.resolve() / "students",  # workers run in their student's folder
@@ -371,7 +375,7 @@ def run(args: argparse.Namespace, console: Console) -> int:
         count = len(found.students)
         console.print(
             f"grading {count} student{'s' if count != 1 else ''} on {len(names)} scenario"
-            f"{'s' if len(names) != 1 else ''} over {args.link} "
+            f"{'s' if len(names) != 1 else ''} over {request.link} "
             f"{describe_cluster(args.scheduler, args.workers)}, into {out}",
             markup=False,
             highlight=False,
@@ -403,11 +407,14 @@ def run(args: argparse.Namespace, console: Console) -> int:
         meta = [
             ("scenarios", ", ".join(names)),
             ("score", _score_words(plan)),
-            ("link", args.link),
-            ("package students", f"{args.package}/{args.executable}"),
-            ("seed", "per scenario" if args.seed is None else str(args.seed)),
-            ("threshold", "per scenario" if args.threshold is None else f"{args.threshold:g} m"),
-            ("warning when clear", args.warning_when_clear or "per scenario (optional)"),
+            ("link", request.link),
+            ("package students", f"{request.package}/{request.executable}"),
+            ("seed", "per scenario" if request.seed is None else str(request.seed)),
+            (
+                "threshold",
+                "per scenario" if request.threshold is None else f"{request.threshold:g} m",
+            ),
+            ("warning when clear", request.warning_when_clear or "per scenario (optional)"),
             ("graded", time.strftime("%Y-%m-%d %H:%M")),
         ]
         csv_path = write_atomically(

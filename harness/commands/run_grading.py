@@ -21,7 +21,7 @@ from typing import TYPE_CHECKING
 
 from rich.console import Console
 
-from harness.commands.arguments import check_output_file, given
+from harness.commands.arguments import check_output_file, given, request_of
 from harness.errors import ConfigError
 from harness.judge.verdicts import RunVerdict
 
@@ -65,8 +65,9 @@ def add_grading_options(parser: argparse.ArgumentParser) -> None:
 
 
 def apply_grading(args: argparse.Namespace) -> RunGrading:
-    """--grading's file read, its scenarios and options set on `args` (where the user typed
-    none), and --gradescope's FILE checked: all before anything runs."""
+    """--grading's file read, its scenarios set on `args` and its options under the typed
+    ones (``args.under``, which `request_of` reads), and --gradescope's FILE checked: all
+    before anything runs."""
     gradescope = getattr(args, "gradescope", None)
     check_output_file("--gradescope", gradescope)
     if gradescope and args.watch:
@@ -84,7 +85,8 @@ def apply_grading(args: argparse.Namespace) -> RunGrading:
         )
     # the lab's node in a workspace; a --node or the reference node runs otherwise
     skip = () if args.workspace else NODE_IN_WORKSPACE
-    grading.apply_to(args, typed=getattr(args, "given", frozenset()), skip=skip)
+    args.under = {k: v for k, v in grading.request_values().items() if k not in skip}
+    args.link = request_of(args, check=False).link  # run, run_steps, run_watch read args.link
     args.scenarios = [p.scenario for p in grading.planned]
     if any(p.hidden for p in grading.planned):
         for name, why in SHOWS_HIDDEN.items():

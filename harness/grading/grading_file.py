@@ -26,7 +26,7 @@ inside a student's folder.
 
 from __future__ import annotations
 
-from collections.abc import Collection, Sequence
+from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal
 
@@ -172,25 +172,6 @@ class GradingFile(_RunOptions):  # type: ignore[valid-type, misc]
             for name, row in RUN_FIELDS.items()
             if getattr(self, name) is not None
         }
-
-    def apply_to(self, args: Any, *, typed: Collection[str], skip: Collection[str] = ()) -> None:
-        """Set the file's options on an argparse namespace, except those the user typed
-        (the command line wins) and those in `skip`."""
-        for name, value in self.judging_options().items():
-            if name not in typed and name not in skip:
-                setattr(args, name, value)
-
-    def judging_options(self) -> dict[str, Any]:
-        """The options the file sets, by their command-line names (faults as --faults
-        text), from the run request's table."""
-        from harness.run_request import option
-
-        options = {}
-        for key, value in self.request_values().items():
-            if key == "faults" and not isinstance(value, str):
-                value = ",".join(value)
-            options[option(key).dest] = value
-        return options
 
 
 def _expanded(ref: str, where: str) -> str:

@@ -85,7 +85,7 @@ def test_the_grading_file_names_files_relative_to_itself(tmp_path: Path) -> None
     assert first.scenario == "approach_wall"
     assert second.scenario == str((tmp_path / "course" / "hidden" / "corridor.yaml").resolve())
     assert (second.hidden, second.label, second.weight) == (True, "hidden 1", 3.0)
-    assert loaded.judging_options() == {"threshold": 0.4, "faults": "dropouts"}
+    assert loaded.request_values() == {"threshold": 0.4, "faults": ["dropouts"]}
 
 
 @pytest.mark.parametrize(

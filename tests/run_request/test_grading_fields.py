@@ -38,9 +38,8 @@ def test_a_bad_run_option_names_its_field(tmp_path: Path, text: str, says: str) 
 
 
 def test_the_files_values_are_request_values(tmp_path: Path) -> None:
-    """By the request's keys (timeout is scan_timeout), and for argparse by its flags."""
+    """By the request's keys (timeout is scan_timeout)."""
     path = tmp_path / "grading.yaml"
     path.write_text("scenarios: [a]\ntimeout: 2\nfaults: [noisy, dropouts]\n", encoding="utf-8")
     loaded = load_grading_file(path)
     assert loaded.request_values() == {"scan_timeout": 2.0, "faults": ["noisy", "dropouts"]}
-    assert loaded.judging_options() == {"timeout": 2.0, "faults": "noisy,dropouts"}
