@@ -169,19 +169,6 @@ def _unfinished_reason(finished: Finished, config: GradeConfig) -> str:
     return f"the test run crashed (exit code {finished.returncode}; see run.log)"
 
 
-def verdicts_from(
-    data: dict[str, Any],
-    finished: Finished,
-    config: GradeConfig,
-    folder: Path,
-    command: str | None = None,
-) -> tuple[dict[str, str], str]:
-    """Each scenario's verdict and the first failure in words, from the worker's results."""
-    verdicts, failures = verdicts_and_failures(data, finished, config, folder, command)
-    first = next((failures[n] for n in config.scenarios if n in failures), "")
-    return verdicts, first
-
-
 def verdicts_and_failures(
     data: dict[str, Any],
     finished: Finished,

@@ -7,7 +7,7 @@ from typing import Any
 
 import pytest
 
-from harness.grading.grade import GradeConfig, verdicts_from
+from harness.grading.grade import GradeConfig, verdicts_and_failures
 from harness.grading.process import Finished
 from harness.links.base import LinkOptions
 from harness.runner.settings import RunSettings
@@ -29,6 +29,12 @@ EXITED = Finished(returncode=0, wall_s=1.0)
 
 def entry(scenario: str, verdict: str, **more: Any) -> dict[str, Any]:
     return {"scenario": scenario, "verdict": verdict, **more}
+
+
+def verdicts_from(*args: Any) -> tuple[dict[str, str], str]:
+    """Each scenario's verdict and the first failure a student reads, in the suite's order."""
+    verdicts, failures = verdicts_and_failures(*args)
+    return verdicts, next((failures[n] for n in SCENARIOS if n in failures), "")
 
 
 @pytest.mark.parametrize(
