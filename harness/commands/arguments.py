@@ -1,14 +1,10 @@
 """Argument types and option groups shared by the commands that run scenarios.
 
-The run options come from the run request's table (harness.run_request):
-`add_row` adds one row's flag, type, default and help, and notes in
-``args.given`` that the user typed it; `request_of` makes the command line's
-`RunRequest`, whose checks word their errors with the flags. Every type
-turns bad input into a one-line argparse error (exit 2). The
-checks of the names and parameters a node gets (a topic used twice, a
-parameter that would set the threshold behind the oracle's back) are
-`harness.commands.node_names`, which the pytest plugin calls too; which
-link takes which option comes from the link table (harness.links.kinds).
+The run options are the run request's table's rows (`add_row`, which notes
+in ``args.given`` what the user typed); `request_of` makes the command line's
+`RunRequest`. Every type turns bad input into a one-line argparse error
+(exit 2); a node's names and parameters are checked by
+`harness.commands.node_names`, which the pytest plugin calls too.
 """
 
 from __future__ import annotations
@@ -356,11 +352,8 @@ lidar_mount = row_type("lidar_mount")
 
 
 def link_options(args: argparse.Namespace) -> LinkOptions:
-    """Link settings from the command line (the runner fills in the threshold), checked.
-
-    ConfigError names the option when a topic or parameter cannot work
-    (`checked_node_options`); topics come back fully qualified.
-    """
+    """Link settings from the command line, topics and parameters checked
+    (`checked_node_options`); the runner fills in the threshold."""
     return checked_node_options(unchecked_link_options(args))
 
 

@@ -231,12 +231,9 @@ def check_out(out: Path) -> None:
 
 
 def prepare_out(out: Path) -> HolderLock:
-    """Create (or reuse) the output folder, marked as ours, without last time's students.
-
-    The folder is locked before anything in it changes (report.folder_lock):
-    a second grade (or run) into it is refused, naming this one, until the
-    returned lock is released.
-    """
+    """Create (or reuse) the output folder, marked as ours, without last time's students;
+    locked first (report.folder_lock): a second grade or run into it is refused until the
+    returned lock is released."""
     check_out(out)
     try:
         out.mkdir(parents=True, exist_ok=True)

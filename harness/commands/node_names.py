@@ -93,13 +93,9 @@ def check_parameters(
 
 
 def checked_node_options(options: LinkOptions, names: Mapping[str, str] = CLI_NAMES) -> LinkOptions:
-    """`options` with fully qualified topics, once its names and parameters can work.
-
-    ConfigError, one line naming the option as `names` calls it, for a
-    topic or parameter name ROS 2 refuses, two of the scan, status and
-    warning topics that are one topic (after resolving ``scan`` to
-    ``/scan``), or a parameter `check_parameters` refuses.
-    """
+    """`options` with fully qualified topics; ConfigError naming the option (as `names`
+    calls it) for a name ROS 2 refuses, two topics that are one (``scan`` is ``/scan``),
+    or a parameter `check_parameters` refuses."""
     topics = {field: topic_option(names[field], getattr(options, field)) for field in TOPIC_FIELDS}
     first_with: dict[str, str] = {}
     for field, topic in topics.items():

@@ -453,15 +453,13 @@ def grade_class(
 ) -> list[StudentGrade]:
     """Every student's row, in the order given, each graded as a task on `client`'s cluster.
 
-    Students go to the cluster only as workers free up (harness.cluster.window),
-    so a worker holds only the student it grades. Open the client with
-    ``retries=WORKER_RETRIES``: a student whose grading kills its worker is
-    then run once more elsewhere (a worker can die for reasons of its own)
-    before their row says so. With `config.defer_plots`, it returns once every
-    worker has drawn its students' plots (bounded). `on_graded` gets each row as it comes, with
-    how many students are being graded then. On Ctrl-C (or SIGTERM) the
-    running builds and suites are stopped, each within its bounded grace,
-    before KeyboardInterrupt goes on up.
+    Students go out only as workers free up (harness.cluster.window), so a worker
+    holds only the student it grades. Open the client with ``retries=WORKER_RETRIES``:
+    a student whose grading kills its worker runs once more elsewhere (a worker can die
+    for reasons of its own) before their row says so. With `config.defer_plots` it
+    returns once every worker drew its plots (bounded). `on_graded` gets each row, with
+    how many are being graded; on Ctrl-C or SIGTERM the running builds and suites stop,
+    each within its bounded grace, before KeyboardInterrupt goes up.
     """
     from harness.cluster.flag import ClusterFlag
     from harness.cluster.window import Window
