@@ -22,7 +22,7 @@ from harness.commands.node_names import checked_node_options
 from harness.errors import ConfigError
 from harness.links.base import LinkOptions
 from harness.links.kinds import default_link, either, link_kind, link_names, serial_links
-from harness.run_request import OPTIONS, OptionError, RunRequest, option, table, values
+from harness.run_request import OPTIONS, OptionError, RunRequest, option, values
 from harness.run_request.request import check_port as request_check_port
 from harness.run_request.table import names as option_names
 from harness.safe_text import shown
@@ -30,7 +30,6 @@ from harness.safe_text import shown
 if TYPE_CHECKING:
     from harness.runner.settings import RunSettings
 
-MAX_WAIT_S = values.MAX_WAIT_S
 #: How every command shows a --faults value: a profile name or an inline fault, comma-separated.
 FAULTS_METAVAR = option("faults").metavar
 
@@ -62,7 +61,7 @@ def whole_number(kind: str, low: int, high: int | None = None) -> Callable[[str]
 def duration(kind: str) -> Callable[[str], float]:
     """Seconds to wait for something: positive, at most a day (the OS's timed waits
     overflow somewhere past 24 days; no wait of the harness needs more than a day)."""
-    return positive(kind, MAX_WAIT_S)
+    return positive(kind, values.MAX_WAIT_S)
 
 
 def row_type(key: str) -> Callable[[str], Any] | None:
@@ -73,7 +72,6 @@ def row_type(key: str) -> Callable[[str], Any] | None:
 
 seed = row_type("seed")
 domain_id = row_type("domain_id")
-param = row_type("params")
 
 
 def name_list(text: str) -> list[str]:
@@ -220,10 +218,6 @@ def add_scenario_overrides(parser: argparse.ArgumentParser) -> None:
     """--seed and --faults: the same scenarios under other fault draws or profiles."""
     add_row(parser, "seed")
     add_row(parser, "faults")
-
-
-WARNING_RULES = table.WARNING_RULES
-warning_rule = row_type("warning_when_clear")
 
 
 def request_of(args: argparse.Namespace, *, check: bool = True) -> RunRequest:

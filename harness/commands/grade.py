@@ -245,18 +245,15 @@ def prepare_out(out: Path) -> HolderLock:
     except OSError as err:
         lock.release()
         raise ConfigError(f"--out {out}: {err.strerror or err}") from None
-    for earlier in ("students", "grader"):  # last time's students
+    for earlier in ("students", "grader", "unpacked"):  # last time's students, their archives
         shutil.rmtree(out / earlier, ignore_errors=True)
-    shutil.rmtree(out / "unpacked", ignore_errors=True)  # and their archives' contents
     return lock
 
 
-def _graded_line(student: Student, grade: object) -> str:
+def _graded_line(student: Student, grade: StudentGrade) -> str:
     """One line per student as their row comes in."""
-    from harness.grading.class_table import StudentGrade
     from harness.safe_text import for_terminal
 
-    assert isinstance(grade, StudentGrade)
     parts = [student.kind]
     if grade.build_s is not None:
         built = not grade.first_failure.startswith("did not build")
@@ -270,16 +267,10 @@ def _graded_line(student: Student, grade: object) -> str:
     return f"  {name}: {', '.join(parts)}"
 
 
-def _all_passed(grade: object) -> bool:
-    from harness.grading.class_table import PASS, StudentGrade
+def _all_passed(grade: StudentGrade) -> bool:
+    from harness.grading.class_table import PASS
 
-    assert isinstance(grade, StudentGrade)
     return bool(grade.verdicts) and all(v == PASS for v in grade.verdicts.values())
-
-
-def _show_dashboard(console: Console, link: str | None) -> None:
-    if link:
-        console.print(f"Dask dashboard: {link}", markup=False, highlight=False)
 
 
 def run(args: argparse.Namespace, console: Console) -> int:
@@ -384,13 +375,15 @@ def run(args: argparse.Namespace, console: Console) -> int:
                 markup=False,
                 highlight=False,
             )
-        _show_dashboard(console, dashboard(client))
+        address = dashboard(client)
+        if address:
+            console.print(f"Dask dashboard: {address}", markup=False, highlight=False)
         started = time.monotonic()
         with task_progress(console, "students", failed="not all passed") as progress:
             bar = add_task(progress, "students", count)
             failed = 0
 
-            def graded(student: Student, grade: object, running: int) -> None:
+            def graded(student: Student, grade: StudentGrade, running: int) -> None:
                 nonlocal failed
                 failed += not _all_passed(grade)
                 progress.console.print(_graded_line(student, grade), markup=False, highlight=False)
