@@ -126,11 +126,8 @@ class Entry:
 
 @dataclass
 class Discovery:
-    """The students found, the archives still to unpack, and what was passed over (with why).
-
-    `students` are the folder (and loose file) students, named among themselves;
-    archives.unpack_submissions names them again together with the archives' students.
-    """
+    """The students found, the archives still to unpack, and what was passed over (with why);
+    archives.unpack_submissions names `students` again together with the archives' ones."""
 
     students: list[Student] = field(default_factory=list)
     skipped: list[str] = field(default_factory=list)
@@ -415,12 +412,9 @@ def add_folder(
     file: str = "",
     exclude: Path | None = None,
 ) -> None:
-    """A folder given to grade (or a class archive unpacked), into `result`.
-
-    One student (`name`, found in `where`) when the folder is one hand-in;
-    otherwise each entry is: a subfolder a student, an archive a student to
-    unpack, another file a row saying why it is not graded.
-    """
+    """A folder given to grade (or a class archive unpacked), into `result`: one student
+    (`name`, found in `where`) when it is one hand-in; otherwise a subfolder is a student,
+    an archive a student to unpack, another file a row saying why it is not graded."""
     if _is_single_student(folder):
         result.entries.append(Entry(where, name, folder, file=file))
         return

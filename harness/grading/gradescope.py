@@ -76,15 +76,10 @@ def gradescope_results(
     output: str = "",
     hidden_names: Mapping[str, str] | None = None,
 ) -> dict[str, Any]:
-    """results.json's object for one submission.
-
-    `verdicts`: scenario name -> PASS, FAIL, ERROR or NOT RUN (missing: NOT RUN);
-    `ticks`: scenario -> (ticks held, ticks it should have run), for partial credit
-    and the output; `failures`: scenario -> its first failure in words; `notes`
-    (e.g. a launch file's problems) and `output` go into the top-level output.
-    `hidden_names` adds what else students must not read (e.g. a hidden scenario's
-    file path -> its label) to the hidden scenarios' names, which are always replaced.
-    """
+    """results.json's object for one submission. `verdicts` (missing: NOT RUN), `ticks`
+    (held, planned) and `failures` by scenario; `notes` and `output` go into the top-level
+    output; `hidden_names` adds what else students must not read (a hidden scenario's file
+    path -> its label) to the hidden scenarios' names, which are always replaced."""
     hidden = {s.name: s.shown_name for s in plan.scenarios if s.hidden}
     hidden.update(hidden_names or {})
     tests = []
