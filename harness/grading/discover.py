@@ -1,28 +1,8 @@
 """Which folders are students, and what each one handed in (pure: files only).
 
-The rules, also in docs/grading.md:
-
-- A folder given on the command line is **one student** when it is itself a
-  colcon workspace or package, or when it has no subfolders and holds one
-  node script. Otherwise **each subfolder is a student**, and **each archive**
-  (.zip, .tar.gz, .tgz, .tar, ...) is a student named after the archive, to be
-  unpacked once the output folder is the grader's (harness.grading.archives).
-  Any other file is a student with the reason it is not graded. Hidden
-  entries, file managers' litter (__MACOSX, Thumbs.db) and the grader's own
-  output folder are passed over. An archive given on the command line is
-  read as the folder it unpacks to.
-- A student folder is a **package** when it has a package.xml at its top; a
-  **workspace** when package.xml files sit below it (only under src/ if it
-  has one; build/, install/, log/, hidden folders and folders holding a
-  COLCON_IGNORE are never searched, at most four levels deep); a **script**
-  when it has no package.xml and top-level .py files, one of which is the
-  node (`node_script`: the lab's fossbot_lidar_node.py, else the one whose
-  __main__ guard starts a node, else the one that imports rclpy; the others
-  are its helper modules). Anything else is still a student, with the reason
-  there is nothing to run.
-- Nothing handed in at all (no folder, no archive: an empty DIR, or only
-  loose files) is a usage error: the DIR is likely the wrong one. A class
-  whose hand-ins cannot run is graded: a row each, with its reason.
+The rules (one student or a folder of them; package, workspace or script; which
+script is the node; what is passed over, and when nothing handed in is a usage
+error) are docs/grading.md's "What counts as a student".
 """
 
 from __future__ import annotations
