@@ -38,7 +38,7 @@ __all__ = ["PLOT_WAIT_S", "PlotRequests", "Plotter", "draw_requested", "plots_dr
 REQUEST_SUFFIX = ".plot.json"
 DONE = b"done\n"
 # For a worker's plots once its last student is graded: a student's seven plots take
-# about 1.5 CPU-s, and a worker may have several students' left on a loaded machine.
+# about 0.5 CPU-s, and a worker may have several students' left on a loaded machine.
 PLOT_WAIT_S = 120.0
 _PNG_NAME = re.compile(r"[A-Za-z0-9_-][A-Za-z0-9._-]*\.png")
 
