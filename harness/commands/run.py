@@ -175,7 +175,7 @@ def run(args: argparse.Namespace, console: Console) -> int:
 def _run(
     args: argparse.Namespace, console: Console, baseline: Baseline | None, grading: RunGrading
 ) -> int:
-    options, scenarios = prepared(args)
+    link, options, scenarios = prepared(args)
     grading.bind(scenarios)
     from harness.judge.alignment import run_alignment
     from harness.report.progress import RunProgress
@@ -185,7 +185,7 @@ def _run(
     from harness.runner.suite import run_suite
     from harness.watch.verdict_cache import verdict_cache
 
-    cache = verdict_cache(args.link, options)
+    cache = verdict_cache(link, options)
     if args.failed_first:
         scenarios = ordered_by_last_run(console, scenarios, cache.failed())
     report = open_report(args.out, animate=args.animate)
@@ -210,7 +210,7 @@ def _run(
         try:
             results = run_suite(
                 scenarios,
-                args.link,
+                link,
                 options,
                 settings_from(args),
                 on_tick=progress.on_tick,

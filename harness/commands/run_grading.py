@@ -21,7 +21,7 @@ from typing import TYPE_CHECKING
 
 from rich.console import Console
 
-from harness.commands.arguments import check_output_file, given, request_of
+from harness.commands.arguments import check_output_file, given
 from harness.errors import ConfigError
 from harness.judge.verdicts import RunVerdict
 
@@ -86,7 +86,6 @@ def apply_grading(args: argparse.Namespace) -> RunGrading:
     # the lab's node in a workspace; a --node or the reference node runs otherwise
     skip = () if args.workspace else NODE_IN_WORKSPACE
     args.under = {k: v for k, v in grading.request_values().items() if k not in skip}
-    args.link = request_of(args, check=False).link  # run, run_steps, run_watch read args.link
     args.scenarios = [p.scenario for p in grading.planned]
     if any(p.hidden for p in grading.planned):
         for name, why in SHOWS_HIDDEN.items():

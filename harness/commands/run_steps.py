@@ -13,6 +13,7 @@ from harness.commands.arguments import (
     check_output_file,
     check_status_regex,
     judging_settings,
+    request_of,
     unchecked_link_options,
 )
 from harness.errors import ConfigError
@@ -62,13 +63,19 @@ def scenario_of(scenarios: Sequence[Scenario]) -> Callable[[RunResult], Scenario
     return lookup
 
 
-def prepared(args: argparse.Namespace) -> tuple[LinkOptions, list[Scenario]]:
-    """The checked link options and scenarios of a run, every check done before a report
+def run_link(args: argparse.Namespace) -> str:
+    """The run's link: the one typed, else the grading file's, else the default."""
+    return request_of(args, check=False).link
+
+
+def prepared(args: argparse.Namespace) -> tuple[str, LinkOptions, list[Scenario]]:
+    """The link, checked link options and scenarios of a run, every check done before a report
     folder exists. The node's fork server (if any) starts first: it takes a while, in
     another process, while the checks run."""
     from harness.links.base import link_class
 
-    link_class(args.link).prepare(unchecked_link_options(args))
+    link = run_link(args)
+    link_class(link).prepare(unchecked_link_options(args))
     options = check_link_options(args)
     scenarios = selected(args.scenarios)
     check_output_file("--junit-xml", args.junit_xml)
@@ -76,7 +83,7 @@ def prepared(args: argparse.Namespace) -> tuple[LinkOptions, list[Scenario]]:
     from harness.runner.settings import check_settings
 
     check_settings(scenarios, settings_from(args))
-    return options, scenarios
+    return link, options, scenarios
 
 
 def write_report_file(option: str, writer: Callable[..., T], *args: Any, **kwargs: Any) -> T:

@@ -17,6 +17,7 @@ from harness.commands.arguments import unchecked_link_options
 from harness.commands.run_steps import (
     open_report,
     prepared,
+    run_link,
     scenario_of,
     selected,
     settings_from,
@@ -37,13 +38,13 @@ if TYPE_CHECKING:
 __all__ = ["watch", "watch_sources"]
 
 
-def watch_sources(args: argparse.Namespace, options: LinkOptions) -> NodeSources:
+def watch_sources(args: argparse.Namespace, link: str, options: LinkOptions) -> NodeSources:
     """The node's files and the scenario files given by path; ConfigError when none."""
     from harness.watch.sources import node_sources, scenario_sources
 
-    sources = node_sources(args.link, options).plus(scenario_sources(args.scenarios))
+    sources = node_sources(link, options).plus(scenario_sources(args.scenarios))
     if not sources.watched:
-        runs_node = link_kind(args.link).runs_node
+        runs_node = link_kind(link).runs_node
         what = "node" if runs_node else "processing function"
         given = (
             "--processor FILE.py:FUNCTION"
@@ -59,12 +60,13 @@ def watch_sources(args: argparse.Namespace, options: LinkOptions) -> NodeSources
 
 def watch(args: argparse.Namespace, console: Console) -> int:
     """Run, then run again on every change, until Ctrl-C (130) or SIGTERM (143)."""
-    sources = watch_sources(args, unchecked_link_options(args))  # before anything starts
+    link = run_link(args)
+    sources = watch_sources(args, link, unchecked_link_options(args))  # before anything starts
     if sources.build is not None:
         from harness.grading.build import colcon_executable
 
         colcon_executable()  # colcon missing: exit 2 now, not at the first save
-    options, _ = prepared(args)
+    link, options, _ = prepared(args)
     if args.out is not None:
         open_report(args.out).close()  # a bad folder fails now, not after the first run
     from harness.runner.settings import check_settings
@@ -74,7 +76,7 @@ def watch(args: argparse.Namespace, console: Console) -> int:
     from harness.watch.verdict_cache import verdict_cache
 
     settings = settings_from(args)
-    cache = verdict_cache(args.link, options)
+    cache = verdict_cache(link, options)
     ran: list[Scenario] = []  # the order of the run in progress, for the reports
 
     def load() -> list[Scenario]:
@@ -91,7 +93,7 @@ def watch(args: argparse.Namespace, console: Console) -> int:
         ran[:] = order
         return run_suite(
             order,
-            args.link,
+            link,
             options,
             settings,
             on_tick=on_tick,
