@@ -172,14 +172,21 @@ class NodeExchange:
                 lambda: obs.statuses_since(first_ns) >= copies,
                 min(max(WARM_UP_RETRY_S, copies * took), opts.ready_timeout),
             )
-        self.wait_for(
-            lambda: not obs.wrong_types() or bool(obs.wrong_types(named_only=True)),
-            WARM_UP_RETRY_S,
-        )
+        self._name_wrong_types()
         if graph.node_gone() is None:
             graph.check_types()
         self.warmed_up = True
         self.delivery.after_first()
+
+    def _name_wrong_types(self) -> None:
+        """Give discovery a moment (bounded) to tie a wrongly typed publisher to its node,
+        so the error names it."""
+        obs = self.graph.observer
+        assert obs is not None
+        self.wait_for(
+            lambda: not obs.wrong_types() or bool(obs.wrong_types(named_only=True)),
+            WARM_UP_RETRY_S,
+        )
 
     def _await_bool_writer(self) -> None:
         """Before the first scan: our Bool reader matched to the node's Bool writer, or its
@@ -248,12 +255,7 @@ class NodeExchange:
                 )
         if obs.node.count_publishers(opts.warning_topic) > 0:
             self.wait_for(lambda: obs.warning_publishers() > 0, WARM_UP_RETRY_S)
-        # By now the node's other publishers are known too; give discovery a
-        # moment to tie a wrongly typed one to its node, so the error names it.
-        self.wait_for(
-            lambda: not obs.wrong_types() or bool(obs.wrong_types(named_only=True)),
-            WARM_UP_RETRY_S,
-        )
+        self._name_wrong_types()  # by now the node's other publishers are known too
         graph.check_types()
         self.wait_for(lambda: False, self.grace())  # the answer's Bool, if any
         obs.drain()
