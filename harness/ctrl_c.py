@@ -1,4 +1,5 @@
-"""Ctrl-C that cannot be lost: an event that every SIGINT sets.
+"""Ctrl-C that cannot be lost: an event that every SIGINT sets, and stops held
+over a few lines that must not be cut in two.
 
 Python swallows a KeyboardInterrupt raised inside a weakref callback or a
 ``__del__`` ("Exception ignored in ..."). A loop that must end on Ctrl-C
@@ -50,3 +51,37 @@ def remembered_ctrl_c() -> Iterator[threading.Event]:
     finally:
         signal.signal(signal.SIGINT, previous)
         sys.unraisablehook = previous_hook
+
+
+STOPS = (signal.SIGINT, signal.SIGTERM)  # the signals the CLI turns into KeyboardInterrupt
+
+
+@contextlib.contextmanager
+def stops_held() -> Iterator[None]:
+    """Ctrl-C and SIGTERM wait until the block is over, then act as they would have.
+
+    For state that a KeyboardInterrupt must never see half made, such as fds 1 and 2
+    pointed at a capture: a stop landing there leaves them so, and the summary written
+    after the stop goes into a deleted file. Only the main thread runs Python's signal
+    handlers, so elsewhere nothing needs holding.
+    """
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    held: list[int] = []
+    previous = {signum: signal.getsignal(signum) for signum in STOPS}
+
+    def hold(signum: int, frame: FrameType | None) -> None:
+        held.append(signum)
+
+    for signum, handler in previous.items():
+        if handler is not None and handler != signal.SIG_IGN:
+            signal.signal(signum, hold)
+    try:
+        yield
+    finally:
+        for signum, handler in previous.items():
+            if handler is not None and handler != signal.SIG_IGN:
+                signal.signal(signum, handler)
+        if held:  # through the handler in place again: the same stop, just later
+            signal.raise_signal(held[0])

@@ -15,6 +15,8 @@ import sys
 import tempfile
 from collections.abc import Iterator
 
+from harness.ctrl_c import stops_held
+
 _LIBC = ctypes.CDLL(None)
 
 
@@ -26,23 +28,21 @@ def captured_output() -> Iterator[list[str]]:
     sys.stdout.flush()
     sys.stderr.flush()
     _LIBC.fflush(None)
-    saved = {fd: os.dup(fd) for fd in (1, 2)}
-    try:
-        with tempfile.TemporaryFile() as capture:  # unlinked at once: nothing is left behind
+    # Held: a Ctrl-C inside would leave fds 1 and 2 here, and the summary after it lost.
+    with stops_held(), tempfile.TemporaryFile() as capture:  # unlinked at once
+        saved = {fd: os.dup(fd) for fd in (1, 2)}
+        try:
             for fd in saved:
                 os.dup2(capture.fileno(), fd)
-            try:
-                yield lines
-            finally:
-                _LIBC.fflush(None)
-                for fd, copy in saved.items():
-                    os.dup2(copy, fd)
-                capture.seek(0)
-                text = capture.read(1 << 20).decode("utf-8", "replace")
-                lines.extend(line.strip() for line in text.splitlines() if line.strip())
-    finally:
-        for copy in saved.values():
-            os.close(copy)
+            yield lines
+        finally:
+            _LIBC.fflush(None)
+            for fd, copy in saved.items():
+                os.dup2(copy, fd)
+                os.close(copy)
+            capture.seek(0)
+            text = capture.read(1 << 20).decode("utf-8", "replace")
+            lines.extend(line.strip() for line in text.splitlines() if line.strip())
 
 
 def last_complaint(lines: list[str]) -> str:
