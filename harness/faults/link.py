@@ -12,7 +12,7 @@ from __future__ import annotations
 import math
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
-from typing import Any, ClassVar, TypeVar
+from typing import Any, ClassVar, TypeVar, get_args
 
 import numpy as np
 
@@ -53,16 +53,19 @@ DRIFT_STEP = 0.15  # one scan's rate change, as a fraction of the drift range (o
 _STREAM = {"delivery": 1, "drift": 2, "line": 3}
 
 
-def _rate(value: float, what: str, top: float = 1.0) -> None:
+def _number(value: Any) -> bool:
+    """A finite int or float (a bool is neither here)."""
     ok = isinstance(value, (int, float)) and not isinstance(value, bool)
-    if not (ok and math.isfinite(value) and 0.0 <= value <= top):
+    return ok and math.isfinite(value)
+
+
+def _rate(value: float, what: str, top: float = 1.0) -> None:
+    if not (_number(value) and 0.0 <= value <= top):
         raise ConfigError(f"{what} must be in [0, {top:g}], got {value!r}")
 
 
 def _seconds(value: float, what: str, top: float, *, positive: bool = False) -> None:
-    ok = isinstance(value, (int, float)) and not isinstance(value, bool)
-    low_ok = ok and (value > 0 if positive else value >= 0)
-    if not (ok and math.isfinite(value) and low_ok and value <= top):
+    if not (_number(value) and (value > 0 if positive else value >= 0) and value <= top):
         low = "(0" if positive else "[0"
         raise ConfigError(f"{what} must be in {low}, {top:g}] s, got {value!r}")
 
@@ -138,8 +141,7 @@ class RateDrift:
     def __post_init__(self) -> None:
         for name in ("min_hz", "max_hz"):
             value = getattr(self, name)
-            ok = isinstance(value, (int, float)) and not isinstance(value, bool)
-            if not (ok and math.isfinite(value) and MIN_DRIFT_HZ <= value <= MAX_DRIFT_HZ):
+            if not (_number(value) and MIN_DRIFT_HZ <= value <= MAX_DRIFT_HZ):
                 raise ConfigError(
                     f"rate_drift {name} must be in [{MIN_DRIFT_HZ:g}, {MAX_DRIFT_HZ:g}] Hz, "
                     f"got {value!r}"
@@ -222,20 +224,7 @@ LinkFault = (
     | LineNoise
 )
 #: kind -> class, for the ``faults:`` list. Delivery kinds first, then the line kinds.
-LINK_KINDS: dict[str, type[Any]] = {
-    cls.kind: cls
-    for cls in (
-        Delay,
-        Drop,
-        Duplicate,
-        Reorder,
-        RateDrift,
-        StaleStamps,
-        LineCorruption,
-        LineDrops,
-        LineNoise,
-    )
-}
+LINK_KINDS: dict[str, type[Any]] = {cls.kind: cls for cls in get_args(LinkFault)}
 LINE_KINDS = ("line_corruption", "line_drops", "line_noise")
 F = TypeVar("F")
 

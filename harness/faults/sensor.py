@@ -73,14 +73,11 @@ CONVENTIONS: dict[str, tuple[str, str, str]] = {
 DROPOUT_VALUES: dict[str, float] = {"nan": math.nan, "zero": 0.0, "inf": math.inf}
 
 
+_ENCODED = {"+inf": math.inf, "-inf": -math.inf, "nan": math.nan, "0": 0.0}
+
+
 def _encoded(word: str, range_max: float) -> float:
-    return {
-        "+inf": math.inf,
-        "-inf": -math.inf,
-        "nan": math.nan,
-        "0": 0.0,
-        "range_max": range_max,
-    }[word]
+    return range_max if word == "range_max" else _ENCODED[word]
 
 
 @dataclass(frozen=True)
@@ -401,24 +398,22 @@ def build_profile(
     labels: list[str] = []
     for i, entry in enumerate(items):
         where = f"{field_name}[{i}]"
-        if isinstance(entry, str) and "(" in entry:
-            item, label = _inline(where, _call_mapping(where, entry))
-            collected.append(item)
-            labels.append(label)
-        elif isinstance(entry, str):
+        if isinstance(entry, str) and "(" not in entry:
             if entry not in _NAMED:
                 known = ", ".join(_NAMED)
                 raise ConfigError(f"{where}: unknown fault profile {entry!r} (known: {known})")
             collected.extend(_NAMED[entry][1])
             labels.append(entry)
-        elif isinstance(entry, Mapping):
-            item, label = _inline(where, entry)
-            collected.append(item)
-            labels.append(label)
-        else:
+            continue
+        if isinstance(entry, str):
+            entry = _call_mapping(where, entry)
+        elif not isinstance(entry, Mapping):
             raise ConfigError(
                 f"{where}: expected a profile name or a mapping with 'type', got {entry!r}"
             )
+        item, label = _inline(where, entry)
+        collected.append(item)
+        labels.append(label)
     return _compose(collected, "+".join(labels) or "clean")
 
 
