@@ -245,11 +245,11 @@ class Oracle:
                 times = "twice" if len(texts) == 2 else f"{len(texts)} times"
                 failures.append(f"answered {times} (one status per scan expected): {quoted}")
             claim = parse_status(texts[0], self.pattern)
-            failures.extend(self._judge_claim(scan, exp, claim))
+            failures.extend(self.claim_failures(scan, exp, claim))
 
         bools = [r.value for r in answers.warnings if isinstance(r.value, bool)]
         warning_got = bools[-1] if bools else None
-        failures.extend(self._judge_warning(exp, warning_got))
+        failures.extend(self.warning_failures(exp, warning_got))
         for earlier_scan, earlier in answers.earlier:  # each answer against the scan it answered
             sub = self.judge(tick, t, earlier_scan, earlier)
             failures.extend(f"answering an earlier driver scan: {f}" for f in sub.failures)
@@ -264,16 +264,8 @@ class Oracle:
                 )
             where = f"t={t:.2f} s tick {tick}" + (f" ({how})" if how else "")
             explanation = f"{where}: {self._context(scan, exp)}; " + "; ".join(failures)
-        return Verdict(
-            tick=tick,
-            t=t,
-            ok=not failures,
-            expected=exp,
-            claim=claim,
-            warning_got=warning_got,
-            failures=tuple(failures),
-            explanation=explanation,
-        )
+        ok = not failures
+        return Verdict(tick, t, ok, exp, claim, warning_got, tuple(failures), explanation)
 
     def _context(self, scan: Scan, exp: Expectation) -> str:
         thr = f"threshold {_num(self.threshold, 2)} m"
@@ -294,13 +286,6 @@ class Oracle:
     def claim_failures(self, scan: Scan, exp: Expectation, claim: StatusClaim) -> list[str]:
         """What is wrong with `claim` as the status for `scan` (empty: it passes); the
         run's hints ask this of answers against other ticks' scans."""
-        return self._judge_claim(scan, exp, claim)
-
-    def warning_failures(self, exp: Expectation, got: bool | None) -> list[str]:
-        """What is wrong with the Bool `got` for a scan expecting `exp` (empty: it passes)."""
-        return self._judge_warning(exp, got)
-
-    def _judge_claim(self, scan: Scan, exp: Expectation, claim: StatusClaim) -> list[str]:
         quoted = _quoted(claim.text)
         if claim.unreadable:  # what it claims is unknown: wrong whatever the scan
             return [f"cannot read status {quoted}: {claim.unreadable}"]
@@ -344,7 +329,8 @@ class Oracle:
             )
         return out
 
-    def _judge_warning(self, exp: Expectation, got: bool | None) -> list[str]:
+    def warning_failures(self, exp: Expectation, got: bool | None) -> list[str]:
+        """What is wrong with the Bool `got` for a scan expecting `exp` (empty: it passes)."""
         if exp.warning is None:
             return []
         shown = "no Bool" if got is None else str(got)

@@ -14,6 +14,7 @@ from __future__ import annotations
 import math
 import re
 import shlex
+from collections.abc import Callable
 from dataclasses import dataclass
 
 from harness.judge.status_numbers import Number, find_numbers
@@ -271,14 +272,11 @@ def _by_position(structure: Structure) -> KeyedClaim | None:
     if flag.value is False:
         return KeyedClaim(False, None, None, f"says {flag.text}", None)
     slots = [f.value for f in structure.fields if f.value is None or isinstance(f.value, Printed)]
-    d, a = (*slots, None, None)[:2]
-    return KeyedClaim(
-        True,
-        _number(d.value, d.text, "distance") if isinstance(d, Printed) else None,
-        _number(a.value, a.text, "angle") if isinstance(a, Printed) else None,
-        None,
-        None,
+    d, a = (
+        _number(v.value, v.text, w) if isinstance(v, Printed) else None
+        for v, w in zip((*slots, None, None)[:2], ("distance", "angle"), strict=True)
     )
+    return KeyedClaim(True, d, a, None, None)
 
 
 def _unreadable(keyed: list[_Keyed], why: str) -> str:
@@ -289,23 +287,9 @@ def _unreadable(keyed: list[_Keyed], why: str) -> str:
         ("distance", ("distance",)),
         ("angle", ("angle",)),
     ):
-        at = next(
-            (
-                i
-                for i, k in enumerate(keyed)
-                if k.own and k.role in roles and not isinstance(k.field.value, Shape)
-            ),
-            None,
-        )
+        at = _first(keyed, lambda k, r=roles: k.own and k.role in r and not _is_shape(k))
         if at is None and group == "distance":  # the first number whose key says nothing
-            at = next(
-                (
-                    i
-                    for i, k in enumerate(keyed)
-                    if k.role is None and isinstance(k.field.value, Printed)
-                ),
-                None,
-            )
+            at = _first(keyed, lambda k: k.role is None and isinstance(k.field.value, Printed))
         if at is not None:
             found.append((at, group, keyed[at].field.key[-1]))
     if not any(group == "distance" for _, group, _ in found):
@@ -318,6 +302,10 @@ def _unreadable(keyed: list[_Keyed], why: str) -> str:
     rx = "(?is)" + pieces[0] + "".join(f"(?:.*?{p})?" for p in pieces[1:])
     option = named("status_regex")
     return f"{why}; if the node is right, say how to read it: {option} {shlex.quote(rx)}"
+
+
+def _first(keyed: list[_Keyed], wanted: Callable[[_Keyed], bool]) -> int | None:
+    return next((i for i, k in enumerate(keyed) if wanted(k)), None)
 
 
 def _piece(key: str, group: str) -> str:
