@@ -29,30 +29,18 @@ __all__ = [
 
 #: The keys issue 7 asks `bench --json` for; each is a number, or null when its stage did not run.
 REQUIRED_KEYS = (
-    "raycast_scans_per_s",
-    "inprocess_scans_per_s",
-    "ros2_lockstep_scans_per_s",
-    "ros2_round_trip_ms_median",
-    "ros2_round_trip_ms_p99",
-    "overhead_ratio",
-    "node_startup_s",
-    "lab_suite_wall_s",
-    "serial_lockstep_scans_per_s",
-    "serial_rate_error_pct",
-    "serial_jitter_p99_ms",
-    "peak_rss_mb",
-)
+    "raycast_scans_per_s", "inprocess_scans_per_s", "ros2_lockstep_scans_per_s",
+    "ros2_round_trip_ms_median", "ros2_round_trip_ms_p99", "overhead_ratio", "node_startup_s",
+    "lab_suite_wall_s", "serial_lockstep_scans_per_s", "serial_rate_error_pct",
+    "serial_jitter_p99_ms", "peak_rss_mb",
+)  # fmt: skip
 
 #: Grading a class (issue 41): a class of correct script students through the default
 #: suite, and the same students' runs back to back.
 GRADE_KEYS = (
-    "grade_s",
-    "grade_per_student_s",
-    "grade_students",
-    "grade_workers",
-    "grade_runs_s",
+    "grade_s", "grade_per_student_s", "grade_students", "grade_workers", "grade_runs_s",
     "grade_ratio",
-)
+)  # fmt: skip
 
 #: HIL without gaps (issue 41): a real-time suite over the virtual board, and the gaps
 #: between its scenarios (the device streams on).
@@ -60,34 +48,19 @@ HIL_KEYS = ("hil_suite_s", "hil_gap_median_s", "hil_gap_min_s", "hil_gap_max_s",
 
 #: The edit-run loop (issue 13): the shipped suite as a user runs it, and its split.
 SUITE_KEYS = (
-    "suite_s",
-    "suite_startup_s",
-    "suite_ticking_s",
-    "suite_stop_s",
-    "suite_process_s",
-    "suite_inprocess_s",
-    "suite_scenarios",
-    "suite_scans",
-    "suite_runs_s",
+    "suite_s", "suite_startup_s", "suite_ticking_s", "suite_stop_s", "suite_process_s",
+    "suite_inprocess_s", "suite_scenarios", "suite_scans", "suite_runs_s",
     # The same suite against the lab's package in a colcon workspace
     # (a student's node), and with the inprocess link; the three runs alternated.
-    "student_build_s",
-    "student_suite_s",
-    "student_suite_runs_s",
-    "student_suite_ratio",
-    "inprocess_suite_s",
-    "inprocess_suite_runs_s",
-    "inprocess_suite_ratio",
-)
+    "student_build_s", "student_suite_s", "student_suite_runs_s", "student_suite_ratio",
+    "inprocess_suite_s", "inprocess_suite_runs_s", "inprocess_suite_ratio",
+)  # fmt: skip
 
 #: The workspace node's suite split like the bundled one's (null with `--quick`).
 STUDENT_SPLIT_KEYS = (
-    "student_suite_startup_s",
-    "student_suite_ticking_s",
-    "student_suite_stop_s",
-    "student_suite_process_s",
-    "student_suite_inprocess_s",
-)
+    "student_suite_startup_s", "student_suite_ticking_s", "student_suite_stop_s",
+    "student_suite_process_s", "student_suite_inprocess_s",
+)  # fmt: skip
 
 OVERHEAD_FORMULA = (
     "per ROS 2 round: (lockstep s/scan - raycast s/scan measured just before the round "

@@ -18,14 +18,12 @@ from __future__ import annotations
 
 import csv
 import statistics
-import subprocess
 import tempfile
-import time
 from pathlib import Path
 
 import harness
 from harness.bench.stage import StageResult
-from harness.bench.suite_commands import COMMAND_FLAGS, _fossbot_hil, cli_args, cli_wall_s
+from harness.bench.suite_commands import COMMAND_FLAGS, cli_args, cli_wall_s, spawn_s
 from harness.cluster.client import default_workers
 from harness.errors import HarnessError
 
@@ -54,20 +52,9 @@ def make_class(folder: Path, students: int) -> list[Path]:
 
 def grade_wall_s(classroom: Path, out: Path, scenarios: tuple[str, ...]) -> float:
     """`fossbot-hil grade CLASS --no-audit` from spawn to exit; every student must pass."""
-    argv = [*_fossbot_hil(), "grade", str(classroom), *cli_args(out=str(out))]
-    argv += [
-        COMMAND_FLAGS["no_audit"],
-        *(cli_args(scenario=",".join(scenarios)) if scenarios else []),
-    ]
-    started = time.perf_counter()
-    try:
-        done = subprocess.run(argv, capture_output=True, timeout=GRADE_TIMEOUT_S, check=False)
-    except subprocess.TimeoutExpired:
-        raise HarnessError(f"fossbot-hil grade took longer than {GRADE_TIMEOUT_S:g} s") from None
-    seconds = time.perf_counter() - started
-    if done.returncode != 0:
-        tail = (done.stderr or done.stdout).decode(errors="replace").strip()[-300:]
-        raise HarnessError(f"fossbot-hil grade exited {done.returncode}: {tail}")
+    argv = ["grade", str(classroom), *cli_args(out=str(out)), COMMAND_FLAGS["no_audit"]]
+    argv += cli_args(scenario=",".join(scenarios)) if scenarios else []
+    seconds = spawn_s(argv, "fossbot-hil grade", GRADE_TIMEOUT_S)
     with open(out / "grades.csv", encoding="utf-8", newline="") as table:
         failed = [r["student"] for r in csv.DictReader(table) if not _all_passed(r["passed"])]
     if failed:

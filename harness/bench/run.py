@@ -8,6 +8,7 @@ ratios between stages hold even when the absolute numbers move with load.
 
 from __future__ import annotations
 
+import importlib
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -77,51 +78,39 @@ def parse_stages(text: str | None) -> tuple[str, ...]:
     return tuple(s for s in STAGES if s in names)
 
 
+#: Each stage's module (imported when the stage runs: ROS stages need rclpy only when
+#: selected) and how it is measured for a plan.
+_MEASURES: dict[str, tuple[str, Callable[[Any, BenchPlan], StageResult]]] = {
+    "raycast": ("raycast", lambda m, p: m.measure_raycast(p.workload)),
+    "synthesis": ("synthesis", lambda m, p: m.measure_synthesis(p.workload)),
+    INPROCESS: ("inprocess", lambda m, p: m.measure_inprocess(p.workload)),
+    ROS2: ("ros2_lockstep", lambda m, p: m.measure_ros2(p.workload)),
+    "serial": ("serial_lockstep", lambda m, p: m.measure_serial(p.serial_workload)),
+    "pacing": ("serial_pacing", lambda m, p: m.measure_pacing(p.workload.scenarios[0], p.pacing_s)),
+    "suite": (
+        "lab_suite",
+        lambda m, p: m.measure_suite(
+            lab_workload(1, p.suite_scenarios or LAB_TRIO),
+            cli=not p.quick,  # the lab trio's CLI in a fresh process too
+            suite_runs=p.suite_runs,
+            student_split=not p.quick,  # quick: no more suites of student node starts
+            suite=p.suite_scenarios,
+        ),
+    ),
+    "grade": (
+        "grade_class",
+        lambda m, p: m.measure_grade(p.grade_students, p.suite_scenarios, runs=not p.quick),
+    ),
+    "hil": ("hil_board", lambda m, p: m.measure_hil(m.QUICK_SUITE if p.quick else ())),
+}
+
+
 def _measure(name: str, plan: BenchPlan) -> StageResult:
-    """Run one stage (imports here: ROS stages need rclpy only when selected)."""
-    if name == "raycast":
-        from harness.bench.raycast import measure_raycast
-
-        return measure_raycast(plan.workload)
-    if name == "synthesis":
-        from harness.bench.synthesis import measure_synthesis
-
-        return measure_synthesis(plan.workload)
-    if name == INPROCESS:
-        from harness.bench.inprocess import measure_inprocess
-
-        return measure_inprocess(plan.workload)
-    if name == ROS2:
-        from harness.bench.ros2_lockstep import measure_ros2
-
-        return measure_ros2(plan.workload)
-    if name == "serial":
-        from harness.bench.serial_lockstep import measure_serial
-
-        return measure_serial(plan.serial_workload)
-    if name == "pacing":
-        from harness.bench.serial_pacing import measure_pacing
-
-        return measure_pacing(plan.workload.scenarios[0], plan.pacing_s)
-    if name == "suite":
-        from harness.bench.lab_suite import measure_suite
-
-        return measure_suite(
-            lab_workload(1, plan.suite_scenarios or LAB_TRIO),
-            cli=not plan.quick,  # the lab trio's CLI in a fresh process too
-            suite_runs=plan.suite_runs,
-            student_split=not plan.quick,  # quick: no more suites of student node starts
-            suite=plan.suite_scenarios,
-        )
-    if name == "grade":
-        from harness.bench.grade_class import measure_grade
-
-        return measure_grade(plan.grade_students, plan.suite_scenarios, runs=not plan.quick)
-    if name == "hil":
-        from harness.bench.hil_board import QUICK_SUITE, measure_hil
-
-        return measure_hil(QUICK_SUITE if plan.quick else ())
-    raise ValueError(name)
+    """Run one stage."""
+    if name not in _MEASURES:
+        raise ValueError(name)
+    module, measure = _MEASURES[name]
+    return measure(importlib.import_module(f"harness.bench.{module}"), plan)
 
 
 def run_bench(

@@ -40,21 +40,25 @@ def _fossbot_hil() -> list[str]:
     return [exe] if exe else [sys.executable, "-m", "harness.cli"]
 
 
-def cli_wall_s(args: Sequence[str]) -> float:
-    """`fossbot-hil run ARGS` from spawn to exit; HarnessError unless it exits 0 (all passed)."""
-    argv = [*_fossbot_hil(), "run", *args]
+def spawn_s(args: Sequence[str], what: str, timeout_s: float) -> float:
+    """`fossbot-hil ARGS` from spawn to exit; HarnessError naming `what` unless it exits 0."""
     started = time.perf_counter()
     try:
-        done = subprocess.run(argv, capture_output=True, timeout=CLI_TIMEOUT_S, check=False)
+        done = subprocess.run(
+            [*_fossbot_hil(), *args], capture_output=True, timeout=timeout_s, check=False
+        )
     except subprocess.TimeoutExpired:
-        raise HarnessError(
-            f"fossbot-hil run {shlex.join(args)} took longer than {CLI_TIMEOUT_S:g} s"
-        ) from None
+        raise HarnessError(f"{what} took longer than {timeout_s:g} s") from None
     seconds = time.perf_counter() - started
     if done.returncode != 0:
         tail = (done.stderr or done.stdout).decode(errors="replace").strip()[-300:]
-        raise HarnessError(f"fossbot-hil run {shlex.join(args)} exited {done.returncode}: {tail}")
+        raise HarnessError(f"{what} exited {done.returncode}: {tail}")
     return seconds
+
+
+def cli_wall_s(args: Sequence[str]) -> float:
+    """`fossbot-hil run ARGS` from spawn to exit; HarnessError unless it exits 0 (all passed)."""
+    return spawn_s(["run", *args], f"fossbot-hil run {shlex.join(args)}", CLI_TIMEOUT_S)
 
 
 def alternate(kinds: Mapping[str, Sequence[str]], rounds: int) -> dict[str, list[float]]:
