@@ -88,11 +88,7 @@ def samples_from_scan(
         if phase:
             angles = angles + phase
         distances = _nearest_beam(scan, angles, distances, mount)
-    order = np.argsort(angles, kind="stable")
-    qualities = np.where(distances > 0.0, int(quality), 0)
-    return [
-        Sample(float(angles[i]), float(distances[i]), int(qualities[i])) for i in order.tolist()
-    ]
+    return _samples(angles, distances, quality)
 
 
 def samples_at_beams(
@@ -118,11 +114,14 @@ def samples_at_beams(
     angles = np.asarray(device_angle_deg(scan.angles(), mount), dtype=np.float64)
     angles = angles.reshape(-1)[index]
     distances = encode_distances_mm(scan.ranges, max_range_m)[index]
-    order = np.argsort(angles, kind="stable")
+    return _samples(angles, distances, quality)
+
+
+def _samples(angles: np.ndarray, distances: np.ndarray, quality: int) -> list[Sample]:
+    """The samples in increasing device angle; no quality where there is no return."""
     qualities = np.where(distances > 0.0, int(quality), 0)
-    return [
-        Sample(float(angles[i]), float(distances[i]), int(qualities[i])) for i in order.tolist()
-    ]
+    order = np.argsort(angles, kind="stable").tolist()
+    return [Sample(float(angles[i]), float(distances[i]), int(qualities[i])) for i in order]
 
 
 def _grid_phase(mount: LidarMount, step: float) -> float:

@@ -49,6 +49,14 @@ class InvalidName(ValueError):
 # -- topic names: rcl_validate_topic_name, rmw_validate_full_topic_name -------
 
 
+_SUBSTITUTION_CHARACTERS = (
+    "substitution name must not contain characters other than alphanumerics or '_'"
+)
+_TOPIC_CHARACTERS = (
+    "topic name must not contain characters other than alphanumerics, '_', '~', '{', or '}'"
+)
+
+
 def topic_name_problem(name: str) -> tuple[str, int] | None:
     """rcl_validate_topic_name: (reason, index) when `name` is not a topic name, else None;
     relative, private and substituted names pass unexpanded (see full_topic_name_problem)."""
@@ -63,40 +71,21 @@ def topic_name_problem(name: str) -> tuple[str, int] | None:
         if c in _ALNUM:
             if c in _DIGITS and in_braces and i - 1 == opened:
                 return "substitution name must not start with a number", i
-        elif c == "_":
+        elif c == "_" or (c == "/" and not in_braces):
             pass
-        elif c == "/":
-            if in_braces:
-                return (
-                    "substitution name must not contain characters other than alphanumerics or '_'",
-                    i,
-                )
         elif c == "~":
             if i != 0:
                 return "topic name must not have tilde '~' unless it is the first character", i
-        elif c == "{":
-            opened = i
-            if in_braces:
-                return (
-                    "substitution name must not contain characters other than alphanumerics or '_'",
-                    i,
-                )
-            in_braces = True
+        elif c == "{" and not in_braces:
+            opened, in_braces = i, True
         elif c == "}":
             if not in_braces:
                 return "topic name must not have unmatched (unbalanced) curly braces '{}'", i
             in_braces = False
-        elif in_braces:
-            return (
-                "substitution name must not contain characters other than alphanumerics or '_'",
-                i,
-            )
+        elif in_braces:  # a '/' or '{' inside braces too
+            return _SUBSTITUTION_CHARACTERS, i
         else:
-            return (
-                "topic name must not contain characters other than alphanumerics, "
-                "'_', '~', '{', or '}'",
-                i,
-            )
+            return _TOPIC_CHARACTERS, i
     if in_braces:
         return "topic name must not have unmatched (unbalanced) curly braces '{}'", opened
     for i in range(len(name) - 1):

@@ -258,36 +258,19 @@ class Observer:
             return None
         if named_only and any(i.node_name == UNKNOWN_NODE_NAME for i in infos):
             return None  # discovery has the endpoint but not its node yet
-        who = sorted(
-            {
-                f"{_full_name(i)} {'publishes' if publishers else 'subscribes to'} "
-                f"{topic} as {i.topic_type}"
-                for i in infos
-            }
-        )
-        return (
-            f"{', '.join(who)}, but the harness {'expects' if publishers else 'publishes'} {want}"
-        )
+        does, expects = ("publishes", "expects") if publishers else ("subscribes to", "publishes")
+        who = sorted({f"{_full_name(i)} {does} {topic} as {i.topic_type}" for i in infos})
+        return f"{', '.join(who)}, but the harness {expects} {want}"
 
     def wrong_types(self, *, named_only: bool = False) -> list[str]:
         """Topics the node uses with another message type than the harness: DDS never connects
         them, so say it rather than "never ready" or "no answer". `named_only`: a topic whose
         endpoints discovery has not tied to a node yet is left for later."""
-        checks = [
-            self._wrong_type(
-                self.status_topic, STATUS_TYPE, publishers=True, named_only=named_only
-            ),
-            self._wrong_type(
-                self.warning_topic, WARNING_TYPE, publishers=True, named_only=named_only
-            ),
-        ]
+        checks = [(self.status_topic, STATUS_TYPE, True), (self.warning_topic, WARNING_TYPE, True)]
         if self.scan_pub is not None:
-            checks.append(
-                self._wrong_type(
-                    self.scan_topic, SCAN_TYPE, publishers=False, named_only=named_only
-                )
-            )
-        return [c for c in checks if c is not None]
+            checks.append((self.scan_topic, SCAN_TYPE, False))
+        found = (self._wrong_type(t, w, publishers=p, named_only=named_only) for t, w, p in checks)
+        return [c for c in found if c is not None]
 
     def qos_mismatches(self) -> list[str]:
         """Publishers of the right type that our reliable subscriptions can never match."""
@@ -364,8 +347,6 @@ def _full_name(info: TopicEndpointInfo) -> str:
 def _topic_list(names_and_types: list[tuple[str, list[str]]]) -> str:
     """'/a (std_msgs/msg/String), /b (...)' without the topics every node has."""
     shown = [
-        f"{topic} ({', '.join(types)})"
-        for topic, types in sorted(names_and_types)
-        if topic not in PLUMBING
+        f"{t} ({', '.join(types)})" for t, types in sorted(names_and_types) if t not in PLUMBING
     ]
     return ", ".join(shown) or "nothing"
