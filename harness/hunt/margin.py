@@ -13,7 +13,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from harness.judge.oracle import Oracle
+from harness.judge.oracle import Oracle, wrap
 from harness.judge.records import RunResult, TickRecord
 from harness.judge.status import half_unit
 
@@ -101,7 +101,7 @@ def closeness(record: TickRecord, threshold: float) -> tuple[float, float, float
         ratio = _beyond_printing(abs(claim.distance - exp.distance), tol, claim.distance_decimals)
         if claim.angle is not None and math.isfinite(claim.angle):
             truths = [scan.angle_min + i * scan.angle_increment for i in exp.indices]
-            off = min(_angle_between(claim.angle, t) for t in truths or [exp.angle])
+            off = min(abs(wrap(claim.angle - t)) for t in truths or [exp.angle])
             tol = Oracle.angle_tolerance(scan, claim.angle_decimals)
             ratio = max(ratio, _beyond_printing(off, tol, claim.angle_decimals))
         answer = _clip(1.0 - ratio)
@@ -113,11 +113,6 @@ def _beyond_printing(error: float, tolerance: float, decimals: int | None) -> fl
     share of the rest of `tolerance`: 0 for a right answer however it was rounded."""
     printing = half_unit(decimals)
     return max(0.0, error - printing) / max(tolerance - printing, 1e-12)
-
-
-def _angle_between(a: float, b: float) -> float:
-    """|a - b| folded into [0, pi]."""
-    return abs((a - b + math.pi) % (2 * math.pi) - math.pi)
 
 
 def _clip(value: float) -> float:

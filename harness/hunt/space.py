@@ -22,7 +22,8 @@ from harness.scenario.schema import Box, Cylinder, RobotConfig, Wall
 OBSTACLES = ("none", "wall", "box", "cylinder")
 MOTIONS = ("still", "straight", "reverse", "turn")
 PRESETS = ("gazebo", "rplidar_a1")  # angle_min -pi (Gazebo) and 0 (the FOSSBot v2's RPLIDAR)
-CONVENTIONS = ("rep117", "zero", "nan")  # no return as +inf, 0.0, NaN
+#: The driver's conventions, and how each gives no return.
+CONVENTIONS = {"rep117": "no return as +inf", "zero": "no return as 0.0", "nan": "no return as NaN"}
 FAULTS = ("none", "noise", "dropouts", "spurious", "far_returns")
 
 #: name -> (low, high) of each number drawn.
@@ -87,7 +88,7 @@ class Candidate:
             )
         else:
             parts.append(f"{self.motion} {self.speed:.3g} m/s for {self.duration:.3g} s")
-        parts.append(f"{self.preset} LIDAR, {_convention_words(self.convention)}")
+        parts.append(f"{self.preset} LIDAR, {CONVENTIONS[self.convention]}")
         if self.fault != "none":
             parts.append(_fault_words(self))
         parts.append(f"threshold {self.threshold:.3g} m")
@@ -105,13 +106,9 @@ class Trial(Protocol):
 def suggest(trial: Trial) -> Candidate:
     """A candidate drawn by `trial`; numbers that do not apply are not asked for, so the
     optimiser learns nothing false about them."""
-    drawn: dict[str, Any] = {
-        "obstacle": trial.suggest_categorical("obstacle", OBSTACLES),
-        "motion": trial.suggest_categorical("motion", MOTIONS),
-        "preset": trial.suggest_categorical("preset", PRESETS),
-        "convention": trial.suggest_categorical("convention", CONVENTIONS),
-        "fault": trial.suggest_categorical("fault", FAULTS),
-    }
+    choices = {"obstacle": OBSTACLES, "motion": MOTIONS, "preset": PRESETS}
+    choices |= {"convention": tuple(CONVENTIONS), "fault": FAULTS}
+    drawn: dict[str, Any] = {k: trial.suggest_categorical(k, v) for k, v in choices.items()}
     wanted = ["duration", "threshold"]
     if drawn["obstacle"] != "none":
         wanted += ["distance", "bearing", "size"]
@@ -272,12 +269,6 @@ def _round(value: float) -> float:
 
 def _round_point(point: tuple[float, float]) -> list[float]:
     return [_round(point[0]), _round(point[1])]
-
-
-def _convention_words(name: str) -> str:
-    return {"rep117": "no return as +inf", "zero": "no return as 0.0", "nan": "no return as NaN"}[
-        name
-    ]
 
 
 def _fault_words(candidate: Candidate) -> str:

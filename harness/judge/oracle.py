@@ -19,7 +19,7 @@ from harness.judge.status import StatusClaim, compile_status_pattern, half_unit,
 from harness.lidar.scan import Scan
 from harness.safe_text import QUOTE_LIMIT, TEXT_LIMIT, clip, for_storage
 
-__all__ = ["Expectation", "Oracle", "Verdict", "summarise_scan"]
+__all__ = ["Expectation", "Oracle", "Verdict", "summarise_scan", "wrap"]
 
 _EPS32 = float(np.finfo(np.float32).eps)
 ABS_DISTANCE_TOL = 1e-6  # metres, on top of printed precision and float32 rounding
@@ -138,7 +138,7 @@ def expect(scan: Scan, threshold: float, band: float) -> Expectation:
     )
 
 
-def _wrap(x: float) -> float:
+def wrap(x: float) -> float:
     """x folded into [-pi, pi)."""
     return (x + math.pi) % (2 * math.pi) - math.pi
 
@@ -379,7 +379,7 @@ def _angle_hint(scan: Scan, truths: list[float], claimed: float, decimals: int |
     index_tol = 1 + half_unit(decimals)
     if any(abs(claimed - i) <= index_tol for i in indices):
         return " (looks like the beam index, not its angle)"
-    if any(abs(_wrap(claimed - a)) <= scan.angle_increment * 1.5 for a in truths):
+    if any(abs(wrap(claimed - a)) <= scan.angle_increment * 1.5 for a in truths):
         return " (right direction, but outside [-2*pi, 2*pi])"
     return ""
 

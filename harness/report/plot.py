@@ -18,6 +18,7 @@ from typing import Any
 import numpy as np
 
 from harness.atomic_write import write_atomically
+from harness.judge.oracle import wrap
 from harness.judge.records import RunResult
 from harness.judge.verdicts import verdict_of
 from harness.lidar.scan import Scan
@@ -122,22 +123,17 @@ def _flag(value: bool | None) -> float:
     return math.nan if value is None else float(value)
 
 
-def _wrap(angle: float) -> float:
-    """`angle` folded into [-pi, pi)."""
-    return (angle + math.pi) % (2 * math.pi) - math.pi
-
-
 def _angles(expected: float | None, claimed: float | None) -> tuple[float, float, bool]:
     """(expected, claimed, off the scale): the claim is drawn on the expected angle's turn,
     so a node answering in [0, 2 pi) lies on the line when it is right; a claim the oracle
     never reads as radians (beyond +-2 pi, degrees most likely) is drawn off the scale."""
-    want = math.nan if expected is None else _wrap(expected)
+    want = math.nan if expected is None else wrap(expected)
     if claimed is None:
         return want, math.nan, False
     if not math.isfinite(claimed) or abs(claimed) > ANGLE_REACH:
         return want, math.nan, True
     base = want if math.isfinite(want) else 0.0
-    return want, base + _wrap(claimed - base), False
+    return want, base + wrap(claimed - base), False
 
 
 def plot_series(result: RunResult) -> PlotSeries:
