@@ -48,11 +48,8 @@ def build_problem(
 
 def declared_list(declared: Sequence[str]) -> str:
     """The node's own parameters in order, then the built-in ones it has."""
-    own = sorted(
-        d
-        for d in declared
-        if d not in BUILT_IN and d not in NOT_SHOWN and not d.startswith("qos_overrides.")
-    )
+    hidden = (*BUILT_IN, *NOT_SHOWN)
+    own = sorted(d for d in declared if d not in hidden and not d.startswith("qos_overrides."))
     return ", ".join([*own, *(b for b in BUILT_IN if b in declared)]) or "nothing"
 
 

@@ -61,12 +61,8 @@ def _elements(root: Element) -> Iterator[Element]:
 def _node(element: Element, unread: list[Unread]) -> NodeEntry:
     package = _plain(element, "pkg", unread)
     if element.text("exec") is None and element.text("type") is not None:
-        unread.append(
-            Unread(
-                element.line_of("type"),
-                "type= is ROS 1's name: ROS 2's launch reads exec= (this node does not start)",
-            )
-        )
+        why = "type= is ROS 1's name: ROS 2's launch reads exec= (this node does not start)"
+        unread.append(Unread(element.line_of("type"), why))
         executable = None
     else:
         executable = _plain(element, "exec", unread)
@@ -75,13 +71,8 @@ def _node(element: Element, unread: list[Unread]) -> NodeEntry:
     for child in element.children:
         if child.tag == "param":
             _param(child, "", params, unread)
-    return NodeEntry(
-        element.line,
-        package,
-        executable,
-        name if name and SUBSTITUTION not in name else None,
-        tuple(params),
-    )
+    name = name if name and SUBSTITUTION not in name else None
+    return NodeEntry(element.line, package, executable, name, tuple(params))
 
 
 def _plain(element: Element, name: str, unread: list[Unread]) -> str | None:
@@ -90,12 +81,8 @@ def _plain(element: Element, name: str, unread: list[Unread]) -> str | None:
         unread.append(Unread(element.line, f"<node> gives no {name}="))
         return None
     if SUBSTITUTION in value:
-        unread.append(
-            Unread(
-                element.line_of(name),
-                f"{name}={value!r} is known only when the file runs: that node is not checked",
-            )
-        )
+        why = f"{name}={value!r} is known only when the file runs: that node is not checked"
+        unread.append(Unread(element.line_of(name), why))
         return None
     return value
 
@@ -103,23 +90,15 @@ def _plain(element: Element, name: str, unread: list[Unread]) -> str | None:
 def _param(element: Element, prefix: str, params: list[ParamSetting], unread: list[Unread]) -> None:
     source = element.text("from")
     if source is not None:
-        unread.append(
-            Unread(
-                element.line_of("from"),
-                f"parameters from {source!r} (a parameter file) are not read: not checked",
-            )
-        )
+        why = f"parameters from {source!r} (a parameter file) are not read: not checked"
+        unread.append(Unread(element.line_of("from"), why))
         return
     name = element.text("name")
     if name is None:
         return
     if SUBSTITUTION in name:
-        unread.append(
-            Unread(
-                element.line_of("name"),
-                f"parameter name {name!r} is known only when the file runs: not checked",
-            )
-        )
+        why = f"parameter name {name!r} is known only when the file runs: not checked"
+        unread.append(Unread(element.line_of("name"), why))
         return
     inner = [child for child in element.children if child.tag == "param"]
     if inner:

@@ -36,12 +36,8 @@ def ros2_launch_missing() -> str | None:
     if program is None:
         return "no ros2 on PATH"
     try:
-        done = subprocess.run(
-            [program, "launch", "--help"],
-            capture_output=True,
-            timeout=HELP_TIMEOUT_S,
-            check=False,
-        )
+        command = [program, "launch", "--help"]
+        done = subprocess.run(command, capture_output=True, timeout=HELP_TIMEOUT_S, check=False)
     except (OSError, subprocess.TimeoutExpired) as err:
         return f"`ros2 launch --help` failed: {err}"
     if done.returncode != 0:

@@ -107,6 +107,13 @@ class _Reader:
         text = " ".join(text.split())
         return text if len(text) <= SNIPPET else text[: SNIPPET - 3] + "..."
 
+    def _runtime(
+        self, expr: ast.expr, what: str, then: str = "not checked", verb: str = "is"
+    ) -> None:
+        """Say that `what` (its ``{}`` the expression's text) is known only when the file runs."""
+        text = f"{what.format(self._snippet(expr))} {verb} known only when the file runs: {then}"
+        self.unread.append(Unread(expr.lineno, text))
+
     # -- calls ---------------------------------------------------------------
     def _argument_name(self, call: ast.Call) -> str | None:
         given = call.args[0] if call.args else _keyword(call, ("name",))
@@ -135,59 +142,30 @@ class _Reader:
             return None
         value = _text(self._follow(given))
         if value is None:
-            self.unread.append(
-                Unread(
-                    given.lineno,
-                    f"{label}={self._snippet(given)} is known only when the file runs: "
-                    "that node is not checked",
-                )
-            )
+            self._runtime(given, label + "={}", "that node is not checked")
         return value
 
     def _parameters(self, given: ast.expr, params: list[ParamSetting]) -> None:
         items = self._follow(given)
         if not isinstance(items, ast.List | ast.Tuple):
-            self.unread.append(
-                Unread(
-                    given.lineno,
-                    f"parameters={self._snippet(given)} is known only when the file runs: "
-                    "its parameters are not checked",
-                )
-            )
+            self._runtime(given, "parameters={}", "its parameters are not checked")
             return
         for item in items.elts:
             value = self._follow(item.value if isinstance(item, ast.Starred) else item)
             if isinstance(value, ast.Dict) and not isinstance(item, ast.Starred):
                 self._dictionary(value, "", params)
             else:
-                self.unread.append(
-                    Unread(
-                        item.lineno,
-                        f"parameters from {self._snippet(item)} (a parameter file or an "
-                        "expression) are known only when the file runs: not checked",
-                    )
-                )
+                what = "parameters from {} (a parameter file or an expression)"
+                self._runtime(item, what, verb="are")
 
     def _dictionary(self, given: ast.Dict, prefix: str, params: list[ParamSetting]) -> None:
         for key, value in zip(given.keys, given.values, strict=True):
             if key is None:
-                self.unread.append(
-                    Unread(
-                        value.lineno,
-                        f"**{self._snippet(value)} in parameters= is known only when the file "
-                        "runs: not checked",
-                    )
-                )
+                self._runtime(value, "**{} in parameters=")
                 continue
             name = _text(self._follow(key))
             if name is None:
-                self.unread.append(
-                    Unread(
-                        key.lineno,
-                        f"parameter name {self._snippet(key)} is known only when the file "
-                        "runs: not checked",
-                    )
-                )
+                self._runtime(key, "parameter name {}")
                 continue
             inner = self._follow(value)
             if isinstance(inner, ast.Dict):

@@ -54,9 +54,7 @@ class LaunchCheck:
             if read is None:
                 continue
             files.append(read)
-            note = (
-                install_note(path, shown, package, found.installed) if found.from_source else None
-            )
+            note = found.from_source and install_note(path, shown, package, found.installed)
             static += [note] if note else []
             static += [
                 f"{named('launch')}: {shown} declares no launch argument {name!r}, so the harness "
@@ -101,10 +99,7 @@ class LaunchCheck:
         --launch, the entry named as the node is, or the file's only one."""
         pairs = [(file, entry) for file in self.files for entry in file.nodes]
         if self.executable is not None:
-            return [
-                (file, entry)
-                for file, entry in pairs
-                if (entry.package, entry.executable) == (self.package, self.executable)
-            ]
+            wanted = (self.package, self.executable)
+            return [(f, entry) for f, entry in pairs if (entry.package, entry.executable) == wanted]
         named = [(file, entry) for file, entry in pairs if entry.name == node.rsplit("/", 1)[-1]]
         return named or (pairs if len(pairs) == 1 else [])
