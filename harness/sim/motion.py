@@ -87,10 +87,8 @@ def integrate_pieces(pose: Pose, pieces: list[Piece]) -> Pose:
 
 def wheel_speeds(linear: float, angular: float, radius: float, track: float) -> tuple[float, float]:
     """Forward wheel spin rates (rad/s, left and right) of a differential drive."""
-    return (
-        (linear - angular * track / 2.0) / radius,
-        (linear + angular * track / 2.0) / radius,
-    )
+    half = angular * track / 2.0
+    return (linear - half) / radius, (linear + half) / radius
 
 
 def nearest_ahead(truth: np.ndarray, mask: np.ndarray) -> float:

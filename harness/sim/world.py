@@ -109,13 +109,8 @@ class World:
         if isinstance(obstacle, Wall):
             (x0, y0), (x1, y1) = obstacle.start, obstacle.end
             half = (math.dist(obstacle.start, obstacle.end) / 2.0, obstacle.thickness / 2.0)
-            return (
-                self._add_box(
-                    ((x0 + x1) / 2.0, (y0 + y1) / 2.0),
-                    (*half, obstacle.height / 2.0),
-                    math.atan2(y1 - y0, x1 - x0),
-                ),
-            )
+            centre, yaw = ((x0 + x1) / 2.0, (y0 + y1) / 2.0), math.atan2(y1 - y0, x1 - x0)
+            return (self._add_box(centre, (*half, obstacle.height / 2.0), yaw),)
         if isinstance(obstacle, Box):
             extents = tuple(s / 2.0 for s in obstacle.size)
             return (self._add_box(obstacle.position, extents, obstacle.yaw),)
@@ -129,14 +124,7 @@ class World:
         visual = pb.createVisualShape(
             pb.GEOM_BOX, halfExtents=half, rgbaColor=_OBSTACLE_RGBA, physicsClientId=c
         )
-        return pb.createMultiBody(
-            0.0,
-            shape,
-            visual,
-            basePosition=(xy[0], xy[1], half[2]),
-            baseOrientation=yaw_quaternion(yaw),
-            physicsClientId=c,
-        )
+        return self._static_body(shape, visual, (xy[0], xy[1], half[2]), yaw_quaternion(yaw))
 
     def _add_cylinder(self, cyl: Cylinder) -> int:
         c = self.client
@@ -155,12 +143,15 @@ class World:
             rgbaColor=_OBSTACLE_RGBA,
             physicsClientId=c,
         )
+        return self._static_body(shape, visual, (*cyl.position[:2], cyl.height / 2.0))
+
+    def _static_body(
+        self, shape: int, visual: int, position: Sequence[float], orientation: Sequence[float] = ()
+    ) -> int:
+        """A body of mass 0 (it never moves) at `position` (turned by `orientation`)."""
+        turned = {"baseOrientation": orientation} if orientation else {}
         return pb.createMultiBody(
-            0.0,
-            shape,
-            visual,
-            basePosition=(cyl.position[0], cyl.position[1], cyl.height / 2.0),
-            physicsClientId=c,
+            0.0, shape, visual, basePosition=position, physicsClientId=self.client, **turned
         )
 
     def _add_model(self, index: int, model: Model) -> tuple[int, ...]:
