@@ -239,6 +239,12 @@ def _check_tree(links: list[str], joints: list[tuple[str, str, str]], what: str)
         raise ConfigError(f"{what}: joints form a loop through {', '.join(map(repr, loop))}")
 
 
+def _check_joint_type(joint: ET.Element, where: str) -> None:
+    kind = joint.get("type", "")
+    if kind not in JOINT_TYPES:
+        raise ConfigError(f"{where}: unknown type {kind!r} (known: {', '.join(JOINT_TYPES)})")
+
+
 def _unique_names(elements: Iterable[ET.Element], kind: str, what: str) -> list[str]:
     names: list[str] = []
     for element in elements:
@@ -382,9 +388,7 @@ def _check_urdf(root: ET.Element, model: ModelFile, what: str) -> ModelParts:
     tree: list[tuple[str, str, str]] = []
     for joint, name in zip(joints, joint_names, strict=True):
         where = f"{what}: joint {name!r}"
-        kind = joint.get("type", "")
-        if kind not in JOINT_TYPES:
-            raise ConfigError(f"{where}: unknown type {kind!r} (known: {', '.join(JOINT_TYPES)})")
+        _check_joint_type(joint, where)
         ends = []
         for role in ("parent", "child"):
             element = joint.find(role)
@@ -477,13 +481,8 @@ def _check_sdf(root: ET.Element, model: ModelFile, what: str) -> None:
             (name, joint.findtext("parent", "").strip(), joint.findtext("child", "").strip())
             for joint, name in zip(joints, joint_names, strict=True)
         ]
-        for name, parent, child in tree:
-            kind = next(j for j in joints if j.get("name") == name).get("type", "")
-            if kind not in JOINT_TYPES:
-                raise ConfigError(
-                    f"{where}: joint {name!r}: unknown type {kind!r} "
-                    f"(known: {', '.join(JOINT_TYPES)})"
-                )
+        for joint, (name, parent, child) in zip(joints, tree, strict=True):
+            _check_joint_type(joint, f"{where}: joint {name!r}")
             if not parent or not child:
                 raise ConfigError(f"{where}: joint {name!r} needs <parent> and <child>")
         _check_tree(names, tree, where)

@@ -169,15 +169,8 @@ class LidarConfig(_Strict):
         return value
 
     def spec(self) -> LidarSpec:
-        base = preset(self.preset)
-        return base.with_overrides(
-            samples=self.samples,
-            angle_min=self.angle_min,
-            angle_increment=self.angle_increment,
-            range_min=self.range_min,
-            range_max=self.range_max,
-            rate_hz=self.rate_hz,
-        )
+        """The preset with every other field as an override (None: the preset's)."""
+        return preset(self.preset).with_overrides(**self.model_dump(exclude={"preset"}))
 
 
 def point_text(point: Sequence[float]) -> str:

@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from dataclasses import dataclass
 from typing import Any
 
 from harness.errors import ConfigError
@@ -19,42 +18,22 @@ from harness.scenario.files import checked_scenario
 from harness.scenario.footprint import Outline
 from harness.scenario.schema import Model, Scenario
 
-__all__ = ["VARIATIONS", "ahead_distance", "check_variation_name", "varied"]
+__all__ = ["VARIATIONS", "ahead_distance", "varied"]
 
 
-@dataclass(frozen=True)
-class Variation:
-    """One generated factor: its name, unit and what a level means."""
-
-    name: str
-    unit: str
-    meaning: str
-
-
+#: Each generated factor: its unit, and what a level means.
 VARIATIONS = {
-    v.name: v
-    for v in (
-        Variation("start_dx", "m", "added to the start pose's x"),
-        Variation("start_dy", "m", "added to the start pose's y"),
-        Variation("start_dyaw", "rad", "added to the start heading"),
-        Variation(
-            "wall_distance",
-            "m",
-            "distance from the robot's start, straight ahead, to the first wall, box or "
-            "cylinder; every obstacle moves along the start heading to make it so",
-        ),
-        Variation("speed", "x", "multiplies every motion segment's linear and angular speed"),
-    )
+    "start_dx": "m, added to the start pose's x",
+    "start_dy": "m, added to the start pose's y",
+    "start_dyaw": "rad, added to the start heading",
+    "wall_distance": "m, distance from the robot's start, straight ahead, to the first wall, "
+    "box or cylinder; every obstacle moves along the start heading to make it so",
+    "speed": "x, multiplies every motion segment's linear and angular speed",
 }
 ORDER = tuple(VARIATIONS)  # applied in this order: the start pose before the wall distance
 MAX_REACH_M = 1000.0  # farther than any scenario's world: nothing ahead
 _HIT_M = 1e-6
 _MAX_STEPS = 10_000
-
-
-def check_variation_name(name: str) -> None:
-    if name not in VARIATIONS:
-        raise ConfigError(f"unknown variation {shown(name, 40)} (known: {', '.join(ORDER)})")
 
 
 def ahead_distance(scenario: Scenario) -> float | None:
