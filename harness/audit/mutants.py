@@ -138,11 +138,7 @@ MUTANTS: tuple[Mutant, ...] = (
         "two consecutive scans with the same answer (standing still, nothing in range)",
         cost_s=2.1,  # a deadline and its catch-up (1 s + 3 s) where a status repeats
     ),
-    Mutant(
-        "status_twice",
-        "publishes the status String twice for every scan",
-        "any scan",
-    ),
+    Mutant("status_twice", "publishes the status String twice for every scan", "any scan"),
     Mutant(
         "crash_when_nothing_in_range",
         "takes the minimum of an empty list when nothing is valid: the node dies",

@@ -110,10 +110,7 @@ class _Round:
 
 
 def _measure_round(
-    link: Link,
-    workload: Workload,
-    pids: list[int | None],
-    floor: Callable[[], float] | None,
+    link: Link, workload: Workload, pids: list[int | None], floor: Callable[[], float] | None
 ) -> _Round:
     floor_s = floor() if floor is not None else None
     pings = ping_pong_s(link, workload)
@@ -132,10 +129,7 @@ def _measure_round(
 
 
 def measure_link(
-    link_name: str,
-    workload: Workload,
-    rounds: int = 1,
-    floor: Callable[[], float] | None = None,
+    link_name: str, workload: Workload, rounds: int = 1, floor: Callable[[], float] | None = None
 ) -> StageResult:
     """Open `link_name` with the reference node, run the workload through it, close it.
 

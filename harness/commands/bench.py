@@ -38,9 +38,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--quick", action="store_true", help="fewer scans and shorter streaming (for tests)"
     )
     parser.add_argument(
-        "--only",
-        metavar="STAGE[,STAGE]",
-        help=f"run only these stages ({', '.join(STAGES)})",
+        "--only", metavar="STAGE[,STAGE]", help=f"run only these stages ({', '.join(STAGES)})"
     )
 
 

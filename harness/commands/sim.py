@@ -144,10 +144,7 @@ def run(args: argparse.Namespace, console: Console) -> int:
     _check_animation_suffix(args.animation)
     node = bool(args.node or args.package or args.executable)
     settings = LiveSettings(
-        rate=args.rate,
-        duration=args.duration,
-        node=node,
-        run=judging_settings(args),
+        rate=args.rate, duration=args.duration, node=node, run=judging_settings(args)
     )
 
     def ready(domain: int) -> None:

@@ -248,11 +248,7 @@ def fit_alignment(
 
 
 def _judge(
-    shares: np.ndarray,
-    truth: np.ndarray,
-    board: np.ndarray,
-    ticks: int,
-    mount: LidarMount | None,
+    shares: np.ndarray, truth: np.ndarray, board: np.ndarray, ticks: int, mount: LidarMount | None
 ) -> Alignment:
     """The verdict on the scores of every (mirror, turn): aligned, misaligned or unknown."""
     mirror, turn = np.unravel_index(int(np.argmax(shares)), shares.shape)

@@ -241,11 +241,7 @@ class FoxgloveView:
         channel.log(message, log_time=nanoseconds(t))
 
     def publish_answer(
-        self,
-        t: float,
-        status: str | None,
-        warning: bool | None,
-        verdict: Verdict | None = None,
+        self, t: float, status: str | None, warning: bool | None, verdict: Verdict | None = None
     ) -> None:
         """What the node said (None: nothing new) and how the live judge found a tick."""
         if self._closed:

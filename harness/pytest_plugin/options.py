@@ -15,13 +15,7 @@ from typing import Any
 
 import pytest
 
-from harness.links.kinds import (
-    default_link,
-    default_serial_link,
-    either,
-    link_names,
-    serial_links,
-)
+from harness.links.kinds import default_link, default_serial_link, either, link_names, serial_links
 from harness.run_request import OPTIONS as TABLE
 from harness.run_request import OptionError, RunOption, RunRequest, table
 from harness.run_request.table import names as option_names

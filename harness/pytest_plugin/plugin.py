@@ -16,12 +16,7 @@ from typing import TYPE_CHECKING, Any
 import pytest
 
 from harness.pytest_plugin.cases import MARKER, MARKER_HELP, HilCase
-from harness.pytest_plugin.options import (
-    HilConfig,
-    add_options,
-    check_config,
-    read_config,
-)
+from harness.pytest_plugin.options import HilConfig, add_options, check_config, read_config
 
 if TYPE_CHECKING:
     from harness.links.base import LinkOptions
@@ -196,8 +191,7 @@ def hil(
 def hil_case() -> HilCase:
     """Given by ``@pytest.mark.hil_scenarios(...)``; without the marker there is none."""
     pytest.fail(
-        f"hil_case comes from @pytest.mark.{MARKER}(...) on the test, which it lacks",
-        pytrace=False,
+        f"hil_case comes from @pytest.mark.{MARKER}(...) on the test, which it lacks", pytrace=False
     )
 
 

@@ -34,11 +34,7 @@ class RunProgress:
     one scenario's only after `delay` seconds, so quick runs never flash a bar."""
 
     def __init__(
-        self,
-        console: Console,
-        scenarios: Sequence[str],
-        *,
-        delay: float = SINGLE_SCENARIO_DELAY_S,
+        self, console: Console, scenarios: Sequence[str], *, delay: float = SINGLE_SCENARIO_DELAY_S
     ) -> None:
         self.enabled = console.is_terminal and not console.is_dumb_terminal
         self._console = console

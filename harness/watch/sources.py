@@ -148,8 +148,7 @@ def _real(path: str | Path) -> Path:
 def _script_sources(script: Path, shown: str) -> NodeSources:
     folder = script.parent
     return NodeSources(
-        (Watched(folder, suffixes=(".py",)),),
-        (f"{shown} and the .py files beside it in {folder}",),
+        (Watched(folder, suffixes=(".py",)),), (f"{shown} and the .py files beside it in {folder}",)
     )
 
 
