@@ -18,18 +18,9 @@ from harness.errors import OptionError
 from harness.option_names import escaped
 
 COLUMNS = (
-    "key",
-    "scenario",
-    "faults",
-    "seed",
-    "threshold",
-    "verdict",
-    "ticks",
-    "failed_ticks",
-    "first_failure",
-    "wall_s",
-    "worker",
-)
+    "key", "scenario", "faults", "seed", "threshold", "verdict", "ticks", "failed_ticks",
+    "first_failure", "wall_s", "worker",
+)  # fmt: skip
 
 
 def columns_for(varied: Sequence[str] = ()) -> tuple[str, ...]:

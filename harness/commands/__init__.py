@@ -11,18 +11,9 @@ import importlib
 from types import ModuleType
 
 COMMAND_MODULES = (
-    "list_scenarios",
-    "run",
-    "sim",
-    "ports",
-    "emulate",
-    "replay",
-    "grade",
-    "sweep",
-    "audit",
-    "hunt",
+    "list_scenarios", "run", "sim", "ports", "emulate", "replay", "grade", "sweep", "audit", "hunt",
     "bench",
-)
+)  # fmt: skip
 
 
 def command_modules() -> list[ModuleType]:

@@ -288,17 +288,9 @@ REALTIME_HELP = (
     "(default: lockstep, the next scan once the node answered)"
 )
 NODE_ROWS = (
-    "node",
-    "package",
-    "executable",
-    "workspace",
-    "params",
-    "threshold_param",
-    "scan_topic",
-    "status_topic",
-    "warning_topic",
-    "ready_timeout",
-)
+    "node", "package", "executable", "workspace", "params", "threshold_param", "scan_topic",
+    "status_topic", "warning_topic", "ready_timeout",
+)  # fmt: skip
 
 
 def add_node_options(

@@ -61,33 +61,14 @@ REPRODUCE_TIMEOUT_S = 180.0  # the counterexample's own run, node start-up inclu
 
 #: Options a reproducing `fossbot-hil run` repeats when they were given (by dest).
 RUN_OPTIONS = (
-    "link",
-    "node",
-    "package",
-    "executable",
-    "workspace",
-    "param",
-    "threshold_param",
-    "scan_topic",
-    "status_topic",
-    "warning_topic",
-    "ready_timeout",
-    "ros_network",
-    "realtime",
-    "status_regex",
-    "warning_when_clear",
-    "timeout",
-)
+    "link", "node", "package", "executable", "workspace", "param", "threshold_param", "scan_topic",
+    "status_topic", "warning_topic", "ready_timeout", "ros_network", "realtime", "status_regex",
+    "warning_when_clear", "timeout",
+)  # fmt: skip
 OUTPUTS = (  # what a hunt writes in DIR: an earlier hunt's are removed first
-    "hunt.json",
-    "runs.csv",
-    "counterexample.yaml",
-    "explanation.txt",
-    "reproduce.sh",
-    "counterexample.mcap",
-    "counterexample.png",
-    "run",
-)
+    "hunt.json", "runs.csv", "counterexample.yaml", "explanation.txt", "reproduce.sh",
+    "counterexample.mcap", "counterexample.png", "run",
+)  # fmt: skip
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

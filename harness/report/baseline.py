@@ -34,15 +34,8 @@ __all__ = [
 
 SUMMARY = "summary.json"
 VERDICTS = tuple(v.value for v in RunVerdict)
-KINDS = (
-    "regressed",
-    "fixed",
-    "still failing",
-    "new",
-    "not compared",
-    "missing",
-    "still passing",
-)  # the order the terminal and the page list them in
+#: The order the terminal and the page list them in.
+KINDS = ("regressed", "fixed", "still failing", "new", "not compared", "missing", "still passing")
 JUDGED_ALIKE = ("link", "threshold", "seed")  # what must match for two verdicts to compare
 WARNING_RULE = "warning_when_clear"  # must match too; absent (older summaries): "optional"
 _FIELDS: dict[str, type | tuple[type, ...]] = {

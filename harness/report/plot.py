@@ -74,14 +74,8 @@ class PlotSeries:
 
 _BOOL_ARRAYS = ("claimed_nonfinite", "angle_off", "failed", "not_delivered")
 _FLOAT_ARRAYS = (
-    "t",
-    "nearest",
-    "claimed",
-    "angle_expected",
-    "angle_claimed",
-    "warning_expected",
-    "warning_got",
-)
+    "t", "nearest", "claimed", "angle_expected", "angle_claimed", "warning_expected", "warning_got",
+)  # fmt: skip
 
 
 def series_data(series: PlotSeries) -> dict[str, Any]:
