@@ -150,23 +150,14 @@ def package_node(package: str, executable: str, workspace: str | None) -> NodeCo
             )
     owner = next((p for p in prefixes if (p / AMENT_MARKERS / package).is_file()), None)
     if owner is None:
-        found = sorted(
-            {
-                m.name
-                for p in prefixes
-                if (p / AMENT_MARKERS).is_dir()
-                for m in (p / AMENT_MARKERS).iterdir()
-            }
-        )
+        indexes = [p / AMENT_MARKERS for p in prefixes if (p / AMENT_MARKERS).is_dir()]
+        found = sorted({marker.name for index in indexes for marker in index.iterdir()})
         listed = ", ".join(found[:20]) or "none"
         raise OptionError.saying("package", f"{package}: not found in {where} (packages: {listed})")
     program = owner / "lib" / package / executable
     if not program.is_file():
-        there = (
-            sorted(p.name for p in (owner / "lib" / package).glob("*"))
-            if (owner / "lib" / package).is_dir()
-            else []
-        )
+        folder = owner / "lib" / package
+        there = sorted(p.name for p in folder.glob("*")) if folder.is_dir() else []
         raise OptionError.saying(
             "executable",
             f"{executable}: not in package {package} (executables: {', '.join(there) or 'none'})",
@@ -177,12 +168,8 @@ def package_node(package: str, executable: str, workspace: str | None) -> NodeCo
 
 def ros_arguments(params: tuple[str, ...], *, use_sim_time: bool = True) -> list[str]:
     """``--ros-args -p use_sim_time:=true -p NAME:=VALUE ...`` (the user's items verbatim)."""
-    args = ["--ros-args"]
-    if use_sim_time:
-        args += ["-p", "use_sim_time:=true"]
-    for item in params:
-        args += ["-p", item]
-    return args
+    head = ["--ros-args", "-p", "use_sim_time:=true"] if use_sim_time else ["--ros-args"]
+    return [*head, *(word for item in params for word in ("-p", item))]
 
 
 def node_arguments(

@@ -161,7 +161,8 @@ class ForkServer:
             raise ConnectionError("the fork server exited")
         return message, fds
 
-    def _wait_ready(self) -> bool:
+    def ready(self) -> bool:
+        """Wait (bounded) until the server has imported its module; False if it cannot."""
         with self._turn:
             if not self._ready and self._socket is not None:
                 try:
@@ -178,10 +179,6 @@ class ForkServer:
                 self.modules = dict(facts.get("modules", {}))
                 self._ready = True
             return self._ready
-
-    def ready(self) -> bool:
-        """Wait (bounded) until the server has imported its module; False if it cannot."""
-        return self._wait_ready()
 
     def still_importing(self) -> bool:
         """Would a start wait for the server's imports now? (It has not said ready.)"""
@@ -214,7 +211,7 @@ class ForkServer:
         if script is not None:
             request.update(script=script, sys_path=sys_path or [])
         with self._turn:  # reentrant: the wait for ready takes its turn too
-            if not self._wait_ready():
+            if not self.ready():
                 return None
             assert self._socket is not None
             try:

@@ -43,6 +43,7 @@ TAIL_BYTES = 16384
 FORK_SERVER_SETTING = "FOSSBOT_HIL_FORK_SERVER"
 LAST_WORDS_S = 0.5  # after the node exited: for its output's readers to reach end of file
 LINE_CHARS = 300  # a longer line in a tail is cut (a flood may have no newlines)
+_FINISHED = "(finished on its own: a node must keep running until it is stopped)"
 
 
 def fork_server_enabled() -> bool:
@@ -247,10 +248,8 @@ class NodeProcess:
                 os.close(fd)
         os.set_blocking(status_r, False)
         self._status_fd = status_r
-        self._outputs = {
-            "stdout": OutputTail(out_r, "node-stdout"),
-            "stderr": OutputTail(err_r, "node-stderr"),
-        }
+        pipes = {"stdout": out_r, "stderr": err_r}
+        self._outputs = {name: OutputTail(fd, f"node-{name}") for name, fd in pipes.items()}
         _LIVE.add(self)
         self.started_at = time.monotonic()
         self._start_pending = True
@@ -411,13 +410,8 @@ class NodeProcess:
         if code is None:
             return "still running"
         self._last_words()
-        if code < 0:
-            how = f"was killed by {signal_name(-code)}"
-        else:
-            how = f"exited with code {code}"
-        words = [how, when]
-        if code == 0:
-            words.append("(finished on its own: a node must keep running until it is stopped)")
+        how = f"was killed by {signal_name(-code)}" if code < 0 else f"exited with code {code}"
+        words = [how, when, _FINISHED if code == 0 else ""]
         last = self.tail("stderr", 3).replace("\n", " | ")
         return " ".join(w for w in words if w) + (f"; last stderr: {last}" if last else "")
 
@@ -434,10 +428,7 @@ class NodeProcess:
         elif code:
             how = f"crashed{at}: it exited with code {code}"
         else:
-            how = (
-                "exited with code 0 (finished on its own: a node must keep running until it is "
-                "stopped)"
-            )
+            how = f"exited with code 0 {_FINISHED}"
         last = last_error(self.tail("stderr"))
         return how + (f"; last stderr: {last}" if last else "")
 

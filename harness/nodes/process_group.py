@@ -5,6 +5,7 @@ delivered, not instant, so "stopped" means nothing in the group runs any more.""
 
 from __future__ import annotations
 
+import contextlib
 import os
 import select
 import time
@@ -14,10 +15,8 @@ __all__ = ["group_members", "signal_group", "wait_group_gone"]
 
 def signal_group(pgid: int, sig: int) -> None:
     """Send `sig` to every process of group `pgid`; a group already gone is fine."""
-    try:
+    with contextlib.suppress(ProcessLookupError, PermissionError):
         os.killpg(pgid, sig)
-    except (ProcessLookupError, PermissionError):
-        pass
 
 
 def group_members(pgid: int) -> list[int]:

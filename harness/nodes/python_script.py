@@ -134,11 +134,8 @@ def environment_difference(env: Mapping[str, str], server_env: Mapping[str, str]
     for name in sorted(names | set(SAME_AT_START)):
         if env.get(name) != server_env.get(name):
             return f"{name} differs from the harness's (read as an interpreter starts)"
-    added = [
-        p
-        for p in env.get("LD_LIBRARY_PATH", "").split(os.pathsep)
-        if p and p not in server_env.get("LD_LIBRARY_PATH", "").split(os.pathsep)
-    ]
+    had = server_env.get("LD_LIBRARY_PATH", "").split(os.pathsep)
+    added = [p for p in env.get("LD_LIBRARY_PATH", "").split(os.pathsep) if p and p not in had]
     for folder in added:
         if any(Path(folder).glob("*.so*")):
             return f"LD_LIBRARY_PATH adds shared libraries ({folder})"

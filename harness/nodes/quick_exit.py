@@ -5,6 +5,7 @@ PyBullet loaded) is skipped."""
 from __future__ import annotations
 
 import atexit
+import contextlib
 import os
 import sys
 from typing import NoReturn
@@ -13,15 +14,11 @@ from typing import NoReturn
 def finish_interpreter() -> None:
     """What the interpreter does on exit that code may rely on: atexit handlers, flushed
     stdout and stderr (a closed pipe or a failing handler is not ours to report)."""
-    try:
+    with contextlib.suppress(BaseException):  # the interpreter goes on past a failing one too
         atexit._run_exitfuncs()
-    except BaseException:  # the interpreter reports such a handler and goes on; so do we
-        pass
     for stream in (sys.stdout, sys.stderr):
-        try:
+        with contextlib.suppress(OSError, ValueError):
             stream.flush()
-        except (OSError, ValueError):
-            pass
 
 
 def exit_now(code: int) -> NoReturn:

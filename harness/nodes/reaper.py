@@ -50,10 +50,8 @@ class Reaper:
         self.code: int | None = None
 
     def emit(self, line: str) -> None:
-        try:
+        with contextlib.suppress(OSError):  # the harness is gone: carry on stopping everything
             os.write(self.status_fd, f"{line}\n".encode(errors="replace"))
-        except OSError:
-            pass  # the harness is gone: carry on stopping everything
 
     def reap(self) -> None:
         """Collect every child that has exited; note the node's exit code."""
@@ -91,12 +89,8 @@ class Reaper:
 
     def serve(self) -> None:
         """Relay exits until a stop is asked for."""
-        while True:
-            info = signal.sigwaitinfo(WATCHED)
-            if info.si_signo == signal.SIGCHLD:
-                self.reap()
-            else:
-                return
+        while signal.sigwaitinfo(WATCHED).si_signo == signal.SIGCHLD:
+            self.reap()
 
     def stop(self) -> None:
         """The node: SIGINT, SIGTERM, SIGKILL to its group; then every descendant left."""
@@ -129,10 +123,8 @@ class Reaper:
                 break
             for pid, name in alive.items():
                 named.setdefault(pid, name)
-                try:
+                with contextlib.suppress(ProcessLookupError):
                     os.kill(pid, signal.SIGKILL)
-                except ProcessLookupError:
-                    pass
             self.wait(0.05, lambda: False)
         self.reap()  # the last ones killed: no zombie is left to init
         for pid, name in list(named.items())[:REPORTED]:
@@ -151,10 +143,8 @@ def _signal_group(pid: int, sig: int) -> None:
     except (ProcessLookupError, PermissionError):
         in_group = False
     for send in (os.killpg,) if in_group else (os.killpg, os.kill):
-        try:
+        with contextlib.suppress(ProcessLookupError, PermissionError):
             send(pid, sig)
-        except (ProcessLookupError, PermissionError):
-            pass
 
 
 def _descendants(root: int) -> dict[int, str]:

@@ -37,14 +37,10 @@ def setup_problem(output: str, argv: Sequence[str]) -> str | None:
         return None
     module = missing[1].split(".")[0]
     program = argv[0] if argv else "the node's interpreter"
-    if argv and is_python(program):
-        return (
-            f"the node's Python ({program}) cannot import {module}: run the node with "
-            f"this harness's Python ({sys.executable}), activate the harness's virtual "
-            "environment, or source ROS 2 Jazzy"
-        )
-    return (
-        f"the node cannot import {module} (ModuleNotFoundError): start it with this "
-        f"harness's Python ({sys.executable}), activate the harness's virtual environment, "
+    fix = (
+        f"this harness's Python ({sys.executable}), activate the harness's virtual environment, "
         "or source ROS 2 Jazzy"
     )
+    if argv and is_python(program):
+        return f"the node's Python ({program}) cannot import {module}: run the node with {fix}"
+    return f"the node cannot import {module} (ModuleNotFoundError): start it with {fix}"
