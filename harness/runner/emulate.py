@@ -149,13 +149,9 @@ def _rts_reporter(log: _Log) -> Callable[[str, bool], None]:
     return told
 
 
-# The device's mode as the status line says it.
-_STATES = {
-    "idle": "idle",
-    "scan": "scanning (standard)",  # SCAN or FORCE_SCAN
-    "express": "scanning (express)",
-    "streaming": "streaming",
-}
+# The device's mode as the status line says it ("scan": SCAN or FORCE_SCAN), else
+# "scanning (MODE)".
+_STATES = {"idle": "idle", "scan": "scanning (standard)", "streaming": "streaming"}
 
 
 def status_line(stats: Any) -> str:
@@ -234,9 +230,8 @@ def emulate(
                         log.line(status_line(server.stats()))
                         status_due += status_every_s
                 scan = plan.profile.emit(tick.truth, spec, rng, stamp=tick.t)
-                samples = profile.revolution(
-                    device, scan, 1.0 / tick.period, spec.range_max, mount=mount
-                )
+                rate_hz = 1.0 / tick.period
+                samples = profile.revolution(device, scan, rate_hz, spec.range_max, mount=mount)
                 revolutions += 1  # first: a stop may come inside send_revolution
                 server.send_revolution(samples, tick.tick, tick.period)
             server.wait_idle(IDLE_WAIT_S)
@@ -245,9 +240,8 @@ def emulate(
     finally:
         line.close()
     stats = server.stats()  # the thread has stopped: the counts are final
-    report = diagnose(
-        stats, port=name, baudrate=profile.baudrate, streams_unasked=profile.streams_unasked
-    )
+    unasked = profile.streams_unasked
+    report = diagnose(stats, port=name, baudrate=profile.baudrate, streams_unasked=unasked)
     return EmulationSummary(
         revolutions=revolutions,
         bytes_written=stats.bytes_written,
