@@ -15,27 +15,10 @@ from typing import Any
 
 import pytest
 
+from harness.commands.arguments import row_type
 from harness.links.kinds import default_link, default_serial_link, either, link_names, serial_links
 from harness.run_request import OPTIONS as TABLE
 from harness.run_request import OptionError, RunOption, RunRequest, table
-from harness.run_request.table import names as option_names
-
-
-def _typed(row: RunOption) -> Callable[[str], Any] | None:
-    """The row's reader as an argparse type: its problem in one line after pytest's
-    "argument --hil-seed:" (or "hil_seed in tox.ini:")."""
-    if row.read is None:
-        return None
-    read = row.read
-
-    def parse(text: str) -> Any:
-        try:
-            return read(text)
-        except OptionError as err:
-            raise argparse.ArgumentTypeError(err.render(option_names("noun"))) from None
-
-    parse.__name__ = row.key  # argparse names the type in its own messages
-    return parse
 
 
 @dataclass(frozen=True)
@@ -56,7 +39,9 @@ class _Option:
 
     @property
     def parse(self) -> Callable[[str], Any] | None:
-        return _typed(self.row)
+        """The CLI's type: its problem in one line after "argument --hil-seed:" (or
+        "hil_seed in tox.ini:")."""
+        return row_type(self.row.key)
 
 
 LINK_HELP = (

@@ -53,17 +53,9 @@ class HilBoard:
     def run_options(self) -> dict[str, Any]:
         """Keyword arguments for ``hil.run`` that send the scenario to this board (the session's
         node options are dropped: the board runs its own driver and node)."""
-        return {
-            "link": self.link,
-            "port": self.port,
-            "domain_id": self.domain_id,
-            "ros_network": True,
-            "node": None,
-            "package": None,
-            "executable": None,
-            "workspace": None,
-            "params": (),
-        }
+        node = dict.fromkeys(("node", "package", "executable", "workspace"), None)
+        board = {"link": self.link, "port": self.port, "domain_id": self.domain_id}
+        return {**board, "ros_network": True, **node, "params": ()}
 
 
 # -- hooks --------------------------------------------------------------------
