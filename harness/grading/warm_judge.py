@@ -119,8 +119,10 @@ def serve(sandboxed: bool) -> int:
     from harness.grading.worker import interrupt_on_sigterm, not_dumpable, run_job, warm_node_server
     from harness.option_names import speak
     from harness.run_request.table import names
+    from harness.runner.frame_memo import remember_frames
 
     speak(names("grading"))  # a student's problems name the options as the grading file does
+    remember_frames()  # the class's scenarios are simulated once, for the first student
 
     # The jobs and answers on fds of their own (not inherited): what the judge starts
     # (a node's reaper) gets /dev/null as its stdin and the job's log as its output.

@@ -7,7 +7,7 @@ differs.
 from __future__ import annotations
 
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from dataclasses import replace
 from typing import TYPE_CHECKING
 
@@ -19,6 +19,7 @@ from harness.judge.records import RunResult, TickRecord
 from harness.lidar.mount import FORWARD
 from harness.lidar.scan import Scan
 from harness.links.base import Link, LinkOptions, create_link
+from harness.runner.frame_memo import frames_of, keeping
 from harness.runner.frames import Frame, check_link_faults, judge_frames
 from harness.runner.plan import RunPlan, plan_run
 from harness.runner.settings import RunSettings, faults_origin
@@ -37,8 +38,9 @@ def run_scenario(
 ) -> RunResult:
     """Run the planned scenario through `link` and judge every tick.
 
-    The link is opened here once the world is built: a node still coming up
-    (started ahead, or by `start`) does so meanwhile. Its wait is the
+    The link is opened here once the world is built (or the frames of an earlier
+    run of the plan here are at hand, harness.runner.frame_memo): a node still
+    coming up (started ahead, or by `start`) does so meanwhile. Its wait is the
     result's `startup_s`; a LinkError from the open propagates (`run_through`).
     """
     from harness.sim.simulation import Simulation  # imports pybullet
@@ -51,25 +53,32 @@ def run_scenario(
         check_link_faults(profile.link, link)
     except ConfigError as err:
         raise ConfigError(f"{faults_origin(scenario, settings)}: {err}") from None
-    periods = plan.periods()
+
+    def judge(frames: Iterable[Frame]) -> None:
+        opening = time.perf_counter()
+        link.open()
+        result.startup_s = time.perf_counter() - opening
+        judge_frames(
+            frames,
+            link,
+            plan.oracle(),
+            result,
+            on_tick=on_tick,
+            link_faults=profile.link,
+            stop_at_first_failure=settings.stop_at_first_failure,
+        )
+
     try:
-        with Simulation(scenario, gui=settings.gui) as sim:
-            opening = time.perf_counter()
-            link.open()
-            result.startup_s = time.perf_counter() - opening
-            frames = (
-                Frame(s.tick, s.t, s.x, s.y, s.yaw, _emit(profile, s, sim.spec, rng))
-                for s in sim.ticks(periods)
-            )
-            judge_frames(
-                frames,
-                link,
-                plan.oracle(),
-                result,
-                on_tick=on_tick,
-                link_faults=profile.link,
-                stop_at_first_failure=settings.stop_at_first_failure,
-            )
+        kept = frames_of(plan)
+        if kept is not None:  # simulated here before: the same frames, no world to build
+            judge(kept)
+        else:
+            with Simulation(scenario, gui=settings.gui) as sim:
+                simulated = (
+                    Frame(s.tick, s.t, s.x, s.y, s.yaw, _emit(profile, s, sim.spec, rng))
+                    for s in sim.ticks(plan.periods())
+                )
+                judge(keeping(plan, simulated))
     finally:  # an interrupted run reports its time too; waiting for the link is start-up
         result.wall_s = time.perf_counter() - started - result.startup_s
     return result

@@ -1,0 +1,63 @@
+"""The frames of a plan simulated once in a process that judges the same plans again.
+
+A grading judge runs the class's scenarios for one student after another. The
+robot's motion is scripted and a plan's faults are seeded, so what the node is
+sent never depends on the node: the second student's frames are the first's. A
+process that knows it repeats plans (``remember_frames``) keeps each plan's
+frames once its simulation has run to the end, and later runs of that plan are
+given them instead of a new world. Kept frames' arrays are read-only, so nothing
+downstream can change what the next run is sent.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Iterator
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from harness.runner.frames import Frame
+    from harness.runner.plan import RunPlan
+
+__all__ = ["MAX_FRAMES", "frames_of", "keeping", "remember_frames"]
+
+MAX_FRAMES = 10_000  # kept at most (a frame is about 3 KB): the default suite has 544
+
+_kept: dict[tuple[object, ...], tuple[object, list[Frame]]] | None = None  # None: not kept
+
+
+def remember_frames(enabled: bool = True) -> None:
+    """From now on (or no longer) keep each plan's frames for its next run here."""
+    global _kept
+    _kept = {} if enabled else None
+
+
+def _key(plan: RunPlan) -> tuple[object, ...] | None:
+    if _kept is None or plan.settings.gui:  # a viewer shows the world: it must be built
+        return None
+    return (id(plan.scenario), plan.seed, plan.profile)
+
+
+def frames_of(plan: RunPlan) -> list[Frame] | None:
+    """The plan's frames, if a run of it here simulated them all."""
+    key = _key(plan)
+    kept = _kept.get(key) if key is not None and _kept is not None else None
+    return kept[1] if kept is not None and kept[0] is plan.scenario else None
+
+
+def keeping(plan: RunPlan, frames: Iterable[Frame]) -> Iterator[Frame]:
+    """`frames` as they come, read-only, and kept for the plan's next run once all came
+    (a run that stops early keeps none: the rest were never simulated)."""
+    key = _key(plan)
+    if key is None:
+        yield from frames
+        return
+    seen: list[Frame] = []
+    for frame in frames:
+        frame.scan.ranges.flags.writeable = False
+        frame.scan.intensities.flags.writeable = False
+        seen.append(frame)
+        yield frame
+    if _kept is not None:
+        held = sum(len(f) for _, f in _kept.values())
+        if held + len(seen) <= MAX_FRAMES:
+            _kept[key] = (plan.scenario, seen)  # the scenario held: its id stays its own
