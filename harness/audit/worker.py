@@ -34,33 +34,11 @@ __all__ = ["FAILURE_CHARS", "UnitClock", "write_job"]
 FAILURE_CHARS = 600  # of each scenario's first failure kept in results.json
 
 
-def write_job(
-    path: Path,
-    *,
-    commands: dict[str, str],
-    scenarios: list[str],
-    link: str,
-    options: Any,
-    settings: Any,
-    seeds: list[int | None],
-    coverage: str | None,
-    results: Path,
-    unit_timeout: float,
-    overrides: dict[str, dict[str, dict[str, Any]]] | None = None,
-) -> Path:
-    """Write a job file: node commands, LinkOptions and RunSettings fields, bounds, overrides."""
-    job = {
-        "commands": commands,
-        "overrides": overrides or {},
-        "scenarios": scenarios,
-        "link": link,
-        "options": asdict(options),
-        "settings": asdict(settings),
-        "seeds": seeds,
-        "coverage": coverage,
-        "results": str(results),
-        "unit_timeout": unit_timeout,
-    }
+def write_job(path: Path, *, options: Any, settings: Any, results: Path, **job: Any) -> Path:
+    """Write a job file: LinkOptions and RunSettings as their fields, the rest as given (the
+    node `commands` and their `overrides` by unit, `scenarios`, `link`, `seeds`, the unit
+    whose `coverage` is kept, `unit_timeout`), as `run_job` reads them."""
+    job |= {"options": asdict(options), "settings": asdict(settings), "results": str(results)}
     return write_atomically(path, json.dumps(job, indent=2).encode())
 
 
