@@ -140,11 +140,6 @@ class LineWatch:
             return
         self.counts.wrong_baud += 1
         self.wrong_baud_rate = baud
-        self._tell(
-            LineEvent(
-                "wrong_baud",
-                f"the client set its line to {baud} baud; this device talks at "
-                f"{self.baudrate} (a pty carries the bytes anyway, a real cable "
-                "would garble them)",
-            )
-        )
+        said = f"the client set its line to {baud} baud; this device talks at {self.baudrate}"
+        said += " (a pty carries the bytes anyway, a real cable would garble them)"
+        self._tell(LineEvent("wrong_baud", said))

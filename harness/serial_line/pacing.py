@@ -130,15 +130,8 @@ class LinePacer:
             mean = sum(intervals) / len(intervals) * 1000.0
             if period_s is not None:
                 jitter = p99([abs(i - period_s) * 1000.0 for i in intervals])
-        return PacingReport(
-            bytes_paced=self.bytes_paced,
-            achieved_bytes_per_s=achieved,
-            nominal_bytes_per_s=nominal,
-            mean_rate_error_pct=error,
-            revolutions=len(self.revolution_starts),
-            period_jitter_p99_ms=jitter,
-            period_mean_ms=mean,
-        )
+        starts = len(self.revolution_starts)
+        return PacingReport(self.bytes_paced, achieved, nominal, error, starts, jitter, mean)
 
 
 LOCKSTEP_CHUNK = 4096  # bytes offered per write in lockstep (a pty takes them at once)

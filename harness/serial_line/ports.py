@@ -7,6 +7,7 @@ stop; a port that breaks is a ``LinkError``, one that cannot be opened a
 
 from __future__ import annotations
 
+import contextlib
 import errno
 import fcntl
 import os
@@ -244,11 +245,9 @@ class PtyPort(DevicePort):
         if modem is not None:
             modem.close()
         if self.symlink is not None and os.path.islink(self.symlink):
-            try:
+            with contextlib.suppress(OSError):
                 if os.readlink(self.symlink) == self.slave_path:
                     os.unlink(self.symlink)
-            except OSError:
-                pass
 
 
 class SerialPort(DevicePort):
@@ -344,10 +343,8 @@ class SerialPort(DevicePort):
     def close(self) -> None:
         ser, self._ser = self._ser, None
         if ser is not None:
-            try:
+            with contextlib.suppress(Exception):  # a vanished port may fail to close: gone anyway
                 ser.close()
-            except Exception:  # noqa: BLE001 - a vanished port may fail to close; it is gone anyway
-                pass
         lock, self._lock = self._lock, None
         if lock is not None:
             lock.release()  # after closing: the next run never finds the device still open
@@ -379,13 +376,6 @@ def list_serial_ports() -> list[PortInfo]:
     found = []
     for p in list_ports.comports():
         vid_pid = f"{p.vid:04X}:{p.pid:04X}" if p.vid is not None and p.pid is not None else None
-        found.append(
-            PortInfo(
-                device=p.device,
-                description=p.description if p.description and p.description != "n/a" else "",
-                vid_pid=vid_pid,
-                serial_number=p.serial_number,
-                manufacturer=p.manufacturer,
-            )
-        )
+        description = p.description if p.description and p.description != "n/a" else ""
+        found.append(PortInfo(p.device, description, vid_pid, p.serial_number, p.manufacturer))
     return sorted(found, key=lambda info: info.device)

@@ -96,14 +96,10 @@ def snapshot(
     return ServerStats(
         mode=mode,
         requests_seen=requests,
-        peer_present=line.peer_present,
-        peer_seen=line.peer_seen,
-        host_baud=line.host_baud,
-        wrong_baud_rate=line.wrong_baud_rate,
-        dtr=line.dtr,
         device_mode=device.mode,
         pacing=pacing,
         requests_by_command=dict(device.requests_by_command),
         device_errors={k: v for k, v in counters.items() if v},
+        **asdict(line),
         **asdict(counts),
     )

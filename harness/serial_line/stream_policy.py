@@ -41,6 +41,10 @@ Mode = Literal["lockstep", "realtime"]
 NextStart = Literal["extra", "replace"]
 # A pushed revolution: samples, tick, period, push id.
 Push = tuple[Sequence[Any], int, float, int]
+MOTOR_OFF = (
+    "a scan was asked for but the motor is off (the board's DTR asserted, or MOTOR_PWM 0): "
+    "an A1 streams nothing until it turns"
+)
 
 
 def no_return(sample: Any) -> Any:
@@ -298,13 +302,7 @@ class StreamPolicy:
         self.counts.motor_off_revolutions += 1
         if not self._motor_off_streak:
             self._motor_off_streak = True
-            self._tell(
-                LineEvent(
-                    "motor_off",
-                    "a scan was asked for but the motor is off (the board's DTR asserted, "
-                    "or MOTOR_PWM 0): an A1 streams nothing until it turns",
-                )
-            )
+            self._tell(LineEvent("motor_off", MOTOR_OFF))
 
     def _encode(self, samples: Sequence[Any], ms: int) -> bytes:
         return self.device.encode_revolution(list(samples), start_ms=ms)
