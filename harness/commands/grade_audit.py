@@ -9,6 +9,7 @@ from typing import TYPE_CHECKING
 from rich.console import Console
 
 from harness.errors import one_line
+from harness.report.console_text import print_safe as say
 
 if TYPE_CHECKING:
     from harness.grading.grade import GradeConfig
@@ -39,11 +40,7 @@ def class_audit(
         seeds=(config.settings.seed,),
         units_dir=out.resolve() / "audit",
     )
-    console.print(
-        "checking which typical mistakes these scenarios catch (fossbot-hil audit)...",
-        markup=False,
-        highlight=False,
-    )
+    say(console, "checking which typical mistakes these scenarios catch (fossbot-hil audit)...")
     try:
         data, cached = known_audit(client, audit, scenarios)
     except Exception as err:  # noqa: BLE001 - the grades are written; the audit is advice

@@ -27,6 +27,7 @@ from harness.commands.run_steps import (
     write_report_file,
 )
 from harness.errors import ConfigError, Interrupted
+from harness.report.console_text import print_safe as say
 
 if TYPE_CHECKING:  # the rest is imported when a run starts (the parser is built for any command)
     from harness.judge.records import RunResult
@@ -190,12 +191,7 @@ def _run(
         scenarios = ordered_by_last_run(console, scenarios, cache.failed())
     report = open_report(args.out, animate=args.animate)
     if report is not None and report.cleared:
-        console.print(
-            f"--out: removed {report.cleared} scenario files of the run before",
-            highlight=False,
-            markup=False,
-            soft_wrap=True,
-        )
+        say(console, f"--out: removed {report.cleared} scenario files of the run before")
     ran = scenario_of(scenarios)
 
     with RunProgress(console, grading.shown_names(scenarios)) as progress:
@@ -238,7 +234,7 @@ def _run(
             alignment=alignment,
             alignment_mode=mode,
         )
-        console.print(f"report: {index}", highlight=False, markup=False, soft_wrap=True)
+        say(console, f"report: {index}")
     if args.junit_xml:
         write_junit_file(args.junit_xml, shown, report)
     grading.finish(console, results, args, wall_s)  # the score; --gradescope's results.json
@@ -257,7 +253,6 @@ def ordered_by_last_run(
     console: Console, scenarios: list[Scenario], failed: set[str]
 ) -> list[Scenario]:
     """`--failed-first`: the scenarios that failed last time first, and a line saying so."""
-    from harness.report.console_text import print_safe
     from harness.watch.order import failed_first
 
     first = [s.name for s in scenarios if s.name in failed]
@@ -265,5 +260,5 @@ def ordered_by_last_run(
         line = f"--failed-first: {len(first)} failed last time, run first: {', '.join(first)}"
     else:
         line = "--failed-first: none of these failed last time (or no earlier run): given order"
-    print_safe(console, line)
+    say(console, line)
     return failed_first(scenarios, failed)

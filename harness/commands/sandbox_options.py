@@ -9,6 +9,7 @@ from rich.console import Console
 
 from harness.commands.arguments import whole_number
 from harness.errors import ConfigError
+from harness.report.console_text import print_safe as say
 from harness.sandbox.limits import SandboxLimits
 
 __all__ = ["add_sandbox_options", "sandbox_limits", "check_workers"]
@@ -53,7 +54,7 @@ def sandbox_limits(args: argparse.Namespace, console: Console) -> SandboxLimits 
     from harness.sandbox.probe import sandbox_problem
 
     if args.no_sandbox:
-        console.print(NO_SANDBOX_WARNING, markup=False, highlight=False, soft_wrap=True)
+        say(console, NO_SANDBOX_WARNING)
         return None
     problem = sandbox_problem()
     if problem is not None:
@@ -72,9 +73,7 @@ def check_workers(client: Any, console: Console) -> None:
     if len(problems) == len(client.scheduler_info().get("workers", {})):
         raise ConfigError(next(iter(problems.values())))
     for worker, problem in sorted(problems.items()):
-        console.print(
+        say(
+            console,
             f"warning: worker {worker} cannot sandbox, its students are not graded: {problem}",
-            markup=False,
-            highlight=False,
-            soft_wrap=True,
         )
