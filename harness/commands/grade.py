@@ -354,7 +354,6 @@ def run(args: argparse.Namespace, console: Console) -> int:
             },
             sandbox=sandbox,
             sandbox_checked=args.scheduler is None,  # the embedded cluster's host is this one
-            defer_plots=True,  # drawn by each worker beside its next student's run
         )
         if replaced:
             console.print(replaced, markup=False, highlight=False)

@@ -31,7 +31,6 @@ from harness.grading.build import build_student
 from harness.grading.class_table import ERROR, NOT_RUN, PASS, StudentGrade
 from harness.grading.discover import Student
 from harness.grading.hidden import HiddenScenario, scrub_folder
-from harness.grading.plots import PLOT_WAIT_S, plots_drawn, plotter
 from harness.grading.process import TERM_GRACE_S, Finished, StopFlag, guarded
 from harness.grading.scoring import held_of
 from harness.grading.warm_judge import Slot, close_judges, drop_judge, warm_judge
@@ -75,9 +74,6 @@ class GradeConfig:
     # True: the grader has found that its host can sandbox, and every worker runs there
     # (the embedded cluster), so a worker need not try again before its first student.
     sandbox_checked: bool = False
-    # True: each student's plots are drawn by the worker after their run, beside the next
-    # student's (harness.grading.plots); `grade_class` waits for them before it returns.
-    defer_plots: bool = False
 
     @property
     def unheld(self) -> dict[str, tuple[int, int]]:
@@ -373,7 +369,6 @@ def _grade(student: Student, config: GradeConfig, cancel: StopFlag) -> StudentGr
         slot.move_out(folder, grader, kept)
         return without_run("interrupted", build_s)
     options = _run_options(student, config, folder)  # as the messages name them
-    plots = grader / "plots" if config.defer_plots else None
     job = write_job(
         slot.grader / "job.json",
         scenarios=list(config.scenario_refs),
@@ -386,13 +381,10 @@ def _grade(student: Student, config: GradeConfig, cancel: StopFlag) -> StudentGr
         hidden={
             n: {"label": h.label, "show_failure": h.show_failure} for n, h in config.hidden.items()
         },
-        plots=None if plots is None else slot.grader / "plots",
     )
     finished = _judge_warm(job, slot, config, cancel)
     slot.move_out(folder, grader, kept)
     _map_results(grader / "results.json", slot.moved(copy, real, folder, grader))
-    if plots is not None and plots.is_dir():  # drawn while the worker's next student runs
-        plotter().submit(plots, folder / "report" / "scenarios", grader / "plot-errors.log")
     data = _read_results(grader / "results.json")
     verdicts, failures = verdicts_and_failures(data, finished, config, folder, options.node)
     first = next((failures[n] for n in config.scenarios if n in failures), "")
@@ -456,8 +448,7 @@ def grade_class(
     Students go out only as workers free up (harness.cluster.window), so a worker
     holds only the student it grades. Open the client with ``retries=WORKER_RETRIES``:
     a student whose grading kills its worker runs once more elsewhere (a worker can die
-    for reasons of its own) before their row says so. With `config.defer_plots` it
-    returns once every worker drew its plots (bounded). `on_graded` gets each row, with
+    for reasons of its own) before their row says so. `on_graded` gets each row, with
     how many are being graded; on Ctrl-C or SIGTERM the running builds and suites stop,
     each within its bounded grace, before KeyboardInterrupt goes up.
     """
@@ -485,8 +476,6 @@ def grade_class(
         raise
     finally:
         _close_judges(client, config)
-    if config.defer_plots:
-        _wait_for_plots(client)
     return [grades[i] for i in range(len(students))]
 
 
@@ -496,13 +485,6 @@ def _close_judges(client: Any, config: GradeConfig) -> None:
     with contextlib.suppress(Exception):
         client.run(close_judges, str(config.grader_dir))
     shutil.rmtree(config.grader_dir / ".slots", ignore_errors=True)
-
-
-def _wait_for_plots(client: Any) -> None:
-    """Every worker's students' plots drawn (each worker waits at most PLOT_WAIT_S); a
-    worker that went away took its undrawn plots with it."""
-    with contextlib.suppress(Exception):
-        client.run(plots_drawn, PLOT_WAIT_S)
 
 
 def _task_key(student: Student) -> str:

@@ -69,12 +69,9 @@ def write_job(
     junit: Path,
     report: Path | None = None,
     hidden: dict[str, Any] | None = None,
-    plots: Path | None = None,
 ) -> Path:
     """Write a job file for this worker: LinkOptions and RunSettings as their fields;
-    `hidden`: scenario name -> {"label", "show_failure"}, shown to the student by label;
-    `plots`: the report's plots left there as data, for the grader to draw
-    (harness.grading.plots), instead of drawn here."""
+    `hidden`: scenario name -> {"label", "show_failure"}, shown to the student by label."""
     job = {
         "hidden": hidden or {},
         "scenarios": scenarios,
@@ -84,7 +81,6 @@ def write_job(
         "results": str(results),
         "junit": str(junit),
         "report": None if report is None else str(report),
-        "plots": None if plots is None else str(plots),
     }
     return write_atomically(path, json.dumps(job, indent=2).encode())
 
@@ -118,7 +114,7 @@ def run_job(job: dict[str, Any]) -> int:
     """Run the job's suite; results.json tells the outcome, the exit code only if it broke."""
     from harness.report.outputs import ReportFolder
 
-    report = ReportFolder(job["report"], _writers(job)) if job.get("report") else None
+    report = ReportFolder(job["report"]) if job.get("report") else None
     suite = _Suite(job, report)
     started = time.monotonic()
     try:
@@ -126,17 +122,6 @@ def run_job(job: dict[str, Any]) -> int:
     finally:
         if report is not None:
             report.finish(time.monotonic() - started)  # index.html of what was judged
-
-
-def _writers(job: dict[str, Any]) -> list[Any] | None:
-    """The report's writers: the usual ones (None), or with the plot left as data."""
-    if not job.get("plots"):
-        return None
-    from harness.grading.plots import PlotRequests
-    from harness.report.outputs import artifact_writers
-
-    requests = PlotRequests(Path(job["plots"]))
-    return [requests.writer() if w.name == "plot" else w for w in artifact_writers()]
 
 
 class _Suite:
