@@ -16,6 +16,7 @@ from rich.console import Console
 from rich.table import Table
 
 from harness.bench import STAGES
+from harness.report.console_text import print_safe as say
 
 if TYPE_CHECKING:  # the stages are imported when the bench runs
     from harness.bench.stage import StageResult
@@ -83,13 +84,8 @@ def print_report(console: Console, report: dict[str, Any]) -> None:
     m = report["machine"]
     load = m.get("load_average_start")
     load_text = " ".join(f"{x:.2f}" for x in load) if load else "unknown"
-    console.print(
-        f"{m['cpu']}, {m['cores']} cores, Python {m['python']}, {m['os']}; "
-        f"load average at start {load_text}",
-        highlight=False,
-        markup=False,
-        soft_wrap=True,
-    )
+    machine = f"{m['cpu']}, {m['cores']} cores, Python {m['python']}, {m['os']}"
+    say(console, f"{machine}; load average at start {load_text}")
     console.print()
     console.print(throughput_table(report))
     console.print()

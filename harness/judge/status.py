@@ -17,7 +17,7 @@ from dataclasses import dataclass
 
 from harness.errors import ConfigError
 from harness.judge.status_numbers import WORD_END, WORD_START, Number, find_numbers
-from harness.judge.structured_status import KeyedClaim, read_structured
+from harness.judge.structured_status import read_structured
 
 __all__ = ["StatusClaim", "compile_status_pattern", "parse_status"]
 
@@ -119,16 +119,22 @@ def _parse_with(rx: re.Pattern[str], text: str) -> StatusClaim:
         obstacle = said.strip().lower() not in _FALSY
     else:
         obstacle = distance is not None
+    why = f"obstacle group {said!r}" if said is not None else "no distance"
+    return _claim(text, obstacle, distance, angle, reason=None if obstacle else why)
+
+
+def _claim(
+    text: str, obstacle: bool, distance: Number | None, angle: Number | None, **more: str | None
+) -> StatusClaim:
+    """The claim of these numbers: their values and printed precision."""
     return StatusClaim(
-        text=text,
-        obstacle=obstacle,
-        distance=distance.value if distance else None,
-        angle=angle.value if angle else None,
-        distance_decimals=distance.decimals if distance else None,
-        angle_decimals=angle.decimals if angle else None,
-        reason=None
-        if obstacle
-        else (f"obstacle group {said!r}" if said is not None else "no distance"),
+        text,
+        obstacle,
+        distance.value if distance else None,
+        angle.value if angle else None,
+        distance.decimals if distance else None,
+        angle.decimals if angle else None,
+        **more,
     )
 
 
@@ -139,35 +145,15 @@ def parse_status(text: str, pattern: str | re.Pattern[str] | None = None) -> Sta
         return _parse_with(rx, text)
     keyed = read_structured(text)
     if keyed is not None:
-        return _from_keys(text, keyed)
+        said = {"reason": keyed.reason, "unreadable": keyed.unreadable}
+        return _claim(text, keyed.obstacle, keyed.distance, keyed.angle, **said)
     negative = _negation(text)
     if negative is not None:
         return StatusClaim(text, False, None, None, None, None, reason=f"says {negative!r}")
     distance, angle = _pick(find_numbers(text))
     if distance is None:
         return StatusClaim(text, False, None, None, None, None, reason="no number")
-    return StatusClaim(
-        text=text,
-        obstacle=True,
-        distance=distance.value,
-        angle=angle.value if angle else None,
-        distance_decimals=distance.decimals,
-        angle_decimals=angle.decimals if angle else None,
-    )
-
-
-def _from_keys(text: str, keyed: KeyedClaim) -> StatusClaim:
-    distance, angle = keyed.distance, keyed.angle
-    return StatusClaim(
-        text=text,
-        obstacle=keyed.obstacle,
-        distance=distance.value if distance else None,
-        angle=angle.value if angle else None,
-        distance_decimals=distance.decimals if distance else None,
-        angle_decimals=angle.decimals if angle else None,
-        reason=keyed.reason,
-        unreadable=keyed.unreadable,
-    )
+    return _claim(text, True, distance, angle)
 
 
 def half_unit(decimals: int | None) -> float:

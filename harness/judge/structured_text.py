@@ -111,15 +111,8 @@ def _printed(text: str) -> Printed:
     return Printed(float(text), text)
 
 
-_WORDS: dict[str, object] = {
-    "inf": math.inf,
-    "infinity": math.inf,
-    "nan": math.nan,
-    "true": True,
-    "false": False,
-    "null": None,
-    "none": None,
-}
+_WORDS: dict[str, object] = {"inf": math.inf, "infinity": math.inf, "nan": math.nan}
+_WORDS |= {"true": True, "false": False, "null": None, "none": None}
 # Calls that only wrap a number as str() and repr() print it: np.float32(0.84), float('inf').
 _WRAPPERS = {"float", "int", "double", "float16", "float32", "float64", "float_", "bool_"}
 
@@ -172,11 +165,8 @@ def _literal(node: ast.expr, src: str, depth: int) -> object:
     if isinstance(node, ast.Dict):
         if depth > 1:
             return Shape.OTHER
-        pairs = []
-        for k, v in zip(node.keys, node.values, strict=True):
-            key = _key(k)
-            pairs.append((key, _literal(v, src, depth + 1)))
-        return _Mapping(pairs)
+        items = zip(node.keys, node.values, strict=True)
+        return _Mapping([(_key(k), _literal(v, src, depth + 1)) for k, v in items])
     if isinstance(node, ast.List | ast.Tuple):
         if depth > 0:
             return Shape.OTHER if node.elts else None
