@@ -37,6 +37,7 @@ PORT_FIELD = "{port}"
 DRIVER_NAME = "the board's LIDAR driver"  # the bundled driver, in messages
 OWN_TOPICS = "/_fossbot_hil"  # where each node under test answers (`node_topics`)
 END_IDLE_S = 1.0  # lockstep: for the idle stream's last revolution to be written
+OUTPUTS = ("stderr", "stdout")
 
 
 def board_command(text: str, port: str = "/dev/null") -> NodeCommand:
@@ -214,9 +215,7 @@ class BoardSession:
     def _empty_revolution(self, rate_hz: float) -> list[Sample]:
         """A revolution with no return anywhere, at the device's native sample count."""
         count = self.profile.samples_per_rev(self.device, rate_hz)
-        return [
-            Sample(angle_deg=360.0 * j / count, distance_mm=0.0, quality=0) for j in range(count)
-        ]
+        return [Sample(360.0 * j / count, 0.0, 0) for j in range(count)]
 
     def node_topics(self, status: str, warning: str) -> tuple[str, str] | None:
         """A status and a warning topic of its own for the next node under test, or None for
@@ -271,13 +270,10 @@ class BoardSession:
 
     def diagnostics(self) -> str:
         """The board's software's last output, for a failure report."""
-        parts = []
-        for name, process in self.processes:
-            for which in ("stderr", "stdout"):
-                tail = process.tail(which)
-                if tail:
-                    parts.append(f"{name} {which} (last lines):\n{tail}")
-        return "\n".join(parts)
+        tails = [(name, which, p.tail(which)) for name, p in self.processes for which in OUTPUTS]
+        return "\n".join(
+            f"{name} {which} (last lines):\n{tail}" for name, which, tail in tails if tail
+        )
 
     def close(self) -> None:
         """Stop the board's software, the device and the line; release the domain. Twice is safe."""

@@ -152,10 +152,7 @@ class NodeGraph:
     def _reads_scans(self) -> bool:
         """Does something besides the harness read the scan topic?"""
         assert self.observer is not None
-        obs = self.observer
-        if obs.scan_pub is not None:
-            return obs.scan_pub.get_subscription_count() > 0
-        return obs.node.count_subscribers(self.options.scan_topic) > 1  # the harness's is one
+        return self.observer.scan_readers() > 0
 
     def _never_ready(self) -> str:
         """Why the node is not ready: what the harness waited for, and what was missing."""
@@ -223,11 +220,9 @@ class NodeGraph:
             gone = self.hooks.gone(when)
             if gone is not None:
                 return gone
-        if self.process is None:  # a physical board: its software runs elsewhere
+        if self.process is None or self.process.returncode() is None:  # a physical board: elsewhere
             return None
-        if self.process.returncode() is not None:
-            return f"node {self.command.description} {self.process.exit_summary(when)}"
-        return None
+        return f"node {self.command.description} {self.process.exit_summary(when)}"
 
     def wait_for(
         self, done: Callable[[], bool], seconds: float, *, poll: float = POLL_S

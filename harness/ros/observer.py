@@ -218,7 +218,7 @@ class Observer:
         readers = self._others(infos)
         return bool(readers) and all(i.node_name != UNKNOWN_NODE_NAME for i in readers)
 
-    def _scan_readers(self) -> int:
+    def scan_readers(self) -> int:
         """Readers of the scan topic other than this observer."""
         if self.scan_pub is not None:
             return self.scan_pub.get_subscription_count()
@@ -314,7 +314,7 @@ class Observer:
     def graph_summary(self) -> str:
         """What the node under test offers, for 'never became ready' explanations."""
         counts = (
-            f"subscribers on {self.scan_topic}: {self._scan_readers()}, "
+            f"subscribers on {self.scan_topic}: {self.scan_readers()}, "
             f"publishers on {self.status_topic}: {self.status_sub.get_publisher_count()}"
         )
         return "; ".join([counts, *self.qos_mismatches(), self.node_topics()])

@@ -88,17 +88,8 @@ def judge_frames(
         seen = answers.seen if answers.seen is not None else frame.scan
         verdict = oracle.judge(frame.tick, frame.t, seen, answers, delivery)
         # Judged whole; kept clipped (lengths noted), so a flood cannot bloat the reports.
-        record = TickRecord(
-            frame.tick,
-            frame.t,
-            frame.x,
-            frame.y,
-            frame.yaw,
-            frame.scan,
-            answers.clipped(),
-            verdict.clipped(),
-            delivery,
-        )
+        taken = (frame.tick, frame.t, frame.x, frame.y, frame.yaw, frame.scan)
+        record = TickRecord(*taken, answers.clipped(), verdict.clipped(), delivery)
         result.records.append(record)
         if on_tick is not None:
             on_tick(record)
@@ -205,7 +196,6 @@ def _interrupted(err: KeyboardInterrupt, result: RunResult, frame: Frame | None)
     stop = Interrupted.of(err)
     where = f" at t={frame.t:.2f} s tick {frame.tick}" if frame is not None else ""
     count = len(result.records)
-    result.error = (
-        f"interrupted by {stop.name}{where} ({count} tick{'' if count == 1 else 's'} judged)"
-    )
+    ticks = f"{count} tick{'' if count == 1 else 's'} judged"
+    result.error = f"interrupted by {stop.name}{where} ({ticks})"
     return Interrupted(stop.signum, [result])

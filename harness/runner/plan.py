@@ -144,21 +144,13 @@ def node_topic_options(scenario: Scenario, options: LinkOptions) -> LinkOptions:
     wanted = scenario.node_topics
     if wanted is None:
         return options
-    defaults = LinkOptions()
-    own_topics = (options.scan_topic, options.status_topic, options.warning_topic) != (
-        defaults.scan_topic,
-        defaults.status_topic,
-        defaults.warning_topic,
-    )
+    defaults, fields = LinkOptions(), ("scan_topic", "status_topic", "warning_topic")
+    own_topics = any(getattr(options, f) != getattr(defaults, f) for f in fields)
     given = {item.split(":=", 1)[0] for item in options.params}
     if own_topics or given & set(options.topic_params):
         return options
-    scan_param, status_param, warning_param = options.topic_params
-    topics = {
-        "scan_topic": (scan_param, wanted.scan),
-        "status_topic": (status_param, wanted.status),
-        "warning_topic": (warning_param, wanted.warning),
-    }
+    names = zip(options.topic_params, (wanted.scan, wanted.status, wanted.warning), strict=True)
+    topics = dict(zip(fields, names, strict=True))  # field -> (its parameter, the topic)
     chosen = {field: topic for field, (_, topic) in topics.items() if topic is not None}
     params = tuple(f"{param}:={topic}" for param, topic in topics.values() if topic is not None)
     return replace(options, **chosen, params=(*options.params, *params))

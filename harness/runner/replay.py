@@ -113,20 +113,8 @@ def replay(
         return replayed
 
     def not_started(reason: str, diagnostics: str) -> RunResult:
-        return RunResult(
-            name,
-            link_name,
-            seed,
-            threshold,
-            faults,
-            noise_sigma,
-            error=reason,
-            diagnostics=diagnostics,
-        )
+        row = (name, link_name, seed, threshold, faults, noise_sigma)
+        return RunResult(*row, error=reason, diagnostics=diagnostics)
 
-    return with_link(
-        link_name,
-        replace(options, threshold=threshold, scan_rate_hz=scan_rate_hz(recording)),
-        body,
-        not_started,
-    )
+    options = replace(options, threshold=threshold, scan_rate_hz=scan_rate_hz(recording))
+    return with_link(link_name, options, body, not_started)
