@@ -98,22 +98,12 @@ def given(option: str) -> Callable[[str], str]:
 #: quoted `--node "python3 ~/lab07/node.py"` reaches us unexpanded.
 COMMAND_OPTIONS: Mapping[str, str] = {"node": "--node", "board_command": "--board-command"}
 PATH_OPTIONS: Mapping[str, str] = {
-    "workspace": "--workspace",
-    "out": "--out",
-    "junit_xml": "--junit-xml",
-    "baseline": "--baseline",
-    "record": "--record",
-    "animation": "--animation",
-    "grading": "--grading",
-    "gradescope": "--gradescope",
-    "roster": "--roster",
-    "port": "--port",
-    "processor": "--processor",
-    "scenarios": "SCENARIO",
-    "dirs": "DIR",
-    "recording": "FILE",
+    "workspace": "--workspace", "out": "--out", "junit_xml": "--junit-xml",
+    "baseline": "--baseline", "record": "--record", "animation": "--animation",
+    "grading": "--grading", "gradescope": "--gradescope", "roster": "--roster", "port": "--port",
+    "processor": "--processor", "scenarios": "SCENARIO", "dirs": "DIR", "recording": "FILE",
     "world": "WORLD",
-}
+}  # fmt: skip
 #: Paths in a comma-separated list: each item expanded (`~` starts each one).
 PATH_LIST_OPTIONS: Mapping[str, str] = {"scenario": "--scenario"}  # names or scenario files
 

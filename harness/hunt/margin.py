@@ -21,14 +21,11 @@ FAILED = -1.0  # the margin of a run that failed
 
 #: What a failure's text starts with (or holds) -> its kind.
 _KINDS = (
-    ("expected warning", "warning"),
-    ("expected distance", "distance"),
-    ("gives no distance", "distance"),
-    ("expected angle", "angle"),
-    ("gives no angle", "angle"),
-    ("claims an obstacle", "phantom obstacle"),
+    ("expected warning", "warning"), ("expected distance", "distance"),
+    ("gives no distance", "distance"), ("expected angle", "angle"),
+    ("gives no angle", "angle"), ("claims an obstacle", "phantom obstacle"),
     ("expected an obstacle", "missed obstacle"),
-)
+)  # fmt: skip
 
 
 @dataclass(frozen=True)

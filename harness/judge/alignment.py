@@ -205,10 +205,6 @@ def _evenly(items: Sequence[tuple[Scan, Scan]], cap: int) -> list[tuple[Scan, Sc
     return [items[i] for i in picks]
 
 
-def _rotation(index: int) -> float:
-    return _normalised(float(index))
-
-
 def _refined(row: np.ndarray, turn: int) -> float:
     """The turn in degrees, from the peak of one mirror's scores.
 
@@ -235,8 +231,7 @@ def fit_alignment(
     if not used:
         return None
     grids = [(_grid(t, *_window(t, b)), _grid(b, *_window(t, b))) for t, b in used]
-    truth = np.array([g[0] for g in grids])
-    board = np.array([g[1] for g in grids])
+    truth, board = (np.array(side) for side in zip(*grids, strict=True))
     plain_agree, plain_union = _scores(truth, board)
     mirror_agree, mirror_union = _scores(truth, _mirror(board))
     # Mirrored turn R compares truth bin i with board bin (R - i): the mirrored rows at -R.
@@ -289,7 +284,8 @@ def _look_alike(shares: np.ndarray, mirror: int, turn: int, rotation: float) -> 
     best, runner = float(shares[mirror, turn]), float(others[second, turn2])
     if best - runner >= MARGIN:
         return ""
-    named = f"{_transform(bool(mirror), rotation)} and {_transform(bool(second), _rotation(turn2))}"
+    other = _transform(bool(second), _normalised(float(turn2)))
+    named = f"{_transform(bool(mirror), rotation)} and {other}"
     agree = f"{_percent(best)} and {_percent(runner)} of compared beams agree"
     if (others > best - MARGIN).sum() >= ROUND_SCENE:
         return f"the run's scenes look alike whichever way they are turned (e.g. {named}: {agree})"

@@ -21,37 +21,22 @@ from collections.abc import Callable
 
 from harness.errors import OptionError
 
-# key -> (x, y, z, th), teleop_twist_keyboard's moveBindings
+# key -> (x, y, z, th), teleop_twist_keyboard's moveBindings (laid out as the keys are)
 MOVE_KEYS: dict[str, tuple[int, int, int, int]] = {
-    "u": (1, 0, 0, 1),
-    "i": (1, 0, 0, 0),
-    "o": (1, 0, 0, -1),
-    "j": (0, 0, 0, 1),
-    "k": (0, 0, 0, 0),
-    "l": (0, 0, 0, -1),
-    "m": (-1, 0, 0, -1),
-    ",": (-1, 0, 0, 0),
-    ".": (-1, 0, 0, 1),
-    "U": (1, 1, 0, 0),
-    "I": (1, 0, 0, 0),
-    "O": (1, -1, 0, 0),
-    "J": (0, 1, 0, 0),
-    "L": (0, -1, 0, 0),
-    "M": (-1, 1, 0, 0),
-    "<": (-1, 0, 0, 0),
-    ">": (-1, -1, 0, 0),
-    "t": (0, 0, 1, 0),
-    "b": (0, 0, -1, 0),
-}
+    "u": (1, 0, 0, 1), "i": (1, 0, 0, 0), "o": (1, 0, 0, -1),
+    "j": (0, 0, 0, 1), "k": (0, 0, 0, 0), "l": (0, 0, 0, -1),
+    "m": (-1, 0, 0, -1), ",": (-1, 0, 0, 0), ".": (-1, 0, 0, 1),
+    "U": (1, 1, 0, 0), "I": (1, 0, 0, 0), "O": (1, -1, 0, 0),
+    "J": (0, 1, 0, 0), "L": (0, -1, 0, 0),
+    "M": (-1, 1, 0, 0), "<": (-1, 0, 0, 0), ">": (-1, -1, 0, 0),
+    "t": (0, 0, 1, 0), "b": (0, 0, -1, 0),
+}  # fmt: skip
 # key -> (factor on speed, factor on turn), teleop_twist_keyboard's speedBindings
 SPEED_KEYS: dict[str, tuple[float, float]] = {
-    "q": (1.1, 1.1),
-    "z": (0.9, 0.9),
-    "w": (1.1, 1.0),
-    "x": (0.9, 1.0),
-    "e": (1.0, 1.1),
-    "c": (1.0, 0.9),
-}
+    "q": (1.1, 1.1), "z": (0.9, 0.9),  # speed and turn
+    "w": (1.1, 1.0), "x": (0.9, 1.0),  # speed only
+    "e": (1.0, 1.1), "c": (1.0, 0.9),  # turn only
+}  # fmt: skip
 DEFAULT_SPEED = 0.5  # m/s, teleop_twist_keyboard's default
 DEFAULT_TURN = 1.0  # rad/s, teleop_twist_keyboard's default
 REPEAT_RATE_HZ = 10.0  # well inside the robot's 0.5 s command timeout

@@ -39,14 +39,9 @@ KINDS = ("regressed", "fixed", "still failing", "new", "not compared", "missing"
 JUDGED_ALIKE = ("link", "threshold", "seed")  # what must match for two verdicts to compare
 WARNING_RULE = "warning_when_clear"  # must match too; absent (older summaries): "optional"
 _FIELDS: dict[str, type | tuple[type, ...]] = {
-    "scenario": str,
-    "verdict": str,
-    "ok": bool,
-    "faults": str,
-    "link": str,
-    "threshold": (int, float, str),
-    "seed": int,
-}
+    "scenario": str, "verdict": str, "ok": bool, "faults": str, "link": str,
+    "threshold": (int, float, str), "seed": int,
+}  # fmt: skip
 Key = tuple[str, str, int]  # scenario, fault profile, occurrence (a run may repeat a scenario)
 
 

@@ -10,13 +10,9 @@ lists the rest. Pure: pydantic and numpy, no pybullet. Add a check in
 from harness import lazy_exports
 
 _EXPORTS = {
-    "Scenario": "schema",
-    "parse_scenario": "files",
-    "load_scenario_file": "files",
-    "resolve_scenario": "files",
-    "shipped_scenarios": "files",
-    "shipped_dir": "files",
+    "Scenario": "schema", "parse_scenario": "files", "load_scenario_file": "files",
+    "resolve_scenario": "files", "shipped_scenarios": "files", "shipped_dir": "files",
     "scenario_mount": "mount",
-}
+}  # fmt: skip
 __all__ = sorted(_EXPORTS)
 __getattr__ = lazy_exports(__name__, _EXPORTS)
