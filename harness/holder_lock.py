@@ -18,6 +18,7 @@ which is then counted and freed by the last release.
 
 from __future__ import annotations
 
+import contextlib
 import fcntl
 import os
 import sys
@@ -99,10 +100,8 @@ def shared_folder(folder: Path) -> Path:
     """A folder of lock files every user of this machine can add to (sticky, like /tmp)."""
     if not folder.is_dir():
         folder.mkdir(parents=True, exist_ok=True)
-        try:
+        with contextlib.suppress(OSError):  # made by another user a moment ago: theirs to set
             folder.chmod(0o1777)  # anyone may add a lock, only its owner remove it
-        except OSError:  # made by another user a moment ago: theirs to set
-            pass
     return folder
 
 
@@ -116,10 +115,8 @@ def _read_holder(handle: int) -> Holder:
 def _open(path: Path, shared: bool) -> int:
     handle = os.open(path, os.O_RDWR | os.O_CREAT | os.O_CLOEXEC, 0o666)
     if shared:
-        try:
+        with contextlib.suppress(OSError):  # another user's file: its owner made it shared
             os.fchmod(handle, 0o666)  # the umask must not lock other users out
-        except OSError:
-            pass  # another user's file: its owner made it shared
     return handle
 
 
@@ -168,10 +165,8 @@ class HolderLock:
             del _held[key]
             handle, _, remove = entry
             if remove:  # still locked, so no other run can be using this file now
-                try:
+                with contextlib.suppress(OSError):
                     os.unlink(key)
-                except OSError:
-                    pass
             os.close(handle)  # closing the only descriptor drops the flock
 
     def __enter__(self) -> HolderLock:
@@ -225,11 +220,10 @@ def take(
             os.close(handle)  # its holder removed it as we locked: lock the new one
             continue
         break
-    try:
+    # Another user's file may be ours to lock but not to write: the lock is what counts.
+    with contextlib.suppress(OSError):
         os.ftruncate(handle, 0)  # a record longer than ours must not leave its tail behind
         os.pwrite(handle, Holder.record(this_process() if command is None else command), 0)
-    except OSError:
-        pass  # another user's file we may lock but not write: the lock is what counts
     with _guard:
         _held[key] = [handle, 1, remove]
     return HolderLock(path)

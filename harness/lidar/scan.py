@@ -7,7 +7,7 @@ scan the node under test received.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 from typing import Any
 
 import numpy as np
@@ -45,20 +45,12 @@ class Scan:
 
     def to_bytes(self) -> bytes:
         """A canonical byte form, for determinism checks and digests."""
-        head = np.array(
-            [
-                self.angle_min,
-                self.angle_max,
-                self.angle_increment,
-                self.time_increment,
-                self.scan_time,
-                self.range_min,
-                self.range_max,
-                self.stamp,
-            ],
-            dtype=np.float64,
-        )
+        head = np.array([*(getattr(self, name) for name in FLOATS), self.stamp], dtype=np.float64)
         return head.tobytes() + self.ranges.tobytes() + self.intensities.tobytes()
+
+
+#: The layout's seven numbers, LaserScan's float fields in its order (angle_min ... range_max).
+FLOATS = tuple(f.name for f in fields(Scan))[:7]
 
 
 def scan_from_message(message: Any) -> Scan:
@@ -66,13 +58,7 @@ def scan_from_message(message: Any) -> Scan:
     reads it) as a Scan; its arrays are copied, so the message may be reused."""
     stamp = message.header.stamp
     return Scan(
-        angle_min=float(message.angle_min),
-        angle_max=float(message.angle_max),
-        angle_increment=float(message.angle_increment),
-        time_increment=float(message.time_increment),
-        scan_time=float(message.scan_time),
-        range_min=float(message.range_min),
-        range_max=float(message.range_max),
+        **{name: float(getattr(message, name)) for name in FLOATS},
         ranges=np.array(message.ranges, dtype=np.float32),
         intensities=np.array(message.intensities, dtype=np.float32),
         stamp=stamp.sec + stamp.nanosec * 1e-9,

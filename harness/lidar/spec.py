@@ -50,19 +50,9 @@ class LidarSpec:
 
     def scan(self, ranges: np.ndarray, **fields: Any) -> Scan:
         """A scan of this layout holding `ranges` (and `fields`: intensities, stamp, ...)."""
-        from harness.lidar.scan import Scan  # numpy: not for those who only read presets
+        from harness.lidar.scan import FLOATS, Scan  # numpy: not for those who only read presets
 
-        return Scan(
-            angle_min=self.angle_min,
-            angle_max=self.angle_max,
-            angle_increment=self.angle_increment,
-            time_increment=self.time_increment,
-            scan_time=self.scan_time,
-            range_min=self.range_min,
-            range_max=self.range_max,
-            ranges=ranges,
-            **fields,
-        )
+        return Scan(**{name: getattr(self, name) for name in FLOATS}, ranges=ranges, **fields)
 
     def with_overrides(self, **changes: float | int | None) -> LidarSpec:
         """A copy with the given fields replaced (None means keep)."""
@@ -114,38 +104,15 @@ def _full_circle(samples: int, *, closed: bool) -> float:
 PRESETS: dict[str, LidarSpec] = {
     spec.name: spec
     for spec in (
+        # name, samples, angle_min, angle_increment, range_min, range_max, rate_hz.
         # The lab's simulator (public FOSSBot Gazebo model): 360 samples from -pi
         # to pi inclusive, as Gazebo spaces them ((max - min) / (samples - 1)).
-        LidarSpec(
-            name="gazebo",
-            samples=360,
-            angle_min=-math.pi,
-            angle_increment=_full_circle(360, closed=True),
-            range_min=0.12,
-            range_max=12.0,
-            rate_hz=10.0,
-        ),
+        LidarSpec("gazebo", 360, -math.pi, _full_circle(360, closed=True), 0.12, 12.0, 10.0),
         # Slamtec RPLIDAR A1M8 as the FOSSBot v2 bridge publishes it: 360 one-degree
         # bins, 0 .. 2*pi - step.
-        LidarSpec(
-            name="rplidar_a1",
-            samples=360,
-            angle_min=0.0,
-            angle_increment=_full_circle(360, closed=False),
-            range_min=0.15,
-            range_max=12.0,
-            rate_hz=5.5,
-        ),
+        LidarSpec("rplidar_a1", 360, 0.0, _full_circle(360, closed=False), 0.15, 12.0, 5.5),
         # LDROBOT LD19/LD06: 4500 samples/s at 10 Hz = 450 points per turn.
-        LidarSpec(
-            name="ld19",
-            samples=450,
-            angle_min=0.0,
-            angle_increment=_full_circle(450, closed=False),
-            range_min=0.02,
-            range_max=12.0,
-            rate_hz=10.0,
-        ),
+        LidarSpec("ld19", 450, 0.0, _full_circle(450, closed=False), 0.02, 12.0, 10.0),
     )
 }
 

@@ -25,28 +25,13 @@ SYSTEM = ("/usr", "/bin", "/sbin", "/lib", "/lib32", "/lib64", "/libx32", "/etc"
 # What the sandboxed environment keeps of the grader's: these names, and names with these
 # beginnings.
 KEPT_NAMES = ("PATH", "LANG", "LANGUAGE", "TZ", "TERM", "VIRTUAL_ENV", "LD_LIBRARY_PATH")
-KEPT_PREFIXES = (
-    "LC_",
-    "PYTHON",
-    "ROS_",
-    "RMW_",
-    "RCUTILS_",
-    "FASTRTPS_",
-    "FASTDDS_",
-    "CYCLONEDDS_",
-    "AMENT_",
-    "COLCON_",
-    "CMAKE_PREFIX_PATH",
-)
+KEPT_PREFIXES = ("LC_", "PYTHON", "ROS_", "RMW_", "RCUTILS_", "FASTRTPS_", "FASTDDS_")
+KEPT_PREFIXES += ("CYCLONEDDS_", "AMENT_", "COLCON_", "CMAKE_PREFIX_PATH")
 
 
 def _existing(paths: Iterable[str | Path]) -> list[str]:
-    seen: dict[str, None] = {}
-    for path in paths:
-        text = os.path.abspath(str(path))
-        if os.path.lexists(text):
-            seen[text] = None
-    return list(seen)
+    texts = (os.path.abspath(str(path)) for path in paths)
+    return list(dict.fromkeys(text for text in texts if os.path.lexists(text)))
 
 
 @functools.cache
@@ -75,11 +60,7 @@ def system_paths() -> tuple[tuple[str, ...], dict[str, str]]:
 def sandbox_env(extra: Mapping[str, str] | None = None) -> dict[str, str]:
     """The grader's environment without anything of its own (tokens, paths of its
     folders): only what Python, ROS 2 and DDS read."""
-    kept = {
-        name: value
-        for name, value in os.environ.items()
-        if name in KEPT_NAMES or name.startswith(KEPT_PREFIXES)
-    }
+    kept = {n: v for n, v in os.environ.items() if n in KEPT_NAMES or n.startswith(KEPT_PREFIXES)}
     kept["PYTHONUNBUFFERED"] = "1"
     return {**kept, **(extra or {})}
 
@@ -107,11 +88,8 @@ def run_view(
 ) -> View:
     """The judging process: the node's files (to start it), the scenario files, and the
     student's output folders (report, results); `env` added to its environment."""
-    return _view(
-        [*(p.resolve() for p in node_files), *(p.resolve() for p in scenario_files)],
-        [p.resolve() for p in outputs],
-        env=sandbox_env(env),
-    )
+    read = [p.resolve() for p in (*node_files, *scenario_files)]
+    return _view(read, [p.resolve() for p in outputs], env=sandbox_env(env))
 
 
 def node_view(node_files: Iterable[Path]) -> View:
