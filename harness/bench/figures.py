@@ -15,17 +15,9 @@ from harness.bench.stage import StageResult
 from harness.links.kinds import INPROCESS, ROS2
 
 __all__ = [
-    "GRADE_KEYS",
-    "HIL_KEYS",
-    "REQUIRED_KEYS",
-    "STUDENT_SPLIT_KEYS",
-    "SUITE_KEYS",
-    "TARGETS",
-    "OVERHEAD_FORMULA",
-    "Target",
-    "check_targets",
-    "figures",
-]
+    "GRADE_KEYS", "HIL_KEYS", "REQUIRED_KEYS", "STUDENT_SPLIT_KEYS", "SUITE_KEYS", "TARGETS",
+    "OVERHEAD_FORMULA", "Target", "check_targets", "figures",
+]  # fmt: skip
 
 #: The keys issue 7 asks `bench --json` for; each is a number, or null when its stage did not run.
 REQUIRED_KEYS = (

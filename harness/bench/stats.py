@@ -13,17 +13,9 @@ from itertools import accumulate, pairwise
 from statistics import median
 
 __all__ = [
-    "RPLIDAR_NODE_BYTES",
-    "RPLIDAR_SCAN_DESCRIPTOR",
-    "arrival_rate",
-    "jitter_ms",
-    "jitter_p99_ms",
-    "median",
-    "overhead_ratio",
-    "percentile",
-    "read_times",
-    "rplidar_revolution_starts",
-]
+    "RPLIDAR_NODE_BYTES", "RPLIDAR_SCAN_DESCRIPTOR", "arrival_rate", "jitter_ms", "jitter_p99_ms",
+    "median", "overhead_ratio", "percentile", "read_times", "rplidar_revolution_starts",
+]  # fmt: skip
 
 #: The RPLIDAR's reply descriptor to SCAN: 0xA5 0x5A, 5-byte nodes, multiple response, type 0x81.
 RPLIDAR_SCAN_DESCRIPTOR = bytes((0xA5, 0x5A, 0x05, 0x00, 0x00, 0x40, 0x81))

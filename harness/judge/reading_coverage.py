@@ -32,17 +32,9 @@ from harness.judge.records import RunResult, TickRecord
 from harness.lidar.scan import Scan
 
 __all__ = [
-    "ANGLE_MARGIN_RAD",
-    "CASES",
-    "NEAR_THRESHOLD_M",
-    "ReadingCoverage",
-    "band_of",
-    "coverage_by_scenario",
-    "coverage_of",
-    "delivered_scans",
-    "gaps",
-    "other_counts",
-]
+    "ANGLE_MARGIN_RAD", "CASES", "NEAR_THRESHOLD_M", "ReadingCoverage", "band_of",
+    "coverage_by_scenario", "coverage_of", "delivered_scans", "gaps", "other_counts",
+]  # fmt: skip
 
 CASES = ("nan", "pos_inf", "neg_inf", "zero", "below_range_min", "above_range_max")
 CASE_NAMES = {  # each case as reports name it

@@ -23,14 +23,8 @@ from harness.errors import OptionError
 from harness.judge.verdicts import RunVerdict
 
 __all__ = [
-    "KINDS",
-    "Baseline",
-    "Change",
-    "Comparison",
-    "compare",
-    "load_baseline",
-    "with_comparison",
-]
+    "KINDS", "Baseline", "Change", "Comparison", "compare", "load_baseline", "with_comparison",
+]  # fmt: skip
 
 SUMMARY = "summary.json"
 VERDICTS = tuple(v.value for v in RunVerdict)

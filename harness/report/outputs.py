@@ -36,15 +36,9 @@ if TYPE_CHECKING:  # pydantic only when a scenario is at hand
     from harness.scenario.schema import Scenario
 
 __all__ = [
-    "ArtifactWriter",
-    "PromisedArtifactWriter",
-    "ReportFolder",
-    "ScenarioFiles",
-    "WorldArtifactWriter",
-    "artifact_writers",
-    "prepare_folder",
-    "write_report",
-]
+    "ArtifactWriter", "PromisedArtifactWriter", "ReportFolder", "ScenarioFiles",
+    "WorldArtifactWriter", "artifact_writers", "prepare_folder", "write_report",
+]  # fmt: skip
 
 SCENARIO_FOLDER = "scenarios"
 SUMMARY, JUNIT, INDEX = "summary.json", "junit.xml", "index.html"

@@ -25,15 +25,9 @@ from harness.lidar.scan import Scan
 from harness.safe_text import visible
 
 __all__ = [
-    "AS_WRITTEN",
-    "PlotSeries",
-    "draw_text",
-    "plot_series",
-    "render_plot",
-    "series_data",
-    "series_from_data",
-    "write_plot",
-]
+    "AS_WRITTEN", "PlotSeries", "draw_text", "plot_series", "render_plot", "series_data",
+    "series_from_data", "write_plot",
+]  # fmt: skip
 
 WIDTH_IN, HEIGHT_IN, DPI = 8.0, 6.0, 90  # about 720 x 540 px: a few tens of kB
 # Where the axes sit, as fractions of the figure: room for the tick labels on the left,

@@ -22,16 +22,9 @@ if TYPE_CHECKING:
     from harness.judge.alignment import Alignment
 
 __all__ = [
-    "FORMAT",
-    "alignment_entry",
-    "alignment_fails",
-    "coverage_entry",
-    "json_bytes",
-    "run_summary",
-    "scenario_details",
-    "scenario_entry",
-    "tick_entry",
-]
+    "FORMAT", "alignment_entry", "alignment_fails", "coverage_entry", "json_bytes", "run_summary",
+    "scenario_details", "scenario_entry", "tick_entry",
+]  # fmt: skip
 
 FORMAT = 1  # bump when a key changes meaning or disappears (docs/reports.md)
 

@@ -28,17 +28,9 @@ from harness.errors import ConfigError
 from harness.safe_text import shown
 
 __all__ = [
-    "MAX_MESH_BYTES",
-    "MAX_MODEL_BYTES",
-    "MESH_SUFFIXES",
-    "ModelFile",
-    "ModelParts",
-    "check_model_file",
-    "exists",
-    "find_model_file",
-    "parse_xml",
-    "robot_models_dir",
-]
+    "MAX_MESH_BYTES", "MAX_MODEL_BYTES", "MESH_SUFFIXES", "ModelFile", "ModelParts",
+    "check_model_file", "exists", "find_model_file", "parse_xml", "robot_models_dir",
+]  # fmt: skip
 
 MAX_MODEL_BYTES = 5 << 20  # a URDF/SDF file; the FOSSBot's is 7 kB
 MAX_MESH_BYTES = 50 << 20  # one mesh file
