@@ -8,6 +8,7 @@ timing something else. The build is timed apart: a student builds once.
 
 from __future__ import annotations
 
+import contextlib
 import re
 import shutil
 import signal
@@ -122,10 +123,8 @@ def build_lab_workspace(
 def _kill(popen: subprocess.Popen[bytes]) -> None:
     """Stop the build's whole process group, bounded."""
     signal_group(popen.pid, signal.SIGKILL)
-    try:
+    with contextlib.suppress(subprocess.TimeoutExpired):  # unkillable (D state): no hang
         popen.wait(timeout=KILL_WAIT_S)
-    except subprocess.TimeoutExpired:  # unkillable (D state): do not hang on it
-        pass
     wait_group_gone(popen.pid, KILL_WAIT_S)
 
 

@@ -145,8 +145,7 @@ def measure_link(
         link.open()
         opened_s = time.perf_counter() - started
         pids = _node_pids(link)
-        for _ in range(rounds):
-            done.append(_measure_round(link, workload, pids, floor))
+        done.extend(_measure_round(link, workload, pids, floor) for _ in range(rounds))
         peaks = [process_peak_rss_mb(pid) for pid in pids]
         startup_s = getattr(link, "startup_s", opened_s)
     finally:

@@ -199,10 +199,7 @@ def _levels(
     from harness.scenario.variations import varied
 
     chosen = [name for item in args.scenario for name in item]
-    if chosen:
-        scenarios = [resolve_scenario(name) for name in chosen]
-    else:
-        scenarios = shipped_scenarios()
+    scenarios = [resolve_scenario(name) for name in chosen] if chosen else shipped_scenarios()
     variations = variation_levels(varied_levels)
     scenarios = [varied(s, dict(v)) for s in scenarios for v in variations]  # each one checked
     faults = split_fault_text(args.faults) if args.faults else [SCENARIO_FAULTS]

@@ -201,15 +201,11 @@ class ReadingCoverage:
 
     def merge(self, other: ReadingCoverage) -> ReadingCoverage:
         """Add `other`'s counts to these; returns self."""
-        self.scans += other.scans
         for case in CASES:
             self.beside_valid[case] += other.beside_valid[case]
             self.without_valid[case] += other.without_valid[case]
-        self.near_threshold += other.near_threshold
-        self.angle_near_pi += other.angle_near_pi
-        self.angle_min_zero += other.angle_min_zero
-        self.angle_min_minus_pi += other.angle_min_minus_pi
-        self.warning_clears += other.warning_clears
+        for name in ("scans", *_OTHER_GAPS):  # the counts beside the cases
+            setattr(self, name, getattr(self, name) + getattr(other, name))
         return self
 
     def as_dict(self) -> dict[str, Any]:
@@ -223,11 +219,7 @@ class ReadingCoverage:
                 }
                 for case in CASES
             },
-            "near_threshold": self.near_threshold,
-            "angle_near_pi": self.angle_near_pi,
-            "angle_min_zero": self.angle_min_zero,
-            "angle_min_minus_pi": self.angle_min_minus_pi,
-            "warning_clears": self.warning_clears,
+            **{name: getattr(self, name) for name in _OTHER_GAPS},
         }
 
 

@@ -115,10 +115,7 @@ def _parse_with(rx: re.Pattern[str], text: str) -> StatusClaim:
     distance = _one_number(groups.get("distance"))
     angle = _one_number(groups.get("angle"))
     said = groups.get("obstacle")
-    if said is not None:
-        obstacle = said.strip().lower() not in _FALSY
-    else:
-        obstacle = distance is not None
+    obstacle = said.strip().lower() not in _FALSY if said is not None else distance is not None
     why = f"obstacle group {said!r}" if said is not None else "no distance"
     return _claim(text, obstacle, distance, angle, reason=None if obstacle else why)
 

@@ -100,8 +100,7 @@ def _label_before(gap: str) -> str | None:
     # unless it is ambiguous between distance and angle.
     if "distance" in found and "angle" in found:
         return None
-    last = max(found, key=lambda label: _last_match_end(KEYWORDS[label], gap))
-    return last
+    return max(found, key=lambda label: _last_match_end(KEYWORDS[label], gap))
 
 
 def _last_match_end(rx: re.Pattern[str], text: str) -> int:
