@@ -24,7 +24,7 @@ from multiprocessing.connection import Connection, Pipe
 from pathlib import Path
 from typing import Any
 
-from harness.nodes.process import OutputTail, signal_name
+from harness.nodes.process import OutputTail, how_it_ended
 from harness.nodes.process_group import signal_group, wait_group_gone
 
 __all__ = ["Outcome", "ProcessorChild"]
@@ -50,10 +50,8 @@ def _describe_raise(err: BaseException) -> str:
         text = str(err)
     except BaseException:  # noqa: BLE001 - its __str__ is the user's code too
         text = "(its message could not be shown)"
-    where = ""
     frames = traceback.extract_tb(err.__traceback__)
-    if frames:
-        where = f" ({Path(frames[-1].filename).name}:{frames[-1].lineno})"
+    where = f" ({Path(frames[-1].filename).name}:{frames[-1].lineno})" if frames else ""
     name = type(err).__name__
     return f"processing function raised {name}{': ' + text if text else ''}{where}"
 
@@ -175,12 +173,7 @@ class ProcessorChild:
         """Why the child cannot answer: how it ended (it is reaped here)."""
         self.close(grace=OUTPUT_WAIT_S)  # it closed its end, or died: let it finish dying
         code = self._returncode
-        if code is None:
-            how = "ended"
-        elif code < 0:
-            how = f"was killed by {signal_name(-code)}"
-        else:
-            how = f"exited with code {code}"
+        how = "ended" if code is None else how_it_ended(code)
         return f"processing function ended its process: it {how}{self._last_output()}"
 
     def _last_output(self) -> str:

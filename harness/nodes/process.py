@@ -169,6 +169,11 @@ def signal_name(number: int) -> str:
         return f"signal {number}"
 
 
+def how_it_ended(code: int) -> str:
+    """An exit code in words: 'exited with code 1', or 'was killed by SIGKILL' (negative)."""
+    return f"was killed by {signal_name(-code)}" if code < 0 else f"exited with code {code}"
+
+
 class NodeProcess:
     """One running node under test, started under reaper.py (see there)."""
 
@@ -410,8 +415,7 @@ class NodeProcess:
         if code is None:
             return "still running"
         self._last_words()
-        how = f"was killed by {signal_name(-code)}" if code < 0 else f"exited with code {code}"
-        words = [how, when, _FINISHED if code == 0 else ""]
+        words = [how_it_ended(code), when, _FINISHED if code == 0 else ""]
         last = self.tail("stderr", 3).replace("\n", " | ")
         return " ".join(w for w in words if w) + (f"; last stderr: {last}" if last else "")
 
@@ -423,10 +427,8 @@ class NodeProcess:
             return "is still running"
         self._last_words()
         at = f" {when}" if when else ""
-        if code < 0:
-            how = f"crashed{at}: it was killed by {signal_name(-code)}"
-        elif code:
-            how = f"crashed{at}: it exited with code {code}"
+        if code:
+            how = f"crashed{at}: it {how_it_ended(code)}"
         else:
             how = f"exited with code 0 {_FINISHED}"
         last = last_error(self.tail("stderr"))

@@ -10,7 +10,7 @@ import struct
 
 import numpy as np
 
-from harness.lidar.scan import Scan
+from harness.lidar.scan import FLOATS, Scan
 
 __all__ = ["clock_cdr", "scan_cdr", "stamp_parts"]
 
@@ -34,28 +34,12 @@ def scan_cdr(scan: Scan) -> bytes:
     frame_id = scan.frame_id.encode() + b"\0"
     header = struct.pack("<iII", *stamp_parts(scan.stamp), len(frame_id)) + frame_id
     header += b"\0" * (-len(header) % 4)  # the float32 fields align to 4
-    fields = np.array(
-        [
-            scan.angle_min,
-            scan.angle_max,
-            scan.angle_increment,
-            scan.time_increment,
-            scan.scan_time,
-            scan.range_min,
-            scan.range_max,
-        ],
-        FLOAT32,
-    )
-    ranges = np.asarray(scan.ranges, FLOAT32)
-    intensities = np.asarray(scan.intensities, FLOAT32)
-    return b"".join(
-        (
-            ENCAPSULATION,
-            header,
-            fields.tobytes(),
-            struct.pack("<I", ranges.size),
-            ranges.tobytes(),
-            struct.pack("<I", intensities.size),
-            intensities.tobytes(),
-        )
-    )
+    fields = np.array([getattr(scan, name) for name in FLOATS], FLOAT32)  # angle_min ...
+    sequences = (_floats(scan.ranges), _floats(scan.intensities))
+    return b"".join((ENCAPSULATION, header, fields.tobytes(), *sequences))
+
+
+def _floats(values: np.ndarray) -> bytes:
+    """A CDR sequence<float32>: its length, then its items."""
+    values = np.asarray(values, FLOAT32)
+    return struct.pack("<I", values.size) + values.tobytes()
