@@ -9,10 +9,8 @@ it: a mutant no scenario fails is a mistake the suite cannot see.
 from harness import lazy_exports
 
 _EXPORTS = {
-    "Mutant": "mutants",
-    "MUTANTS": "mutants",
-    "mutant_named": "mutants",
+    "Mutant": "mutants", "MUTANTS": "mutants", "mutant_named": "mutants",
     "mutant_command": "mutants",
-}
+}  # fmt: skip
 __all__ = sorted(_EXPORTS)
 __getattr__ = lazy_exports(__name__, _EXPORTS)

@@ -24,36 +24,20 @@ from std_msgs.msg import Bool, String
 CONTROL = "correct"
 MUTANT_NAMES = (
     # the angle of the nearest return
-    "angle_in_degrees",
-    "angle_without_angle_min",
-    "angle_from_filtered_index",
+    "angle_in_degrees", "angle_without_angle_min", "angle_from_filtered_index",
     "angle_from_wrong_end",
     # which readings count
-    "min_over_raw_ranges",
-    "only_inf_filtered",
-    "nan_not_filtered",
-    "zero_as_obstacle",
-    "below_range_min_kept",
-    "above_range_max_kept",
-    "front_sector_only",
+    "min_over_raw_ranges", "only_inf_filtered", "nan_not_filtered", "zero_as_obstacle",
+    "below_range_min_kept", "above_range_max_kept", "front_sector_only",
     # the warning
-    "threshold_hard_coded",
-    "warning_inverted",
-    "warning_latched",
-    "warning_never",
+    "threshold_hard_coded", "warning_inverted", "warning_latched", "warning_never",
     "rounded_before_comparing",
     # when and how it answers
-    "one_scan_late",
-    "silent_when_clear",
-    "status_only_on_change",
-    "status_twice",
-    "crash_when_nothing_in_range",
-    "slow_callback",
-    "goes_silent",
+    "one_scan_late", "silent_when_clear", "status_only_on_change", "status_twice",
+    "crash_when_nothing_in_range", "slow_callback", "goes_silent",
     # units and configuration
-    "centimetres",
-    "scan_topic_ignored",
-)
+    "centimetres", "scan_topic_ignored",
+)  # fmt: skip
 EXIT_UNKNOWN = 2
 
 NO_OBSTACLE = "No obstacle detected"

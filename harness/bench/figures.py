@@ -62,12 +62,9 @@ OVERHEAD_FORMULA = (
 
 #: Throughput stages, by the name their figures carry.
 _THROUGHPUT = {
-    "raycast": "raycast",
-    "synthesis": "synthesis",
-    INPROCESS: INPROCESS,
-    ROS2: "ros2_lockstep",
+    "raycast": "raycast", "synthesis": "synthesis", INPROCESS: INPROCESS, ROS2: "ros2_lockstep",
     "serial": "serial_lockstep",
-}
+}  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -86,33 +83,17 @@ TARGETS = (
     Target("lab_suite_wall_s", "lab trio over ROS 2", "< 5 s", lambda v: v < 5.0),
     Target("lab_suite_cli_wall_s", "lab trio, CLI from spawn", "< 5 s", lambda v: v < 5.0),
     Target("suite_s", "shipped suite over ROS 2, CLI from spawn", "<= 2.0 s", lambda v: v <= 2.0),
-    Target(
-        "student_suite_ratio",
-        "shipped suite, workspace node / bundled node",
-        "<= 1.2",
-        lambda v: v <= 1.2,
-    ),
-    Target(
-        "inprocess_suite_ratio",
-        "shipped suite, bundled node / inprocess link",
-        "<= 1.5",
-        lambda v: v <= 1.5,
-    ),
-    Target(
-        "grade_ratio",
-        "grading a class / its runs on the same workers",
-        "<= 1.3",
-        lambda v: v <= 1.3,
-    ),
-    Target(
-        "hil_gap_median_s",
-        "real-time HIL: gap between scenarios, median",
-        "<= 1 s",
-        lambda v: v <= 1.0,
-    ),
+    Target("student_suite_ratio", "shipped suite, workspace node / bundled node",
+           "<= 1.2", lambda v: v <= 1.2),
+    Target("inprocess_suite_ratio", "shipped suite, bundled node / inprocess link",
+           "<= 1.5", lambda v: v <= 1.5),
+    Target("grade_ratio", "grading a class / its runs on the same workers",
+           "<= 1.3", lambda v: v <= 1.3),
+    Target("hil_gap_median_s", "real-time HIL: gap between scenarios, median",
+           "<= 1 s", lambda v: v <= 1.0),
     Target("serial_rate_error_pct", "serial byte rate error", "within 1 %", lambda v: abs(v) <= 1),
     Target("serial_jitter_p99_ms", "revolution jitter p99", "< 2 ms", lambda v: v < 2.0),
-)
+)  # fmt: skip
 
 
 def _extra(stage: StageResult | None, key: str) -> Any:

@@ -38,13 +38,10 @@ __all__ = [
 
 CASES = ("nan", "pos_inf", "neg_inf", "zero", "below_range_min", "above_range_max")
 CASE_NAMES = {  # each case as reports name it
-    "nan": "NaN",
-    "pos_inf": "+inf",
-    "neg_inf": "-inf",
-    "zero": "0.0",
+    "nan": "NaN", "pos_inf": "+inf", "neg_inf": "-inf", "zero": "0.0",
     "below_range_min": "below range_min (0 < r < range_min)",
     "above_range_max": "above range_max (finite)",
-}
+}  # fmt: skip
 NEAR_THRESHOLD_M = 0.1  # beyond the band's edge, either side of the threshold
 ANGLE_MARGIN_RAD = 0.2  # of +pi or -pi
 ANGLE_MIN_TOL = 1e-6  # angle_min 0 or -pi within this

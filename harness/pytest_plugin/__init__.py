@@ -4,11 +4,8 @@
 from harness import lazy_exports
 
 _EXPORTS = {
-    "NodeUnderTest": "plugin",
-    "HilBoard": "plugin",
-    "HilCase": "cases",
-    "Hil": "hil",
+    "NodeUnderTest": "plugin", "HilBoard": "plugin", "HilCase": "cases", "Hil": "hil",
     "HilResult": "result",
-}
+}  # fmt: skip
 __all__ = sorted(_EXPORTS)
 __getattr__ = lazy_exports(__name__, _EXPORTS)

@@ -30,11 +30,9 @@ if TYPE_CHECKING:
 
 DIAGNOSTIC_LINES = 15
 VERDICT_STYLES = {
-    RunVerdict.PASS: "green",
-    RunVerdict.FAIL: "red",
-    RunVerdict.ERROR: "red",
+    RunVerdict.PASS: "green", RunVerdict.FAIL: "red", RunVerdict.ERROR: "red",
     RunVerdict.NOT_RUN: "yellow",
-}
+}  # fmt: skip
 CHANGE_STYLES = {"regressed": "bold red", "fixed": "green", "still failing": "yellow"}
 
 

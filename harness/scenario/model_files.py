@@ -40,11 +40,9 @@ JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "floating", "plan
 SHAPES = ("box", "cylinder", "sphere", "capsule", "mesh", "plane")  # URDF's and SDF's
 # The sizes each solid shape must give (name, how many numbers), every one positive.
 _SIZES = {
-    "box": (("size", 3),),
-    "cylinder": (("radius", 1), ("length", 1)),
-    "capsule": (("radius", 1), ("length", 1)),
-    "sphere": (("radius", 1),),
-}
+    "box": (("size", 3),), "cylinder": (("radius", 1), ("length", 1)),
+    "capsule": (("radius", 1), ("length", 1)), "sphere": (("radius", 1),),
+}  # fmt: skip
 
 
 def robot_models_dir() -> Path:

@@ -8,10 +8,7 @@
 from harness import lazy_exports
 
 _EXPORTS = {
-    "ChangeFeed": "changes",
-    "WatchLoop": "loop",
-    "WatchScreen": "screen",
-    "failed_first": "order",
-}
+    "ChangeFeed": "changes", "WatchLoop": "loop", "WatchScreen": "screen", "failed_first": "order",
+}  # fmt: skip
 __all__ = sorted(_EXPORTS)
 __getattr__ = lazy_exports(__name__, _EXPORTS)
