@@ -75,9 +75,7 @@ class ResultsTable:
         self.path = path
         self.columns = tuple(columns)
         resuming = resume and path.exists()
-        if resuming:
-            check_columns(path, self.columns)
-        rows = read_rows(path) if resuming else []
+        rows = rows_to_resume(path, self.columns) if resuming else []
         self.done = {row["key"] for row in rows}
         self.rows = rows
         path.parent.mkdir(parents=True, exist_ok=True)

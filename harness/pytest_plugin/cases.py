@@ -52,16 +52,9 @@ def _fault_items(faults: Any) -> list[str | None]:
     )
 
 
-def split_faults(text: str) -> list[str]:
-    """ "noisy,drop(rate=0.1)" -> ["noisy", "drop(rate=0.1)"]."""
-    from harness.faults.sensor import split_fault_text
-
-    return split_fault_text(text)
-
-
 def cases_from_marker(args: Sequence[Any], kwargs: dict[str, Any]) -> list[HilCase]:
     """The cases a marker names, checked: unknown names raise ConfigError (one line)."""
-    from harness.faults.sensor import build_profile
+    from harness.faults.sensor import build_profile, split_fault_text
     from harness.scenario.files import resolve_scenario, shipped_scenarios
 
     unknown = sorted(set(kwargs) - {"faults"})
@@ -75,5 +68,5 @@ def cases_from_marker(args: Sequence[Any], kwargs: dict[str, Any]) -> list[HilCa
     faults = _fault_items(kwargs.get("faults"))
     for item in faults:
         if item is not None:
-            build_profile(split_faults(item), field_name="faults")
+            build_profile(split_fault_text(item), field_name="faults")
     return [HilCase(name, item) for name in names for item in faults]

@@ -19,7 +19,7 @@ import pytest
 from harness.errors import ConfigError, HarnessError
 from harness.links.kinds import link_kind
 from harness.option_names import speaking
-from harness.pytest_plugin.cases import HilCase, split_faults
+from harness.pytest_plugin.cases import HilCase
 from harness.pytest_plugin.result import HilResult
 from harness.run_request.table import DEFAULT_PORT_WAIT_S, names
 
@@ -64,13 +64,13 @@ def _fail(message: str) -> NoReturn:
 
 def _fault_list(faults: Faults) -> list[str | dict[str, Any]] | None:
     """A name, "a,b", or a list of names and inline fault mappings; checked now."""
-    from harness.faults.sensor import build_profile
+    from harness.faults.sensor import build_profile, split_fault_text
 
     if faults is None:
         return None
     items: list[str | dict[str, Any]]
     if isinstance(faults, str):
-        items = list(split_faults(faults))
+        items = list(split_fault_text(faults))
     elif isinstance(faults, Sequence):
         items = list(faults)
     else:
