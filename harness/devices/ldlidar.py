@@ -202,11 +202,8 @@ class LdlidarDevice(DeviceDefaults):
         while len(self._pending) >= POINTS_PER_PACKET:
             chunk = self._pending[:POINTS_PER_PACKET]
             del self._pending[:POINTS_PER_PACKET]
-            out += encode_packet(
-                [s for s, _ in chunk],
-                speed_deg_s=self.speed_deg_s,
-                timestamp_ms=int(chunk[0][1]),
-            )
+            samples, stamp = [s for s, _ in chunk], int(chunk[0][1])
+            out += encode_packet(samples, speed_deg_s=self.speed_deg_s, timestamp_ms=stamp)
         return bytes(out)
 
     def receive(self, data: bytes) -> bytes:

@@ -171,6 +171,7 @@ class Part:
         return self if link is None else getattr(getattr(link, self.part), self.name)
 
 
+ROS_WHEELS = "install the ROS 2 wheels: pip install 'fossbot-hil[ros]', or source ROS 2 Jazzy"
 _REGISTRY: dict[str, type[Link]] = {}
 L = TypeVar("L", bound=type[Link])
 M = TypeVar("M")
@@ -180,10 +181,7 @@ def register(name: str) -> Callable[[L], L]:
     """Class decorator: make a link available under `name` (once), as ``kinds`` declares
     it: a class whose own ClassVars say otherwise than its row is refused."""
 
-    def decorate(cls: L) -> L:
-        return add_link(name, cls)
-
-    return decorate
+    return lambda cls: add_link(name, cls)
 
 
 def add_link(name: str, link: M) -> M:
@@ -222,12 +220,7 @@ def link_class(name: str) -> type[Link]:
         try:
             importlib.import_module(kind.module)
         except ImportError as err:
-            hint = ""
-            if is_ros_module(err.name or ""):
-                hint = (
-                    " (install the ROS 2 wheels: pip install 'fossbot-hil[ros]',"
-                    " or source ROS 2 Jazzy)"
-                )
+            hint = f" ({ROS_WHEELS})" if is_ros_module(err.name or "") else ""
             raise ConfigError(f"link {name!r} cannot start: {err}{hint}") from None
         if name not in _REGISTRY:
             raise RuntimeError(f"{kind.module} registers no link {name!r}")

@@ -117,16 +117,9 @@ class ForkServer:
         self.env = {**os.environ, "PYTHONUNBUFFERED": "1"}
         try:
             sandbox = node_sandbox_prefix()  # grading: the nodes' nested sandbox
+            argv = [*sandbox, sys.executable, "-m", __name__, str(theirs.fileno())]
             self._process: subprocess.Popen[bytes] | None = subprocess.Popen(
-                [
-                    *sandbox,
-                    sys.executable,
-                    "-m",
-                    __name__,
-                    str(theirs.fileno()),
-                    parent_for(sandbox),
-                    module,
-                ],
+                [*argv, parent_for(sandbox), module],
                 pass_fds=(theirs.fileno(),),
                 env=self.env,
                 stdin=subprocess.DEVNULL,

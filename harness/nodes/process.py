@@ -220,19 +220,9 @@ class NodeProcess:
         out_r, out_w = os.pipe()
         err_r, err_w = os.pipe()
         sandbox = node_sandbox_prefix()  # grading: the node's nested sandbox
-        argv = [
-            *sandbox,
-            sys.executable,
-            "-I",  # the reaper needs the standard library only
-            "-S",
-            str(REAPER),
-            str(status_w),
-            parent_for(sandbox),
-            f"{INT_GRACE_S:g}",
-            f"{TERM_GRACE_S:g}",
-            "--",
-            *self.argv,
-        ]
+        reaper = [sys.executable, "-I", "-S", str(REAPER)]  # it needs the standard library only
+        graces = [f"{INT_GRACE_S:g}", f"{TERM_GRACE_S:g}"]
+        argv = [*sandbox, *reaper, str(status_w), parent_for(sandbox), *graces, "--", *self.argv]
         held = [] if self._held is None else [self._held]
         try:
             self._popen = self._forked([status_w, out_w, err_w, *held]) or subprocess.Popen(

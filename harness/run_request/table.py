@@ -352,13 +352,7 @@ def names(of: str) -> Names:
     "grading" (the grading file's field)."""
     table: dict[str, str] = {}
     for row in OPTIONS:
-        name = {
-            "cli": row.cli,
-            "hil": "--hil-" + row.hil.replace("_", "-") if row.hil else None,
-            "noun": row.noun,
-            "run": row.run,
-            "grading": row.grading,
-        }[of]
+        name = (row.hil_flag if row.hil else None) if of == "hil" else getattr(row, of)
         table[row.key] = name if name is not None else row.key
     return table
 

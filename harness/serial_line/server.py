@@ -8,6 +8,7 @@ waits, and errors carried from the thread to the caller.
 
 from __future__ import annotations
 
+import contextlib
 import os
 import threading
 import time
@@ -34,11 +35,9 @@ _STOP_JOIN_S = 2.0
 
 
 def _drain(fd: int) -> None:
-    try:
+    with contextlib.suppress(OSError):  # BlockingIOError: empty
         while os.read(fd, 4096):
             pass
-    except OSError:  # BlockingIOError: empty
-        pass
 
 
 class DeviceServer:
@@ -298,12 +297,10 @@ class DeviceServer:
         self._wake()
         if self._started:
             self._thread.join(timeout)
-        alive = self._thread.is_alive()
-        if not alive:
-            os.close(self._wake_r)
-            os.close(self._wake_w)
-        if alive:
+        if self._thread.is_alive():
             raise LinkError(f"serial device server did not stop within {timeout:g} s")
+        os.close(self._wake_r)
+        os.close(self._wake_w)
         if self._error is not None and not self._error_raised:
             self._error_raised = True
             raise self._error
@@ -318,10 +315,8 @@ class DeviceServer:
             raise RuntimeError("DeviceServer not started")
 
     def _wake(self) -> None:
-        try:
+        with contextlib.suppress(OSError):  # full (a wake-up is pending anyway) or closed
             os.write(self._wake_w, b"w")
-        except OSError:  # full (a wake-up is pending anyway) or closed
-            pass
 
     def _tell(self, event: Any) -> None:
         if self.listener is not None:
