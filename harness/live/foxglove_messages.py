@@ -38,20 +38,15 @@ _TRISTATE = {"type": "integer", "enum": [1, 0, -1]}  # 1 True, 0 False, -1 eithe
 SCHEMAS: dict[str, dict[str, Any]] = {
     STRING: {"data": {"type": "string"}},
     BOOL: {"data": {"type": "boolean"}},
-    VERDICT: {
-        "tick": {"type": "integer"},
-        "ok": {"type": "boolean"},
-        "expected_obstacle": {"type": "boolean"},
-        "expected_distance": _NUMBER_OR_NULL,
-        "expected_angle": _NUMBER_OR_NULL,
-        "expected_warning": _TRISTATE,
-        "claimed_obstacle": {"type": "boolean"},
-        "claimed_distance": _NUMBER_OR_NULL,
-        "claimed_angle": _NUMBER_OR_NULL,
-        "warning": _TRISTATE,
+    VERDICT: {  # the fields of harness.record.messages.VERDICT_DEFINITION, in its order
+        "tick": {"type": "integer"}, "ok": {"type": "boolean"},
+        "expected_obstacle": {"type": "boolean"}, "expected_distance": _NUMBER_OR_NULL,
+        "expected_angle": _NUMBER_OR_NULL, "expected_warning": _TRISTATE,
+        "claimed_obstacle": {"type": "boolean"}, "claimed_distance": _NUMBER_OR_NULL,
+        "claimed_angle": _NUMBER_OR_NULL, "warning": _TRISTATE,
         "explanation": {"type": "string"},
     },
-}
+}  # fmt: skip
 
 _OBSTACLE_RGBA = (0.8, 0.55, 0.3, 1.0)  # as harness.sim.world draws them
 _MODEL_RGBA = (0.75, 0.3, 0.75, 0.8)  # a model file's place (its shape is not drawn)

@@ -53,6 +53,8 @@ TRAIL, RETURN, INVALID, NEAREST = "#8fb3e0", "#5b8fd1", "#c4c4c4", "#0b3d91"
 CLAIM = "#e07b00"
 PASS, FAIL, FAILED_BACKGROUND = "#1a7f37", "#c62828", "#fbe3e3"
 LAMP_ON, LAMP_OFF, LAMP_NONE = "#d62728", "#9e9e9e", "#ffffff"
+LEGEND = {"loc": "upper center", "bbox_to_anchor": (0.5, 0.955), "ncols": 6, "fontsize": 6}
+LEGEND |= {"frameon": False, "handletextpad": 0.3, "columnspacing": 1.0, "markerscale": 1.5}
 
 
 @dataclass(frozen=True)
@@ -261,16 +263,7 @@ class _View:
         self.nearest = self._line("o", ms=5, color=NEAREST, label="nearest")
         self.claim = self._line("x", ms=7, mew=1.6, color=CLAIM, label="node's nearest")
         ax.plot([], [], "--", lw=0.7, color="#777777", label="threshold")
-        self.fig.legend(
-            loc="upper center",
-            bbox_to_anchor=(0.5, 0.955),
-            ncols=6,
-            fontsize=6,
-            frameon=False,
-            handletextpad=0.3,
-            columnspacing=1.0,
-            markerscale=1.5,
-        )
+        self.fig.legend(**LEGEND)
 
     def _text(self, x: float, y: float, **style: Any) -> Any:
         return self._changes(draw_text(self.fig, x, y, "", **style))
