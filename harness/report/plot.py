@@ -190,6 +190,8 @@ class _Canvas:
         from matplotlib.backends.backend_agg import FigureCanvasAgg
         from matplotlib.figure import Figure  # lazy: matplotlib takes a while to import
 
+        from harness.report.axis_layers import AxisLayers
+
         # Fixed margins, not a layout engine: "constrained" measured every text to place
         # the axes and cost 40 % of the plot's time, paid for every scenario of every report.
         self.fig = fig = Figure(figsize=(WIDTH_IN, HEIGHT_IN), dpi=DPI)
@@ -242,6 +244,7 @@ class _Canvas:
             (self.got, "warning received"),
             (self.band_key, "warning either accepted"),
         ]
+        self.layers = AxisLayers(self.axes)  # the axes' ticks and grid, once per set of limits
         # The figure without its axes and title, one per set of legend entries shown: the
         # legend is the same picture each time and took a quarter of the plot's time.
         self.backgrounds: dict[tuple[str, ...], Any] = {}
@@ -317,6 +320,7 @@ class _Canvas:
             note = "no valid return in any scan: nothing in range"
         self.note.set_text(note)
 
+        self.layers.prepare(self.canvas)
         self.canvas.restore_region(background)
         renderer = self.canvas.get_renderer()
         for artist in (*self.axes, self.title):  # drawn as Figure.draw orders them
