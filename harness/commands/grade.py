@@ -245,9 +245,33 @@ def prepare_out(out: Path) -> HolderLock:
     except OSError as err:
         lock.release()
         raise ConfigError(f"--out {out}: {err.strerror or err}") from None
-    for earlier in ("students", "grader", "unpacked"):  # last time's students, their archives
-        shutil.rmtree(out / earlier, ignore_errors=True)
+    _set_aside(out, ("students", "grader", "unpacked"))  # last time's students, their archives
     return lock
+
+
+REPLACED_PREFIX = ".replaced-"  # last time's folders, moved aside while they are removed
+
+
+def _set_aside(out: Path, names: tuple[str, ...]) -> None:
+    """Move the `names` in `out` aside at once and remove them in the background (a class's
+    reports take a while to delete); what an earlier grade left aside goes with them."""
+    import threading
+    import uuid
+
+    aside = out / f"{REPLACED_PREFIX}{uuid.uuid4().hex[:8]}"
+    doomed = [p for p in out.glob(f"{REPLACED_PREFIX}*") if p.is_dir()]
+    for name in names:
+        if (out / name).exists():
+            aside.mkdir(exist_ok=True)
+            (out / name).rename(aside / name)
+    doomed += [aside] if aside.is_dir() else []
+
+    def remove() -> None:
+        for folder in doomed:
+            shutil.rmtree(folder, ignore_errors=True)
+
+    if doomed:
+        threading.Thread(target=remove, name="fossbot-hil-set-aside", daemon=True).start()
 
 
 def _graded_line(student: Student, grade: StudentGrade) -> str:
