@@ -238,19 +238,8 @@ class RplidarDevice(DeviceDefaults):
         self._forced = False
         self._express_pending: list[Sample] = []
         self._express_restart = True
-        self._handlers = {
-            CMD_STOP: self._on_stop,
-            CMD_RESET: self._on_reset,
-            CMD_SCAN: self._on_scan,
-            CMD_FORCE_SCAN: self._on_force_scan,
-            CMD_EXPRESS_SCAN: self._on_express_scan,
-            CMD_GET_INFO: self._on_get_info,
-            CMD_GET_HEALTH: self._on_get_health,
-            CMD_GET_SAMPLERATE: self._on_get_samplerate,
-            CMD_GET_LIDAR_CONF: self._on_get_lidar_conf,
-            CMD_SET_MOTOR_PWM: self._on_motor_pwm,
-            CMD_GET_ACC_BOARD_FLAG: self._on_acc_board_flag,
-        }
+        # Each command's handler is named after it: GET_INFO -> _on_get_info.
+        self._handlers = {c: getattr(self, f"_on_{n.lower()}") for c, n in COMMAND_NAMES.items()}
 
     # -- state seen by the front end ----------------------------------------
 
@@ -509,7 +498,7 @@ class RplidarDevice(DeviceDefaults):
             self.motor_on = self.pwm > 0
         return b""
 
-    def _on_acc_board_flag(self, payload: bytes) -> bytes:
+    def _on_get_acc_board_flag(self, payload: bytes) -> bytes:
         body = struct.pack("<I", 0)  # no accessory board: motor speed is not PWM-controlled
         return encode_descriptor(len(body), SEND_SINGLE, ANS_ACC_BOARD_FLAG) + body
 

@@ -261,9 +261,8 @@ class FaultProfile:
         v32[cls == _NO_RETURN] = _encoded(no_return, spec.range_max)
         v32[cls == _TOO_CLOSE] = _encoded(too_close, spec.range_max)
 
-        intensities = np.where((cls == _VALID) | (cls == _GHOST), RETURN_INTENSITY, 0.0).astype(
-            np.float32
-        )
+        returned = (cls == _VALID) | (cls == _GHOST)
+        intensities = np.where(returned, RETURN_INTENSITY, 0.0).astype(np.float32)
         return spec.scan(v32, intensities=intensities, stamp=float(stamp))
 
 

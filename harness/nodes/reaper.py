@@ -30,13 +30,8 @@ REPORTED = 20  # leftover processes named, at most
 WATCHED = {signal.SIGCHLD, signal.SIGTERM, signal.SIGINT, signal.SIGHUP}
 # The node starts with these at their defaults, whatever the harness inherited
 # (Python ignores SIGPIPE; a background job may ignore SIGINT): exec keeps SIG_IGN.
-DEFAULT_SIGNALS = (
-    signal.SIGINT,
-    signal.SIGTERM,
-    signal.SIGHUP,
-    signal.SIGQUIT,
-    signal.SIGPIPE,
-    signal.SIGXFSZ,
+DEFAULT_SIGNALS = tuple(
+    getattr(signal, f"SIG{n}") for n in ("INT", "TERM", "HUP", "QUIT", "PIPE", "XFSZ")
 )
 
 

@@ -9,21 +9,9 @@ import contextlib
 import importlib
 import importlib.metadata
 
-WARM_MODULES = (
-    "math",
-    "numpy",
-    "rclpy",
-    "rclpy.node",
-    "rclpy.executors",
-    "rclpy.qos",
-    "rclpy.logging",
-    "rclpy.parameter",
-    "rclpy.exceptions",
-    "rclpy.signals",
-    "sensor_msgs.msg",
-    "std_msgs.msg",
-    "geometry_msgs.msg",
-)
+_RCLPY = ("node", "executors", "qos", "logging", "parameter", "exceptions", "signals")
+WARM_MODULES = ("math", "numpy", "rclpy", *(f"rclpy.{name}" for name in _RCLPY))
+WARM_MODULES += ("sensor_msgs.msg", "std_msgs.msg", "geometry_msgs.msg")
 
 for _name in WARM_MODULES:
     with contextlib.suppress(ImportError):  # a node that needs it will say so itself

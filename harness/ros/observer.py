@@ -89,16 +89,13 @@ class Observer:
         self.scan_topic, self.status_topic = scan_topic, status_topic
         self.warning_topic = warning_topic
         # We publish the scans (ros2), or a board's driver does and we hear them (serial).
-        self.scan_pub = (
-            self.node.create_publisher(LaserScan, scan_topic, QOS) if publish_scans else None
-        )
-        self.scan_sub = (
-            None
-            if publish_scans
-            else self.node.create_subscription(
-                LaserScan, scan_topic, self._hear("scan", scan_from_message), QOS
-            )
-        )
+        self.scan_pub: Any = None
+        self.scan_sub: Any = None
+        if publish_scans:
+            self.scan_pub = self.node.create_publisher(LaserScan, scan_topic, QOS)
+        else:
+            hear = self._hear("scan", scan_from_message)
+            self.scan_sub = self.node.create_subscription(LaserScan, scan_topic, hear, QOS)
         self.clock_pub = self.node.create_publisher(Clock, "/clock", QOS)
         self.inbox: deque[Heard] = deque(maxlen=INBOX_LIMIT)
         self.heard: Counter[str] = Counter()  # messages of each kind, all told

@@ -198,6 +198,4 @@ def check_port(path: str, key: str = "port") -> None:
 
 def link_keys() -> tuple[str, ...]:
     """The request's keys that are LinkOptions fields, in the table's order."""
-    return tuple(
-        f.name for f in fields(RunRequest) if f.name not in RUN_KEYS and f.name not in OWN_KEYS
-    )
+    return tuple(f.name for f in fields(RunRequest) if f.name not in (*RUN_KEYS, *OWN_KEYS))

@@ -24,12 +24,7 @@ class SandboxLimits:
 
     def prefix(self) -> list[str]:
         """The command that starts what follows it under these limits."""
-        return [
-            "prlimit",
-            f"--as={self.memory_mb * MIB}",
-            f"--nproc={self.processes}",
-            "--",
-        ]
+        return ["prlimit", f"--as={self.memory_mb * MIB}", f"--nproc={self.processes}", "--"]
 
     def describe(self) -> str:
         return f"{self.memory_mb} MB of memory per process, at most {self.processes} processes"

@@ -95,12 +95,5 @@ def run_view(
 def node_view(node_files: Iterable[Path]) -> View:
     """The node, inside the judging run's sandbox: its own files only; the environment
     the judging process gives it (already the sandbox's)."""
-    return _view(
-        [p.resolve() for p in node_files],
-        [],
-        own_network=False,
-        own_pids=False,
-        share_shm=True,
-        keep_env=True,
-        unset=(NODE_SANDBOX_ENV,),
-    )
+    nested = {"own_network": False, "own_pids": False, "share_shm": True, "keep_env": True}
+    return _view([p.resolve() for p in node_files], [], **nested, unset=(NODE_SANDBOX_ENV,))
