@@ -81,13 +81,8 @@ class RunProgress:
             console=self._console,
             transient=True,
         )
-        self._task = self._progress.add_task(
-            self._current(),
-            total=len(self._names),
-            completed=self._done,
-            ticks=self._ticks,
-            failed=self._failed,
-        )
+        self._task = self._progress.add_task("", total=len(self._names), ticks=0, failed=0)
+        self._update()  # the counts so far
         self._progress.start()
 
     def _update(self) -> None:

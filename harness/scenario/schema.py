@@ -123,6 +123,21 @@ Text = Annotated[str, AfterValidator(_printable)]
 ModelPath = Annotated[str, Field(min_length=1, max_length=MAX_PATH), AfterValidator(_printable)]
 
 
+def _ending(problem: str, *suffixes: str) -> AfterValidator:
+    """A model path ending in one of `suffixes`; `problem` says what is wrong otherwise."""
+
+    def check(value: str) -> str:
+        if not value.endswith(suffixes):
+            raise ValueError(f"{problem}, got {value[:100]!r}")
+        return value
+
+    return AfterValidator(check)
+
+
+UrdfPath = Annotated[ModelPath, _ending("the robot must be a .urdf file", ".urdf")]
+ModelRef = Annotated[ModelPath, _ending("model path must end in .urdf or .sdf", ".urdf", ".sdf")]
+
+
 class Pose2D(_Strict):
     """A planar pose: metres and radians (yaw CCW from +x)."""
 
@@ -137,17 +152,10 @@ LinkName = Annotated[Text, Field(min_length=1, max_length=255)]
 class RobotConfig(_Strict):
     """Which URDF to load, its LIDAR links and where it starts."""
 
-    urdf: ModelPath = "fossbot_v2.urdf"
+    urdf: UrdfPath = "fossbot_v2.urdf"
     lidar_link: LinkName = "lidar_scan_frame"  # the scan frame: x forward, z up
     lidar_device_link: LinkName = DEFAULT_DEVICE_LINK  # where the device's zero points
     start: Pose2D = Pose2D()
-
-    @field_validator("urdf")
-    @classmethod
-    def _is_urdf(cls, value: str) -> str:
-        if not value.endswith(".urdf"):
-            raise ValueError(f"the robot must be a .urdf file, got {value[:100]!r}")
-        return value
 
 
 class LidarConfig(_Strict):
@@ -238,16 +246,9 @@ class Model(_Strict):
     """A URDF or SDF file, relative to the scenario file or robot_models/."""
 
     type: Literal["model"]
-    path: ModelPath
+    path: ModelRef
     position: tuple[Coordinate, Coordinate, Coordinate] = (0.0, 0.0, 0.0)
     yaw: Finite = 0.0
-
-    @field_validator("path")
-    @classmethod
-    def _known_format(cls, value: str) -> str:
-        if not value.endswith((".urdf", ".sdf")):
-            raise ValueError(f"model path must end in .urdf or .sdf, got {value[:100]!r}")
-        return value
 
 
 Obstacle = Annotated[Wall | Box | Cylinder | Model, Field(discriminator="type")]
