@@ -72,22 +72,15 @@ class Candidate:
 
     def describe(self) -> str:
         """One line: what the scenario holds and does."""
-        parts = []
-        if self.obstacle == "none":
-            parts.append("no obstacle")
-        else:
-            parts.append(
-                f"{self.obstacle} {self.size:.3g} m at {self.distance:.3g} m, "
-                f"bearing {self.bearing:.3g} rad"
-            )
+        at = f"{self.size:.3g} m at {self.distance:.3g} m, bearing {self.bearing:.3g} rad"
+        parts = ["no obstacle" if self.obstacle == "none" else f"{self.obstacle} {at}"]
         if self.motion == "still":
             parts.append(f"standing {self.duration:.3g} s")
-        elif self.motion == "turn":
-            parts.append(
-                f"turning {self.speed * TURN_PER_SPEED:.3g} rad/s for {self.duration:.3g} s"
-            )
         else:
-            parts.append(f"{self.motion} {self.speed:.3g} m/s for {self.duration:.3g} s")
+            turn = self.motion == "turn"
+            rate, unit = (self.speed * TURN_PER_SPEED, "rad/s") if turn else (self.speed, "m/s")
+            how = "turning" if turn else self.motion
+            parts.append(f"{how} {rate:.3g} {unit} for {self.duration:.3g} s")
         parts.append(f"{self.preset} LIDAR, {CONVENTIONS[self.convention]}")
         if self.fault != "none":
             parts.append(_fault_words(self))

@@ -231,11 +231,9 @@ class Oracle:
         if not texts:
             if answers.timed_out:
                 came = [r for r in answers.late if r.tick == tick and isinstance(r.value, str)]
-                late = (
-                    f"{CAME_LATE} {came[0].after:.2f} s: {_quoted(str(came[0].value))}"
-                    if came
-                    else ""
-                )
+                late = ""
+                if came:
+                    late = f"{CAME_LATE} {came[0].after:.2f} s: {_quoted(str(came[0].value))}"
                 failures.append(f"no status within the deadline ({answers.waited:.2f} s){late}")
             elif not answers.crashed:
                 failures.append("no status arrived")
