@@ -35,6 +35,8 @@ WIDTH_IN, HEIGHT_IN, DPI = 8.0, 6.0, 90  # about 720 x 540 px: a few tens of kB
 MARGINS = {"left": 0.085, "right": 0.985, "top": 0.945, "bottom": 0.215, "hspace": 0.12}
 ANGLE_REACH = 2 * math.pi + 0.1  # the oracle accepts angles in [-2 pi, 2 pi]; beyond: off scale
 FAILED_COLOUR = "#f2b8b8"
+# zlib level 3, not Pillow's 6: a third of the time to encode (9 against 24 ms), 11 % larger.
+PNG_FAST = {"compress_level": 3}
 # matplotlib text properties for text from outside (a scenario name, a node's status):
 # mathtext off, so a "$" in it is a dollar sign, never a formula matplotlib fails to parse.
 AS_WRITTEN: dict[str, Any] = {"parse_math": False}
@@ -326,7 +328,8 @@ class _Canvas:
         for artist in (*self.axes, self.title):  # drawn as Figure.draw orders them
             artist.draw(renderer)
         out = io.BytesIO()
-        imsave(out, self.canvas.buffer_rgba(), format="png", dpi=DPI, metadata={"Software": None})
+        pixels, unstamped = self.canvas.buffer_rgba(), {"Software": None}
+        imsave(out, pixels, format="png", dpi=DPI, metadata=unstamped, pil_kwargs=PNG_FAST)
         return out.getvalue()
 
 
