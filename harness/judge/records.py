@@ -88,14 +88,9 @@ class RunResult:
         """The explanation read first: the run error or first failed tick, with the run's hint."""
         failed = self.failed_ticks
         if failed:
-            hint = run_hint(
-                [r.verdict for r in self.records],
-                self.threshold,
-                scans=[
-                    r.answers.seen if r.answers.seen is not None else r.scan for r in self.records
-                ],
-                noise_sigma=self.noise_sigma,
-            )
+            seen = [r.answers.seen if r.answers.seen is not None else r.scan for r in self.records]
+            verdicts = [r.verdict for r in self.records]
+            hint = run_hint(verdicts, self.threshold, scans=seen, noise_sigma=self.noise_sigma)
             more = f" ({hint})" if hint else ""
             return f"{self.scenario}: {failed[0].verdict.explanation}{more}"
         if self.error is not None:

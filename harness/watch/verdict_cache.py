@@ -67,11 +67,8 @@ class VerdictCache:
             stored = json.loads(self.path.read_text(encoding="utf-8"))
         except (OSError, ValueError):
             return {}
-        if not isinstance(stored, dict) or stored.get("format") != FORMAT:
-            return {}
-        if stored.get("key") != dict(self.key):
-            return {}
-        verdicts = stored.get("verdicts")
+        ours = isinstance(stored, dict) and stored.get("format") == FORMAT
+        verdicts = stored.get("verdicts") if ours and stored.get("key") == dict(self.key) else None
         if not isinstance(verdicts, dict):
             return {}
         return {
