@@ -36,7 +36,7 @@ if TYPE_CHECKING:  # pydantic only when a scenario is at hand
     from harness.scenario.schema import Scenario
 
 __all__ = [
-    "ArtifactWriter", "PromisedArtifactWriter", "ReportFolder", "ScenarioFiles",
+    "ArtifactWriter", "ReportFolder", "ScenarioFiles",
     "WorldArtifactWriter", "artifact_writers", "prepare_folder", "write_report",
 ]  # fmt: skip
 
@@ -64,18 +64,7 @@ class WorldArtifactWriter:
     write: Callable[[Path, RunResult, Scenario], Path]
 
 
-@dataclass(frozen=True)
-class PromisedArtifactWriter:
-    """A per-scenario file another process writes later, from what `write(final, result)`
-    leaves for it (``grade`` draws its students' plots outside their sandboxes): the
-    report names `final` as if written; `write` returns it."""
-
-    name: str
-    suffix: str
-    write: Callable[[Path, RunResult], Path]
-
-
-Writer = ArtifactWriter | WorldArtifactWriter | PromisedArtifactWriter
+Writer = ArtifactWriter | WorldArtifactWriter
 
 
 def _write_plot(path: Path, result: RunResult) -> Path:
@@ -135,9 +124,7 @@ def _write_via_temporary(
     writer: Writer, final: Path, result: RunResult, scenario: Scenario | None
 ) -> Path | None:
     """Run `writer` on a hidden temporary file, then rename it to `final`; None for a
-    world writer without its scenario. A promised file is left to its writer."""
-    if isinstance(writer, PromisedArtifactWriter):
-        return writer.write(final, result)
+    world writer without its scenario."""
     if isinstance(writer, ArtifactWriter):
         write = writer.write
         return fill_atomically(

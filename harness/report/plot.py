@@ -25,8 +25,7 @@ from harness.lidar.scan import Scan
 from harness.safe_text import visible
 
 __all__ = [
-    "AS_WRITTEN", "PlotSeries", "draw_text", "plot_series", "render_plot", "series_data",
-    "series_from_data", "write_plot",
+    "AS_WRITTEN", "PlotSeries", "draw_text", "plot_series", "render_plot", "write_plot",
 ]  # fmt: skip
 
 WIDTH_IN, HEIGHT_IN, DPI = 8.0, 6.0, 90  # about 720 x 540 px: a few tens of kB
@@ -66,41 +65,6 @@ class PlotSeries:
     warning_got: np.ndarray  # 1 True, 0 False, NaN no Bool
     failed: np.ndarray  # bool
     not_delivered: np.ndarray  # bool: a link fault dropped it, or the line lost it
-
-
-_BOOL_ARRAYS = ("claimed_nonfinite", "angle_off", "failed", "not_delivered")
-_FLOAT_ARRAYS = (
-    "t", "nearest", "claimed", "angle_expected", "angle_claimed", "warning_expected", "warning_got",
-)  # fmt: skip
-
-
-def series_data(series: PlotSeries) -> dict[str, Any]:
-    """`series` as JSON-ready data (NaN as null), for a plot drawn later by another
-    process (``grade`` draws its students' plots outside their sandboxes)."""
-    data: dict[str, Any] = {"title": series.title, "threshold": series.threshold}
-    for name in _FLOAT_ARRAYS:
-        values = getattr(series, name).tolist()
-        data[name] = [v if math.isfinite(v) else None for v in values]
-    for name in _BOOL_ARRAYS:
-        data[name] = [bool(v) for v in getattr(series, name)]
-    return data
-
-
-def series_from_data(data: dict[str, Any]) -> PlotSeries:
-    """The PlotSeries `series_data` gave; ValueError for anything else (arrays of
-    other lengths, values that are not numbers)."""
-    try:
-        arrays: dict[str, np.ndarray] = {
-            name: np.array([math.nan if v is None else v for v in data[name]], dtype=float)
-            for name in _FLOAT_ARRAYS
-        }
-        arrays.update((name, np.array(data[name], dtype=bool)) for name in _BOOL_ARRAYS)
-        title, threshold = str(data["title"]), float(data["threshold"])
-    except (KeyError, TypeError) as err:
-        raise ValueError(f"not a plot's data: {err}") from None
-    if len({a.shape for a in arrays.values()}) != 1 or arrays["t"].ndim != 1:
-        raise ValueError("not a plot's data: its arrays differ in shape")
-    return PlotSeries(title=title, threshold=threshold, **arrays)
 
 
 def _nearest_valid(scan: Scan) -> float:
