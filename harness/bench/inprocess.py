@@ -23,14 +23,7 @@ def measure_inprocess(workload: Workload) -> StageResult:
         run = run_through(link, workload)
     finally:
         link.close()
-    return StageResult(
-        INPROCESS,
-        len(run.result.records),
-        run.seconds,
-        simulated_seconds(run.result),
-        extra={
-            "cpu_ms_per_scan": run.cpu_s * 1000.0 / max(1, len(run.result.records)),
-            "failed_ticks": run.failed,
-            "error": run.result.error,
-        },
-    )
+    scans = len(run.result.records)
+    cpu_ms = run.cpu_s * 1000.0 / max(1, scans)
+    extra = {"cpu_ms_per_scan": cpu_ms, "failed_ticks": run.failed, "error": run.result.error}
+    return StageResult(INPROCESS, scans, run.seconds, simulated_seconds(run.result), extra=extra)

@@ -61,13 +61,8 @@ def measure_raycast(workload: Workload) -> StageResult:
                 truth_rounds.append(round_truth)
             cast_s += median(cast_rounds)
             truth_s += median(truth_rounds)
-    return StageResult(
-        "raycast",
-        scans,
-        cast_s,
-        simulated,
-        extra={"truth_ms": truth_s / scans * 1000.0, "rounds": ROUNDS},
-    )
+    extra = {"truth_ms": truth_s / scans * 1000.0, "rounds": ROUNDS}
+    return StageResult("raycast", scans, cast_s, simulated, extra=extra)
 
 
 def _check_same(hits: list, truth: np.ndarray, range_max: float) -> None:

@@ -64,13 +64,8 @@ def run_through(
     taken out. No diagnostics (they stop a node), so the link can run it again; CPU time
     beside, as on a shared machine it moves less than wall time."""
     oracle = workload.oracle()
-    result = RunResult(
-        scenario="+".join(s.name for s in workload.scenarios),
-        link=link.name,
-        seed=0,
-        threshold=workload.threshold,
-        faults="scenarios' own",
-    )
+    names = "+".join(s.name for s in workload.scenarios)
+    result = RunResult(names, link.name, 0, workload.threshold, faults="scenarios' own")
     judged_at: list[float] = []
     with prepared_frames(workload) as frames:
         first = next(frames)

@@ -38,10 +38,5 @@ def measure_synthesis(workload: Workload) -> StageResult:
     scans, seconds, simulated = _timed_frames(workload)
     harsh = replace(workload, settings=replace(workload.settings, faults=HARSH))
     harsh_scans, harsh_seconds, _ = _timed_frames(harsh)
-    return StageResult(
-        "synthesis",
-        scans,
-        seconds,
-        simulated,
-        extra={"harsh_scans_per_s": harsh_scans / harsh_seconds},
-    )
+    extra = {"harsh_scans_per_s": harsh_scans / harsh_seconds}
+    return StageResult("synthesis", scans, seconds, simulated, extra=extra)
