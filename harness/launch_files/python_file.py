@@ -175,17 +175,11 @@ class _Reader:
 
 
 def _keyword(call: ast.Call, names: tuple[str, ...]) -> ast.expr | None:
-    for name in names:
-        for keyword in call.keywords:
-            if keyword.arg == name:
-                return keyword.value
-    return None
+    return next((k.value for name in names for k in call.keywords if k.arg == name), None)
 
 
 def _text(expr: ast.expr | None) -> str | None:
-    if isinstance(expr, ast.Constant) and isinstance(expr.value, str):
-        return expr.value
-    return None
+    return expr.value if isinstance(expr, ast.Constant) and isinstance(expr.value, str) else None
 
 
 def _imports(tree: ast.Module) -> dict[str, str]:
@@ -193,12 +187,9 @@ def _imports(tree: ast.Module) -> dict[str, str]:
     names: dict[str, str] = {}
     for node in ast.walk(tree):
         if isinstance(node, ast.Import):
-            for alias in node.names:
-                if alias.asname:
-                    names[alias.asname] = alias.name
-                else:
-                    first = alias.name.split(".")[0]
-                    names[first] = first
+            for alias in node.names:  # `import a.b` binds a; `import a.b as c` binds c
+                first = alias.name.split(".")[0]
+                names[alias.asname or first] = alias.name if alias.asname else first
         elif isinstance(node, ast.ImportFrom) and node.module and not node.level:
             for alias in node.names:
                 if alias.name == "*":

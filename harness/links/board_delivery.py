@@ -76,20 +76,20 @@ class BoardDelivery(ScanDelivery):
         return self.exchange.graph.observer
 
     @property
-    def _server(self) -> DeviceServer | None:
-        return self.session.server if self.session is not None else None
+    def _server(self) -> DeviceServer:
+        server = self.session.server if self.session is not None else None
+        assert server is not None, "open() the link first"
+        return server
 
     def damage_line(self, damage: LineDamage) -> None:
         """Line faults: revolutions reach the driver damaged from the next push on (never the
         idle stream); one the driver then makes no scan of is lost, not a broken link."""
-        assert self._server is not None, "open() the link first"
         self._line_damage = damage
         if self.idle.pushed:
             self._server.damage = damage
 
     def _damage_from_now(self) -> None:
         """The idle stream is over: line damage acts from then on."""
-        assert self._server is not None
         if self._line_damage is not None:
             self._server.damage = self._line_damage
 
@@ -109,13 +109,11 @@ class BoardDelivery(ScanDelivery):
         """As after a warm-up, the stream ends on a whole start marker, so the later
         revolutions are the same bytes however many copies of the first it took."""
         self._after_copies()
-        assert self._server is not None
         self._server.align_stream()
 
     def after_warm_up(self) -> None:
         """The stream ends on a whole start marker, so the scenario's revolutions are the
         same bytes however many warm-up pushes it took."""
-        assert self._server is not None
         self._server.align_stream()
 
     def unanswerable(self) -> Answers | None:
@@ -164,7 +162,7 @@ class BoardDelivery(ScanDelivery):
 
     def deliver(self, scan: Scan, tick: int, *, clock: float | None = None) -> int:
         """Send the revolution down the line; wait (bounded) for the driver's /scan of it."""
-        assert self._obs is not None and self._server is not None
+        assert self._obs is not None
         obs = self._obs
         obs.publish_clock(scan.stamp if clock is None else clock)
         rate = self._rate(scan)
@@ -229,7 +227,6 @@ class BoardDelivery(ScanDelivery):
         copy (a scratch copy of it, the stream aligned so its bytes are the first's), and once
         the copies are out the line goes on from its state after the first (`_after_copies`):
         nothing the driver sees or the line counts depends on how many copies it took."""
-        assert self._server is not None
         if self._line_damage is None:
             return
         if n == 0:
@@ -242,7 +239,6 @@ class BoardDelivery(ScanDelivery):
             self._server.damage = copy.deepcopy(self._first_damage)
 
     def _after_copies(self) -> None:
-        assert self._server is not None
         if self._after_first is not None:
             self._line_damage, self._after_first = self._after_first, None
             self._server.damage = self._line_damage
@@ -258,7 +254,7 @@ class BoardDelivery(ScanDelivery):
         before its last write, or None (why: `_delivery_problem`). A device the driver stopped
         (a driver restarting: STOP, RESET, ... SCAN) is waited for as long as a board may take
         to come up, and the revolution goes again once it scans."""
-        assert self._server is not None and self._obs is not None
+        assert self._obs is not None
         server, period = self._server, 1.0 / rate
         push = server.send_revolution(samples, tick, period)
         limit = self.exchange.options.scan_timeout + (

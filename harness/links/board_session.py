@@ -11,6 +11,7 @@ uses the session's device and domain."""
 
 from __future__ import annotations
 
+import contextlib
 import os
 import shlex
 import sys
@@ -283,10 +284,8 @@ class BoardSession:
         for _, process in self.processes:
             process.request_stop()
         if self.server is not None:
-            try:
+            with contextlib.suppress(LinkError):  # already reported by the exchange that met it
                 self.server.close()
-            except LinkError:
-                pass  # already reported by the exchange that met it
         for _, process in self.processes:
             process.stop()
         if self.port is not None:
