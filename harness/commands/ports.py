@@ -35,14 +35,9 @@ def run(args: argparse.Namespace, console: Console) -> int:
     rows = [("PORT", "USB ID", "LIKELY", "MAY OPEN")]
     for port in ports:
         problem = access_problem(port.device)
-        rows.append(
-            (
-                port.device,
-                port.vid_pid or NO_USB_ID,
-                likely_adapter(port.device, port.vid_pid),
-                "yes" if problem is None else f"no: {problem}",
-            )
-        )
+        may_open = "yes" if problem is None else f"no: {problem}"
+        likely = likely_adapter(port.device, port.vid_pid)
+        rows.append((port.device, port.vid_pid or NO_USB_ID, likely, may_open))
     widths = [max(len(row[i]) for row in rows) for i in range(3)]
     for row in rows:
         cells = [cell.ljust(width) for cell, width in zip(row, widths, strict=False)]

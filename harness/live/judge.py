@@ -60,10 +60,8 @@ class LiveJudge:
             self.unmatched += 1
             return
         received = Received(value, max(0.0, (source_ns - owner.sent_ns) / 1e9), source_ns=source_ns)
-        if kind == "status":
-            owner.answers.statuses.append(received)
-        elif kind == "warning":
-            owner.answers.warnings.append(received)
+        lists = {"status": owner.answers.statuses, "warning": owner.answers.warnings}
+        lists.get(kind, []).append(received)  # any other kind: no answer to judge
 
     def settle(self, now_ns: int, *, final: bool = False) -> list[Verdict]:
         """Judge every scan whose window has closed by `now_ns` (all of them when `final`)."""
