@@ -92,12 +92,6 @@ def read_scans(path: str | Path, topic: str | None = None) -> RecordedScans:
         raise ConfigError(f"{source}: not a readable recording ({reason})") from None
     if not scans:
         raise ConfigError(f"{source}: topic {chosen!r} holds no messages")
-    start = times[0]
-    return RecordedScans(
-        source=str(source),
-        topic=chosen,
-        scans=scans,
-        times=[(t - start) * 1e-9 for t in times],
-        poses=poses if len(poses) == len(scans) else None,
-        run=_run_metadata(source),
-    )
+    seconds = [(t - times[0]) * 1e-9 for t in times]
+    matched = poses if len(poses) == len(scans) else None  # one pose per scan, or none
+    return RecordedScans(str(source), chosen, scans, seconds, matched, _run_metadata(source))
