@@ -129,20 +129,10 @@ class World:
     def _add_cylinder(self, cyl: Cylinder) -> int:
         c = self.client
         vertices, indices = cylinder_prism(cyl.radius, cyl.height)
-        shape = pb.createCollisionShape(
-            pb.GEOM_MESH,
-            vertices=vertices,
-            indices=indices,
-            flags=pb.GEOM_FORCE_CONCAVE_TRIMESH,
-            physicsClientId=c,
-        )
-        visual = pb.createVisualShape(
-            pb.GEOM_CYLINDER,
-            radius=cyl.radius,
-            length=cyl.height,
-            rgbaColor=_OBSTACLE_RGBA,
-            physicsClientId=c,
-        )
+        mesh = {"vertices": vertices, "indices": indices, "flags": pb.GEOM_FORCE_CONCAVE_TRIMESH}
+        shape = pb.createCollisionShape(pb.GEOM_MESH, **mesh, physicsClientId=c)
+        look = {"radius": cyl.radius, "length": cyl.height, "rgbaColor": _OBSTACLE_RGBA}
+        visual = pb.createVisualShape(pb.GEOM_CYLINDER, **look, physicsClientId=c)
         return self._static_body(shape, visual, (*cyl.position[:2], cyl.height / 2.0))
 
     def _static_body(
@@ -228,9 +218,8 @@ class World:
         c = self.client
         root = pb.getBodyInfo(self.robot, physicsClientId=c)[0].decode()
         joints = range(pb.getNumJoints(self.robot, physicsClientId=c))
-        return [root] + [
-            pb.getJointInfo(self.robot, j, physicsClientId=c)[12].decode() for j in joints
-        ]
+        names = [pb.getJointInfo(self.robot, j, physicsClientId=c)[12].decode() for j in joints]
+        return [root, *names]
 
     def joint_names(self) -> list[str]:
         """The robot's joint names, by joint index."""
@@ -290,9 +279,8 @@ class World:
             axis = np.array(pb.rotateVector(orn, info[13]))
             signs.append(1 if float(axis @ base_y) > 0 else -1)
         track = abs(float((positions[0] - positions[1]) @ base_y))
-        return WheelGeometry(
-            joints[0], joints[1], (radii[0] + radii[1]) / 2.0, track, signs[0], signs[1]
-        )
+        radius = (radii[0] + radii[1]) / 2.0
+        return WheelGeometry(joints[0], joints[1], radius, track, signs[0], signs[1])
 
     def _wheel_radius(self, name: str, joint: int) -> float:
         shapes = pb.getCollisionShapeData(self.robot, joint, physicsClientId=self.client)
