@@ -376,6 +376,5 @@ def explain(
 
 def _useful(runs: list[_Run], index: int, factors: Factors) -> bool:
     """A rate line says something when the rates differ (seeds: always, for flakiness)."""
-    if factors[index] == "seed":
-        return True
-    return len({(t.failed, t.runs) for t in _by_level(runs, index).values()}) > 1
+    rates = {(t.failed, t.runs) for t in _by_level(runs, index).values()}
+    return factors[index] == "seed" or len(rates) > 1

@@ -79,9 +79,7 @@ def run(args: argparse.Namespace, console: Console) -> int:
     )
     for line in summary.lines():
         _print_safe(line)
-    if summary.stopped_by is None and summary.client_read is False:
-        return 1
-    return 0
+    return 1 if summary.stopped_by is None and summary.client_read is False else 0
 
 
 def _print_safe(line: str) -> None:

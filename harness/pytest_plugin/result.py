@@ -53,9 +53,7 @@ class HilResult:
 
     def _node_output_matters(self) -> bool:
         """The node's stderr explains a crash, a start-up failure or silence, not a wrong value."""
-        if self.raw.error is not None:
-            return True
-        return any(r.verdict.claim is None for r in self.failed_ticks)
+        return self.raw.error is not None or any(r.verdict.claim is None for r in self.failed_ticks)
 
     @property
     def explanation(self) -> str:
