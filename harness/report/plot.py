@@ -25,7 +25,8 @@ from harness.lidar.scan import Scan
 from harness.safe_text import visible
 
 __all__ = [
-    "AS_WRITTEN", "PlotSeries", "draw_text", "plot_series", "render_plot", "write_plot",
+    "AS_WRITTEN", "PlotSeries", "draw_text", "plot_series", "prepare_canvas", "render_plot",
+    "write_plot",
 ]  # fmt: skip
 
 WIDTH_IN, HEIGHT_IN, DPI = 8.0, 6.0, 90  # about 720 x 540 px: a few tens of kB
@@ -307,11 +308,18 @@ _canvas: list[_Canvas] = []  # built by the first plot of the process
 _drawing = threading.Lock()  # one figure: one plot at a time
 
 
-def render_plot(series: PlotSeries) -> bytes:
-    """The PNG bytes (deterministic: no software or date in the metadata)."""
+def prepare_canvas() -> None:
+    """Import matplotlib and build the process's figure now (a second or so of CPU), for a
+    process that has idle time before its first plot (a grading judge at its start)."""
     with _drawing:
         if not _canvas:
             _canvas.append(_Canvas())
+
+
+def render_plot(series: PlotSeries) -> bytes:
+    """The PNG bytes (deterministic: no software or date in the metadata)."""
+    prepare_canvas()
+    with _drawing:
         return _canvas[0].draw(series)
 
 
