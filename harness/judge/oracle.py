@@ -127,15 +127,9 @@ def expect(scan: Scan, threshold: float, band: float) -> Expectation:
         warning: bool | None = None
     else:
         warning = distance < threshold
-    return Expectation(
-        obstacle=True,
-        distance=distance,
-        angle=scan.angle_min + index * scan.angle_increment,
-        index=index,
-        warning=warning,
-        indices=indices,
-        may_be_clear=bool(lowest == np.float32(scan.range_max)),
-    )
+    angle = scan.angle_min + index * scan.angle_increment
+    at_max = bool(lowest == np.float32(scan.range_max))
+    return Expectation(True, distance, angle, index, warning, indices, may_be_clear=at_max)
 
 
 def wrap(x: float) -> float:

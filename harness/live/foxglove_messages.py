@@ -81,12 +81,8 @@ def foxglove_sdk() -> SimpleNamespace:
         import foxglove.websocket
     except ImportError:
         raise ConfigError(INSTALL_HINT) from None
-    return SimpleNamespace(
-        foxglove=foxglove,
-        channels=foxglove.channels,
-        m=foxglove.messages,
-        websocket=foxglove.websocket,
-    )
+    messages, channels, websocket = foxglove.messages, foxglove.channels, foxglove.websocket
+    return SimpleNamespace(foxglove=foxglove, channels=channels, m=messages, websocket=websocket)
 
 
 def sdk_stamp(seconds: float) -> Any:

@@ -122,13 +122,8 @@ def hil_config(pytestconfig: pytest.Config) -> HilConfig:
 @pytest.fixture
 def hil_node(hil_config: HilConfig) -> NodeUnderTest:
     """The node under test; override in a conftest to fix it for a project."""
-    return NodeUnderTest(
-        command=hil_config.node,
-        package=hil_config.package,
-        executable=hil_config.executable,
-        workspace=hil_config.workspace,
-        params=hil_config.param,
-    )
+    c = hil_config
+    return NodeUnderTest(c.node, c.package, c.executable, c.workspace, params=c.param)
 
 
 @pytest.fixture
