@@ -34,7 +34,12 @@ def remember_frames(enabled: bool = True) -> None:
 def _key(plan: RunPlan) -> tuple[object, ...] | None:
     if _kept is None or plan.settings.gui:  # a viewer shows the world: it must be built
         return None
-    return (id(plan.scenario), plan.seed, plan.profile)
+    key = (id(plan.scenario), plan.seed, plan.profile)
+    try:
+        hash(key)
+    except TypeError:  # a fault given values that cannot be compared: simulated each time
+        return None
+    return key
 
 
 def frames_of(plan: RunPlan) -> list[Frame] | None:
