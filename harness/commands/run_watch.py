@@ -91,28 +91,15 @@ def watch(args: argparse.Namespace, console: Console) -> int:
         on_judged: Callable[[RunResult], None],
     ) -> list[RunResult]:
         ran[:] = order
-        return run_suite(
-            order,
-            link,
-            options,
-            settings,
-            on_tick=on_tick,
-            on_result=on_result,
-            on_judged=on_judged,
-        )
+        hooks = {"on_tick": on_tick, "on_result": on_result, "on_judged": on_judged}
+        return run_suite(order, link, options, settings, **hooks)
 
     def after(results: list[RunResult]) -> list[str]:
         cache.remember(results)
         return write_reports(args, results, ran)
 
-    loop = WatchLoop(
-        sources,
-        WatchScreen(console, sources.description),
-        load=load,
-        suite=suite,
-        after=after,
-        failed=cache.failed(),
-    )
+    screen = WatchScreen(console, sources.description)
+    loop = WatchLoop(sources, screen, load=load, suite=suite, after=after, failed=cache.failed())
     return loop.run_forever()
 
 
