@@ -41,10 +41,8 @@ def never_ready(
     (`reads`: the node subscribed to the scans; `publishes`: it publishes the status) and
     the graph; `clock_all_along`: /clock (time 0) was published while waiting."""
     o = options
-    missing = [
-        *([] if reads else [f"subscribe to {o.scan_topic}"]),
-        *([] if publishes else [f"publish {o.status_topic}"]),
-    ]
+    missing = [] if reads else [f"subscribe to {o.scan_topic}"]
+    missing += [] if publishes else [f"publish {o.status_topic}"]
     reason = (
         f"it did not {' or '.join(missing)}" if missing else "it was ready only as time ran out"
     )

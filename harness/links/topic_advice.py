@@ -27,16 +27,12 @@ def topics_elsewhere(node: Any, type_name: str, topic: str, *, publishers: bool)
     """Topics other than `topic` that a node other than the harness's `node` publishes (or
     subscribes to) as `type_name`: where a node with another topic name sends (or reads) it."""
     me = (node.get_name(), node.get_namespace())
+    get = node.get_publishers_info_by_topic if publishers else node.get_subscriptions_info_by_topic
     found = []
     for name, types in node.get_topic_names_and_types():
         if name == topic or type_name not in types:
             continue
-        infos = (
-            node.get_publishers_info_by_topic(name)
-            if publishers
-            else node.get_subscriptions_info_by_topic(name)
-        )
-        if any((i.node_name, i.node_namespace) != me for i in infos):
+        if any((i.node_name, i.node_namespace) != me for i in get(name)):
             found.append(name)
     return sorted(found)
 

@@ -24,12 +24,10 @@ def node_on(node: Node, topics: list[tuple[str, bool]]) -> str | None:
     (False) one of `topics`, in order: the node under test, as the graph knows it."""
     me = (node.get_name(), node.get_namespace())
     for topic, publishes in topics:
-        infos = (
-            node.get_publishers_info_by_topic(topic)
-            if publishes
-            else node.get_subscriptions_info_by_topic(topic)
+        get = (
+            node.get_publishers_info_by_topic if publishes else node.get_subscriptions_info_by_topic
         )
-        for info in infos:
+        for info in get(topic):
             if (info.node_name, info.node_namespace) != me:
                 return f"{info.node_namespace.rstrip('/')}/{info.node_name}"
     return None
