@@ -184,8 +184,7 @@ class NodeExchange:
         obs = self.graph.observer
         assert obs is not None
         self.wait_for(
-            lambda: not obs.wrong_types() or bool(obs.wrong_types(named_only=True)),
-            WARM_UP_RETRY_S,
+            lambda: not obs.wrong_types() or bool(obs.wrong_types(named_only=True)), WARM_UP_RETRY_S
         )
 
     def _await_bool_writer(self) -> None:

@@ -59,10 +59,7 @@ def topic_hints(node: Any, options: LinkOptions, *, reads: bool, publishes: bool
 
 
 def untaken_topic_parameter(
-    options: LinkOptions,
-    parameter: str,
-    topic: str,
-    ask: Callable[[], tuple[str, list[str]] | str],
+    options: LinkOptions, parameter: str, topic: str, ask: Callable[[], tuple[str, list[str]] | str]
 ) -> str | None:
     """The rest of a note when the harness set the node's topic through `parameter` (a
     scenario's node_topics) and the node does not declare it, naming a parameter of its

@@ -178,12 +178,7 @@ class NodeProcess:
     """One running node under test, started under reaper.py (see there)."""
 
     def __init__(
-        self,
-        command: NodeCommand,
-        args: list[str],
-        env: dict[str, str],
-        *,
-        held: int | None = None,
+        self, command: NodeCommand, args: list[str], env: dict[str, str], *, held: int | None = None
     ) -> None:
         """`held`: a descriptor the node's supervisor holds open until the node and all
         it started are gone (the run's domain lock: a node that outlives its harness,

@@ -173,12 +173,7 @@ def _descendants(root: int) -> dict[int, str]:
 def spawn(argv: list[str]) -> int:
     """Start `argv` in its own session with default signal handling; its pid."""
     return os.posix_spawnp(
-        argv[0],
-        argv,
-        os.environ,
-        setsid=True,
-        setsigmask=(),
-        setsigdef=DEFAULT_SIGNALS,
+        argv[0], argv, os.environ, setsid=True, setsigmask=(), setsigdef=DEFAULT_SIGNALS
     )
 
 

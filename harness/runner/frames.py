@@ -11,13 +11,7 @@ from collections.abc import Callable, Iterable
 from dataclasses import dataclass, replace
 
 from harness.errors import ConfigError, Interrupted, LinkError
-from harness.faults.link import (
-    NO_LINK_FAULTS,
-    Delivery,
-    LineDamage,
-    LinkFaults,
-    plan_deliveries,
-)
+from harness.faults.link import NO_LINK_FAULTS, Delivery, LineDamage, LinkFaults, plan_deliveries
 from harness.judge.answers import Answers, Received
 from harness.judge.oracle import Oracle
 from harness.judge.records import RunResult, TickRecord

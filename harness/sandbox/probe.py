@@ -42,11 +42,7 @@ def sandbox_problem() -> str | None:
     outer = bwrap_argv(run_view([], [], []), inner, bwrap=bwrap)
     try:
         done = subprocess.run(
-            outer,
-            stdin=subprocess.DEVNULL,
-            capture_output=True,
-            text=True,
-            timeout=PROBE_TIMEOUT_S,
+            outer, stdin=subprocess.DEVNULL, capture_output=True, text=True, timeout=PROBE_TIMEOUT_S
         )
     except (OSError, subprocess.TimeoutExpired) as err:
         return REFUSED.format(where=where, said=str(err), no_sandbox=named("no_sandbox"))
