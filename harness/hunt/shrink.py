@@ -24,6 +24,9 @@ ROUND_STEPS: dict[str, tuple[float, ...]] = {
     "fault_rate": (0.1, 0.05, 0.01),
     "duration": (0.5, 0.1),
 }
+#: name -> (the field that must be on for it to matter, that field's off value).
+_SIZES = {name: ("obstacle", "none") for name in ("distance", "size")}
+_SIZES |= {"speed": ("motion", "still"), "fault_rate": ("fault", "none")}
 BEARINGS = (0.0, math.pi / 2, -math.pi / 2, math.pi, math.pi / 4, -math.pi / 4)
 
 
@@ -46,9 +49,10 @@ def simplifications(candidate: Candidate) -> list[Step]:
             offer(f"{duration:g} s long", duration=duration)
     offer("the gazebo LIDAR preset", preset="gazebo")
     offer("threshold 0.5 m", threshold=0.5)
-    if candidate.obstacle != "none":
+    round_bearing = any(abs(candidate.bearing - b) < 1e-9 for b in BEARINGS)
+    if candidate.obstacle != "none" and not round_bearing:
         for bearing in BEARINGS:
-            if abs(candidate.bearing - bearing) > 1e-9 and not _round_angle(candidate.bearing):
+            if abs(candidate.bearing - bearing) > 1e-9:
                 offer(f"bearing {bearing:.4g} rad", bearing=bearing)
     for name, units in ROUND_STEPS.items():
         if not _applies(candidate, name):
@@ -62,14 +66,9 @@ def simplifications(candidate: Candidate) -> list[Step]:
 
 
 def _applies(candidate: Candidate, name: str) -> bool:
-    """Does `name` change the scenario of `candidate`?"""
-    if name in ("distance", "size"):
-        return candidate.obstacle != "none"
-    if name == "speed":
-        return candidate.motion != "still"
-    if name == "fault_rate":
-        return candidate.fault != "none"
-    return True
+    """Does `name` change the scenario of `candidate`? Not while what it sizes is off."""
+    field, off = _SIZES.get(name, ("", None))
+    return not field or getattr(candidate, field) != off
 
 
 def _rounded(value: float, unit: float) -> float | None:
@@ -84,7 +83,3 @@ def _digits(value: float) -> int:
         if abs(value - round(value, places)) < 1e-9:
             return places
     return 7
-
-
-def _round_angle(angle: float) -> bool:
-    return any(abs(angle - b) < 1e-9 for b in BEARINGS)
