@@ -49,16 +49,14 @@ def test_a_plan_run_again_is_sent_the_frames_of_its_first_run(remembered: None) 
     assert [t[:5] for t in ticks(mistaken)] == [t[:5] for t in alone] and not mistaken.ok
 
 
-def test_a_run_that_stops_early_keeps_nothing_and_other_seeds_are_other_plans(
+def test_a_run_that_stops_early_keeps_every_frame_and_other_seeds_are_other_plans(
     remembered: None,
 ) -> None:
-    run(f"{STUDENTS}:angle_in_degrees", stop_at_first_failure=True)
-    assert (
-        frame_memo.frames_of(
-            plan_run(SCENARIO, "inprocess", LinkOptions(), RunSettings(stop_at_first_failure=True))
-        )
-        is None
-    )
+    stopped = run(f"{STUDENTS}:angle_in_degrees", stop_at_first_failure=True)
+    plan = plan_run(SCENARIO, "inprocess", LinkOptions(), RunSettings(stop_at_first_failure=True))
+    kept = frame_memo.frames_of(plan)
+    assert stopped.stopped_early and kept is not None and len(kept) > len(stopped.records)
+    assert ticks(run()) == ticks(run(f"{STUDENTS}:correct_other_wording"))  # its frames, whole
     first = ticks(run(seed=1))
     assert ticks(run(seed=2)) != first and ticks(run(seed=1)) == first
 

@@ -183,7 +183,10 @@ def main(argv: list[str]) -> int:
     if len(argv) != 1:
         print("usage: python -m harness.audit.worker JOB.json", file=sys.stderr)
         return 2
+    from harness.runner.frame_memo import remember_frames
+
     job = json.loads(Path(argv[0]).read_text(encoding="utf-8"))
+    remember_frames()  # a batch runs the suite once a mutant: its scenarios simulated once
     clock = UnitClock(float(job["unit_timeout"]))
     clock.install()
     return run_job(job, clock)

@@ -4,9 +4,10 @@ A grading judge runs the class's scenarios for one student after another. The
 robot's motion is scripted and a plan's faults are seeded, so what the node is
 sent never depends on the node: the second student's frames are the first's. A
 process that knows it repeats plans (``remember_frames``) keeps each plan's
-frames once its simulation has run to the end, and later runs of that plan are
-given them instead of a new world. Kept frames' arrays are read-only, so nothing
-downstream can change what the next run is sent.
+frames once its simulation has run to the end (the rest simulated for a run that
+ended early), and later runs of that plan are given them instead of a new world.
+Kept frames' arrays are read-only, so nothing downstream can change what the next
+run is sent.
 """
 
 from __future__ import annotations
@@ -18,7 +19,7 @@ if TYPE_CHECKING:
     from harness.runner.frames import Frame
     from harness.runner.plan import RunPlan
 
-__all__ = ["MAX_FRAMES", "frames_of", "keeping", "remember_frames"]
+__all__ = ["MAX_FRAMES", "complete", "frames_of", "keeping", "remember_frames"]
 
 MAX_FRAMES = 10_000  # kept at most (a frame is about 3 KB): the default suite has 544
 
@@ -51,7 +52,7 @@ def frames_of(plan: RunPlan) -> list[Frame] | None:
 
 def keeping(plan: RunPlan, frames: Iterable[Frame]) -> Iterator[Frame]:
     """`frames` as they come, read-only, and kept for the plan's next run once all came
-    (a run that stops early keeps none: the rest were never simulated)."""
+    (`complete` simulates the rest of a run that stopped early)."""
     key = _key(plan)
     if key is None:
         yield from frames
@@ -66,3 +67,12 @@ def keeping(plan: RunPlan, frames: Iterable[Frame]) -> Iterator[Frame]:
         held = sum(len(f) for _, f in _kept.values())
         if held + len(seen) <= MAX_FRAMES:
             _kept[key] = (plan.scenario, seen)  # the scenario held: its id stays its own
+
+
+def complete(kept: Iterator[Frame]) -> None:
+    """Where frames are kept: draw the rest of `kept` (what `keeping` gave a run that ended
+    before its last frame: its node broke, or its first failure ended it), so the plan's
+    next run here is given them all instead of a world of its own."""
+    if _kept is not None:
+        for _ in kept:
+            pass

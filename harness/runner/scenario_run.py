@@ -19,7 +19,7 @@ from harness.judge.records import RunResult, TickRecord
 from harness.lidar.mount import FORWARD
 from harness.lidar.scan import Scan
 from harness.links.base import Link, LinkOptions, create_link
-from harness.runner.frame_memo import frames_of, keeping
+from harness.runner.frame_memo import complete, frames_of, keeping
 from harness.runner.frames import Frame, check_link_faults, judge_frames
 from harness.runner.plan import RunPlan, plan_run
 from harness.runner.settings import RunSettings, faults_origin
@@ -78,7 +78,9 @@ def run_scenario(
                     Frame(s.tick, s.t, s.x, s.y, s.yaw, _emit(profile, s, sim.spec, rng))
                     for s in sim.ticks(plan.periods())
                 )
-                judge(keeping(plan, simulated))
+                kept = keeping(plan, simulated)
+                judge(kept)
+                complete(kept)  # where frames are kept: those of a run that ended early too
     finally:  # an interrupted run reports its time too; waiting for the link is start-up
         result.wall_s = time.perf_counter() - started - result.startup_s
     return result
