@@ -199,11 +199,10 @@ def latched_warning_hint(verdicts: Sequence[Verdict]) -> str | None:
 
 def _bounds(verdicts: Sequence[Verdict]) -> tuple[float | None, float | None]:
     """(largest distance it warned at, smallest it published False at)."""
-    warned = [v.expected.distance for v in verdicts if v.warning_got is True]
-    calm = [v.expected.distance for v in verdicts if v.warning_got is False]
-    warned_at = [d for d in warned if d is not None]
-    calm_at = [d for d in calm if d is not None]
-    return (max(warned_at) if warned_at else None, min(calm_at) if calm_at else None)
+    known = [(v.expected.distance, v.warning_got) for v in verdicts]
+    warned_at = [d for d, got in known if got is True and d is not None]
+    calm_at = [d for d, got in known if got is False and d is not None]
+    return (max(warned_at, default=None), min(calm_at, default=None))
 
 
 def _other_threshold(verdicts: Sequence[Verdict], threshold: float) -> tuple[float, float] | None:

@@ -235,12 +235,8 @@ class WatchScreen:
         table.add_column("time", justify="right", no_wrap=True)
         table.add_column("detail", no_wrap=True, overflow="ellipsis", max_width=120)
         for row in self._rows:
-            if row.seconds is not None:
-                when = f"{row.seconds:.2f} s"
-            elif row.state == "running":
-                when = f"{row.ticks} ticks"
-            else:
-                when = ""
+            ticks = f"{row.ticks} ticks" if row.state == "running" else ""
+            when = f"{row.seconds:.2f} s" if row.seconds is not None else ticks
             table.add_row(
                 Text(row.state, style=STATE_STYLES.get(row.state, "")),
                 Text(for_terminal(clip(row.name, 200))),
