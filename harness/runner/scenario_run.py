@@ -78,9 +78,9 @@ def run_scenario(
                     Frame(s.tick, s.t, s.x, s.y, s.yaw, _emit(profile, s, sim.spec, rng))
                     for s in sim.ticks(plan.periods())
                 )
-                kept = keeping(plan, simulated)
-                judge(kept)
-                complete(kept)  # where frames are kept: those of a run that ended early too
+                frames = keeping(plan, simulated)
+                judge(frames)
+                complete(frames)  # where frames are kept: those of a run that ended early too
     finally:  # an interrupted run reports its time too; waiting for the link is start-up
         result.wall_s = time.perf_counter() - started - result.startup_s
     return result
