@@ -60,16 +60,12 @@ def parse_scenario(data: Any, *, source: str = "<scenario>") -> Scenario:
     return scenario
 
 
-def _read_text(path: Path) -> str:
-    """The file's text: a regular file, at most MAX_FILE_BYTES, UTF-8; never blocks on a FIFO."""
-    return read_text_file(path, limit=MAX_FILE_BYTES, name=shown(str(path)), kind="scenario file")
-
-
 def load_scenario_file(path: str | Path) -> Scenario:
     """Read and validate one scenario file, and the model files it names."""
     path = Path(path)
     name = shown(str(path))
-    text = _read_text(path)
+    # a regular file, at most MAX_FILE_BYTES, UTF-8; never blocks on a FIFO
+    text = read_text_file(path, limit=MAX_FILE_BYTES, name=name, kind="scenario file")
     try:
         data = load_yaml(text)
     except yaml.YAMLError as err:
