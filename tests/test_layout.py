@@ -199,3 +199,15 @@ def test_the_map_names_every_package() -> None:
     text = DOCS.read_text()
     missing = sorted(name for name in RANK if name != "cli" and f"{name}/" not in text)
     assert not missing, f"docs/architecture.md does not show: {missing}"
+
+
+MAX_MODULE_LINES = 600  # a module past this holds more than one concept: split it by role
+
+
+def test_no_module_is_over_600_lines() -> None:
+    long = sorted(
+        f"{path.relative_to(HARNESS)} ({count})"
+        for path in _code_files()
+        if (count := len(path.read_text(encoding="utf-8").splitlines())) > MAX_MODULE_LINES
+    )
+    assert not long, f"modules over {MAX_MODULE_LINES} lines: {long}"
