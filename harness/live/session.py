@@ -247,10 +247,8 @@ class LiveSession:
             return None
         from harness.live.teleop import KeyboardTeleop, TeleopState
 
-        limits = world.limits
-        teleop = KeyboardTeleop(
-            self.keys, TeleopState(limits.top_speed, limits.top_turn), show=self.show
-        )
+        state = TeleopState(world.limits.top_speed, world.limits.top_turn)
+        teleop = KeyboardTeleop(self.keys, state, show=self.show)
         teleop.start()
         return teleop
 
