@@ -183,7 +183,6 @@ def emulate(
     settings: RunSettings | None = None,
     announce: Callable[[str], None] = print,
     verbose: bool = False,
-    status_every_s: float = STATUS_EVERY_S,
     mount: LidarMount = FORWARD,
 ) -> EmulationSummary:
     """Serve every revolution of `scenario` in real time until it ends or Ctrl-C stops it."""
@@ -220,7 +219,7 @@ def emulate(
         # The simulation first: building it silences stdout (fd 1) for a moment,
         # which would swallow what the server thread logs meanwhile.
         with Simulation(scenario) as sim, server:
-            status_due = started + status_every_s
+            status_due = started + STATUS_EVERY_S
             for tick in sim.ticks(plan.periods()):
                 due = started + tick.t
                 while (left := due - time.monotonic()) > 0:
@@ -228,7 +227,7 @@ def emulate(
                     server.wait_idle(0)  # surfaces a vanished port promptly
                     if time.monotonic() >= status_due:
                         log.line(status_line(server.stats()))
-                        status_due += status_every_s
+                        status_due += STATUS_EVERY_S
                 scan = plan.profile.emit(tick.truth, spec, rng, stamp=tick.t)
                 rate_hz = 1.0 / tick.period
                 samples = profile.revolution(device, scan, rate_hz, spec.range_max, mount=mount)

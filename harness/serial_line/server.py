@@ -57,7 +57,6 @@ class DeviceServer:
         revolution_period_s: float = 0.1,
         next_start: NextStart = "extra",
         bits_per_byte: int = 10,
-        unit_samples: int | None = None,
         follow_dtr: bool = True,
         motor_on_when_dtr: bool = False,
         motor_on_without_dtr: bool = True,
@@ -87,7 +86,6 @@ class DeviceServer:
             period_s=revolution_period_s,
             next_start=next_start,
             continuous=continuous,
-            unit_samples=unit_samples,
             tell=self._tell,
             on_bytes=self._unstall,
         )

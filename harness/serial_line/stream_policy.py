@@ -72,7 +72,6 @@ class StreamPolicy:
         period_s: float = 0.1,
         next_start: NextStart = "extra",
         continuous: bool = False,
-        unit_samples: int | None = None,
         tell: Callable[[Any], None] = lambda event: None,
         on_bytes: Callable[[], None] = lambda: None,
     ) -> None:
@@ -89,7 +88,6 @@ class StreamPolicy:
         self.continuous = continuous
         self.damage: Any = None
         self.t0 = 0.0  # device timestamps count from here in realtime
-        self._unit_override = unit_samples
         self._tell, self._on_bytes = tell, on_bytes
         self.stream = bytearray()  # queued bytes, taken by the writer (``consumed``)
         self._rev_left = 0  # bytes of the current revolution (not its marker) still in stream
@@ -111,7 +109,7 @@ class StreamPolicy:
     @property
     def unit(self) -> int:
         """Samples in one packet of the device's stream (1 for RPLIDAR nodes)."""
-        return self._unit_override or self.device.samples_per_packet
+        return self.device.samples_per_packet
 
     @property
     def streaming(self) -> bool:
