@@ -35,8 +35,7 @@ class OptionError(ConfigError):
     """
 
     def __init__(self, key: str, template: str, names: Names | None = None) -> None:
-        self.key = key
-        self.template = template
+        self.key, self.template = key, template
         super().__init__(self.render(names))
 
     @classmethod

@@ -80,8 +80,7 @@ class Held(Exception):
 
     def __init__(self, path: Path, holder: Holder) -> None:
         super().__init__(f"{path}: held by {holder}")
-        self.path = path
-        self.holder = holder
+        self.path, self.holder = path, holder
 
 
 def this_process() -> str:

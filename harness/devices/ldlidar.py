@@ -164,8 +164,7 @@ class LdlidarDevice(DeviceDefaults):
     def __init__(self, *, speed_deg_s: float = SPEED_DEG_S, samples_per_s: int = SAMPLES_PER_S):
         if speed_deg_s <= 0 or samples_per_s <= 0:
             raise ValueError("speed_deg_s and samples_per_s must be positive")
-        self.speed_deg_s = speed_deg_s
-        self.samples_per_s = samples_per_s
+        self.speed_deg_s, self.samples_per_s = speed_deg_s, samples_per_s
         self._pending: list[tuple[Sample, float]] = []  # samples and their times (ms)
         # "requests": whole LDROBOT command frames (ignored, but not an error).
         self.counters: dict[str, int] = {"requests": 0, "ignored_host_bytes": 0}

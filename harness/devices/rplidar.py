@@ -205,17 +205,13 @@ class RplidarDevice(DeviceDefaults):
     ) -> None:
         if len(serial_number) != 16:
             raise ValueError(f"serial_number must be 16 bytes, got {len(serial_number)}")
-        self.model = model
-        self.firmware = firmware
-        self.hardware = hardware
+        self.model, self.firmware, self.hardware = model, firmware, hardware
         self.serial_number = bytes(serial_number)
-        self.standard_sample_us = standard_sample_us
-        self.express_sample_us = express_sample_us
+        self.standard_sample_us, self.express_sample_us = standard_sample_us, express_sample_us
         if scan_modes is None:
             scan_modes = default_scan_modes(standard_sample_us, express_sample_us)
         self.scan_modes = tuple(scan_modes)
-        self.typical_mode = typical_mode
-        self.pwm_controls_motor = pwm_controls_motor
+        self.typical_mode, self.pwm_controls_motor = typical_mode, pwm_controls_motor
         major, minor = firmware
         # What the A1 prints (CRLF text, no descriptor) at power-up and after RESET.
         self.reset_banner = (
@@ -224,8 +220,7 @@ class RplidarDevice(DeviceDefaults):
         ).encode("ascii")
         self.motor_on = False
         self.pwm: int | None = None  # last MOTOR_PWM value, None if never sent
-        self.health_status = HEALTH_OK
-        self.health_error = 0
+        self.health_status, self.health_error = HEALTH_OK, 0
         self.fault_persists = False  # a fault that RESET does not clear
         self.rebooting = False
         self.session = 0  # bumped whenever a scan starts or ends: stale bytes can be dropped

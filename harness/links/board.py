@@ -224,8 +224,7 @@ class SerialLidar:
     starts_ahead = BoardLink.starts_ahead
 
     def __init__(self, name: str, profile: DeviceProfile, module: str) -> None:
-        self.name = name
-        self.profile = profile
+        self.name, self.profile = name, profile
         self.__module__ = module  # the link module that declares it (``kinds``' row)
 
     def __call__(self, options: LinkOptions, session: BoardSession | None = None) -> BoardLink:

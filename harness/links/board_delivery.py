@@ -53,8 +53,7 @@ class BoardDelivery(ScanDelivery):
     copies_queue = False
 
     def __init__(self, exchange: NodeExchange, profile: DeviceProfile) -> None:
-        self.exchange = exchange
-        self.profile = profile
+        self.exchange, self.profile = exchange, profile
         self.session: BoardSession | None = None  # the run's (or the link's own), once open
         self.idle = IdleStreamEnd(exchange, self._damage_from_now)
         self._seen: Scan | None = None

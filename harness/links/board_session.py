@@ -90,8 +90,7 @@ class BoardSession:
     context manager); ``options`` are the first scenario's, only the rate changes after."""
 
     def __init__(self, profile: DeviceProfile, options: LinkOptions) -> None:
-        self.profile = profile
-        self.options = options
+        self.profile, self.options = profile, options
         self.physical = options.port is not None
         if self.physical and options.board_commands:
             raise OptionError(

@@ -52,8 +52,7 @@ class NodeGraph:
         wiring: WiringNotes,
         hooks: GraphHooks | None = None,
     ) -> None:
-        self.options = options
-        self.command = command
+        self.options, self.command = options, command
         self.wiring = wiring  # the run's launch files, if any
         self.hooks = hooks or GraphHooks()
         self.process: NodeProcess | None = None

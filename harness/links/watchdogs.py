@@ -97,9 +97,8 @@ class FloodWatch:
     status_topic: str
     warning_topic: str
     counted: tuple[int, int] = (0, 0)  # statuses and Bools heard, all told, at the last count
-    recent: deque[tuple[int, int, float]] = field(
-        default_factory=lambda: deque(maxlen=FLOOD_SCANS)
-    )  # (statuses, Bools, seconds) of each recent exchange
+    # (statuses, Bools, seconds) of each recent exchange
+    recent: deque[tuple[int, int, float]] = field(default_factory=lambda: deque(maxlen=FLOOD_SCANS))
 
     def restart(self, statuses: int, bools: int) -> None:
         """Count from here: what was heard so far (warm-up, the first scan's copies) is no flood."""

@@ -63,10 +63,8 @@ class LineWatch:
         changed: Callable[[], None] = lambda: None,
     ) -> None:
         self.device, self.port, self.counts = device, port, counts
-        self.baudrate = baudrate
-        self.follow_dtr = follow_dtr
-        self.motor_on_when_dtr = motor_on_when_dtr
-        self.motor_on_without_dtr = motor_on_without_dtr
+        self.baudrate, self.follow_dtr = baudrate, follow_dtr
+        self.motor_on_when_dtr, self.motor_on_without_dtr = motor_on_when_dtr, motor_on_without_dtr
         self._tell, self._changed = tell, changed
         self.dtr: bool | None = None
         self._polled = 0.0

@@ -50,15 +50,13 @@ class LinePacer:
     ) -> None:
         if baudrate <= 0 or bits_per_byte <= 0:
             raise ValueError("baudrate and bits_per_byte must be positive")
-        self.baudrate = baudrate
-        self.bits_per_byte = bits_per_byte
+        self.baudrate, self.bits_per_byte = baudrate, bits_per_byte
         self.byte_time_s = bits_per_byte / baudrate
         self.chunk_bytes = max(1, int(chunk_s / self.byte_time_s))
         self.max_lag_s = max_lag_s
         self._burst_start: float | None = None
         self._burst_bytes = 0  # bytes scheduled in the current burst
-        self._first_write = 0.0
-        self._last_write = 0.0
+        self._first_write = self._last_write = 0.0
         self._last_chunk = 0
         self._busy_bytes = 0  # closed bursts: bytes between first and last chunk write
         self._busy_time = 0.0

@@ -69,8 +69,7 @@ class DeviceServer:
         self.device, self.port, self.baudrate = device, port, baudrate
         self.mode: Mode = mode
         self.next_start: NextStart = next_start
-        self.continuous = continuous
-        self.poll_s = poll_s
+        self.continuous, self.poll_s = continuous, poll_s
         # Told (on the server thread) of line events and, through the device, of
         # each request and protocol error: what `emulate -v` prints.
         self.listener = listener

@@ -37,10 +37,7 @@ class LidarModel:
     def __init__(
         self, client: int, body: int, link_index: int, spec: LidarSpec, *, ray_mask: int = -1
     ) -> None:
-        self.client = client
-        self.body = body
-        self.link_index = link_index
-        self.spec = spec
+        self.client, self.body, self.link_index, self.spec = client, body, link_index, spec
         self.ray_mask = ray_mask  # collisionFilterMask: which collision groups the beams see
         self._directions = beam_directions(spec)
 

@@ -235,8 +235,7 @@ class WheelDriver:
     """Drives the wheel motors and steps the physics at a fixed 240 Hz."""
 
     def __init__(self, world: RobotWorld, time_step: float) -> None:
-        self.world = world
-        self.time_step = time_step
+        self.world, self.time_step = world, time_step
         self.wheels = world.wheel_geometry(*WHEEL_JOINTS)
         self._steps = 0
         self._command: tuple[float, float] | None = None
