@@ -19,9 +19,10 @@ HAMMER = textwrap.dedent(
     from harness.sim import bullet
 
     where = (os.fstat(1).st_ino, os.fstat(2).st_ino)
-    main, done = threading.get_ident(), threading.Event()
+    main, go, done = threading.get_ident(), threading.Event(), threading.Event()
 
     def shoot():
+        go.wait()
         rnd = random.Random(7)
         while not done.is_set():
             time.sleep(rnd.uniform(0, 0.0003))
@@ -29,31 +30,26 @@ HAMMER = textwrap.dedent(
 
     signal.signal(signal.SIGINT, signal.default_int_handler)
     threading.Thread(target=shoot, daemon=True).start()
-    runs = stopped = 0
-    moved = False
+    count = {"runs": 0, "stopped": 0, "moved": False}
     deadline = time.monotonic() + 1.5
-    while not moved:
+    while True:  # a stop may land anywhere in here, not only in the capture: go on
         try:
-            if time.monotonic() > deadline:
-                break
-            runs += 1
-            with bullet.captured_output():
-                pass
-        except KeyboardInterrupt:
-            stopped += 1
-        try:
-            moved = (os.fstat(1).st_ino, os.fstat(2).st_ino) != where
-        except KeyboardInterrupt:
-            pass
-    while True:  # ignored first: the stops still on their way; one may land in here
-        try:
-            signal.signal(signal.SIGINT, signal.SIG_IGN)
+            go.set()
+            while not count["moved"] and time.monotonic() < deadline:
+                count["runs"] += 1
+                try:
+                    with bullet.captured_output():
+                        pass
+                except KeyboardInterrupt:
+                    count["stopped"] += 1
+                count["moved"] = (os.fstat(1).st_ino, os.fstat(2).st_ino) != where
+            signal.signal(signal.SIGINT, signal.SIG_IGN)  # the stops still on their way
             break
         except KeyboardInterrupt:
             pass
     done.set()
     with open(sys.argv[1], "w") as out:
-        out.write(f"{runs} {stopped} {moved}")
+        out.write(f"{count['runs']} {count['stopped']} {count['moved']}")
     """
 )
 
