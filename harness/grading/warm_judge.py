@@ -113,7 +113,7 @@ def _to(fd: int) -> None:
 
 
 def serve(sandboxed: bool) -> int:
-    """Judge a job a line on stdin (``{"job", "log"}``), its account in `log`; ``done
+    """Judge a job a line on stdin (``{"job", "log", "plot_cache"}``), its account in `log`; ``done
     CODE`` a line on the original stdout once judged and, sandboxed, once nothing of the
     student is left. Ends with stdin, or when a student's processes cannot be ended."""
     from harness.grading.worker import interrupt_on_sigterm, not_dumpable, run_job, warm_node_server
@@ -137,6 +137,8 @@ def serve(sandboxed: bool) -> int:
     warmed = False
     for line in jobs:
         request = json.loads(line)
+        if request.get("plot_cache") and "MPLCONFIGDIR" not in os.environ:  # before matplotlib
+            os.environ["MPLCONFIGDIR"] = request["plot_cache"]
         job = json.loads(Path(request["job"]).read_text(encoding="utf-8"))
         log = os.open(request["log"], os.O_WRONLY | os.O_CREAT | os.O_APPEND, 0o644)
         _to(log)
@@ -199,6 +201,12 @@ class Slot:
     def grader(self) -> Path:
         return self.root / "out" / "grader"
 
+    @property
+    def plot_cache(self) -> Path:
+        """matplotlib's cache for the judge (its home is an empty tmpfs), kept while the slot
+        lasts: the font list, which matplotlib builds in a quarter second of CPU otherwise."""
+        return self.root / "out" / ".matplotlib"
+
     def fill(self, files: Path | None, leave_out: Path) -> Path:
         """The slot emptied, then `files` (a student's folder, without `leave_out`, the
         grader's own folder should it be inside) in it: where they now are. Hard links
@@ -207,6 +215,7 @@ class Slot:
         self.empty()
         for folder in (self.node, self.student, self.grader):
             folder.mkdir(parents=True, exist_ok=True)
+        _seed_plot_cache(self.plot_cache)
         if files is None:
             return self.node / "colcon"
         copy = self.node / files.name
@@ -245,6 +254,18 @@ class Slot:
             return text
 
         return moved
+
+
+def _seed_plot_cache(cache: Path) -> None:
+    """The worker's own matplotlib font list (if it has one) in the judge's cache, once."""
+    if cache.is_dir():
+        return
+    cache.mkdir(parents=True)
+    home = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+    mine = Path(os.environ.get("MPLCONFIGDIR") or os.path.join(home, "matplotlib"))
+    for fonts in sorted(mine.glob("fontlist-*.json")) if mine.is_dir() else ():
+        with contextlib.suppress(OSError):
+            shutil.copy2(fonts, cache / fonts.name)
 
 
 def _link_or_copy(source: str, target: str) -> None:
@@ -289,7 +310,9 @@ class WarmJudge:
         assert popen.stdin is not None and popen.stdout is not None
         log.touch()
         try:
-            popen.stdin.write(json.dumps({"job": str(job), "log": str(log)}) + "\n")
+            cache = str(Slot(self.slot).plot_cache)
+            popen.stdin.write(json.dumps({"job": str(job), "log": str(log), "plot_cache": cache}))
+            popen.stdin.write("\n")
             popen.stdin.flush()
         except OSError:
             return Finished(popen.poll(), 0.0, start_error="the judging process had ended"), False
