@@ -20,7 +20,8 @@ from matplotlib.artist import Artist
 __all__ = ["AxisLayers"]
 
 KEPT = 16  # sets of limits kept (about 2 MB each): a class's scenarios
-MARGIN_PX = 12  # around the axes and their labels: tick marks, a label's last pixels
+MARGIN_PX = 12  # above an axes: its tick marks and the top tick label's upper half
+BELOW_PX = 56  # below an axes: the x tick labels and the axis label under them
 ZORDER = 1.5  # where matplotlib draws an axis when ``axes.axisbelow`` is "line"
 
 
@@ -68,23 +69,21 @@ class AxisLayers:
             layer.pixels, layer.at = pixels, at
 
     def _draw(self, canvas: Any) -> list[tuple[np.ndarray, tuple[int, int]]]:
-        from matplotlib.transforms import Bbox
-
         renderer = canvas.get_renderer()
         width, height = int(renderer.width), int(renderer.height)
         drawn = []
         for ax in self.axes:
             renderer.clear()  # transparent: only the decorations get alpha
-            boxes = [ax.bbox]  # the grid; the ticks' labels and the axis labels outside it
             for part in (ax.xaxis, ax.yaxis):
                 part.set_visible(True)
                 part.draw(renderer)
-                boxes.append(part.get_tightbbox(renderer) or ax.bbox)
                 part.set_visible(False)  # from now on the layer stands in for it
-            box = Bbox.union(boxes)  # and a margin: tick marks stand out of the axes
-            x0, y0 = max(0, int(box.x0) - MARGIN_PX), max(0, int(box.y0) - MARGIN_PX)
-            x1, y1 = min(width, int(box.x1) + MARGIN_PX), min(height, int(box.y1) + MARGIN_PX)
-            rows = np.asarray(renderer.buffer_rgba())[height - y1 : height - y0, x0:x1]
+            # The figure's width (the tick labels on the left) and the axes' height, with
+            # room below for the x tick labels and the axis label: measuring each text's
+            # extent instead cost as much as drawing it.
+            box = ax.bbox
+            y0, y1 = max(0, int(box.y0) - BELOW_PX), min(height, int(box.y1) + MARGIN_PX)
+            rows = np.asarray(renderer.buffer_rgba())[height - y1 : height - y0, :width]
             pixels = np.ascontiguousarray(rows[::-1])  # draw_image counts rows from the bottom
-            drawn.append((pixels, (x0, y0)))
+            drawn.append((pixels, (0, y0)))
         return drawn
