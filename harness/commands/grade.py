@@ -340,7 +340,11 @@ def run(args: argparse.Namespace, console: Console) -> int:
                 workers=args.workers,
                 retries=WORKER_RETRIES,
                 worker_wait=args.worker_wait,
-                preload=("harness.grading.grade",),  # each student runs in a process of its own
+                preload=("harness.grading.grade",),  # what a worker process imports first
+                # A sandboxed student cannot reach the grader's processes (PID namespace),
+                # so the embedded workers can be its threads; --no-sandbox keeps processes,
+                # so a node that kills its worker costs that worker, not the class.
+                threads=not args.no_sandbox,
             )
         )
         if any(s.kind in ("package", "workspace") for s in found.students):

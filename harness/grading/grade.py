@@ -14,6 +14,7 @@ from __future__ import annotations
 import contextlib
 import json
 import os
+import re
 import shlex
 import shutil
 import socket
@@ -260,8 +261,21 @@ def _script_name(student: Student) -> Path:
 
 
 def _slot(config: GradeConfig) -> Slot:
-    """This worker process's slot for its warm judge, under the grader's folder."""
-    return Slot(config.grader_dir / ".slots" / f"{socket.gethostname()}-{os.getpid()}")
+    """This worker's slot for its warm judge, under the grader's folder: named by host,
+    process and Dask worker (the embedded cluster's workers are threads of one process)."""
+    where = f"{socket.gethostname()}-{os.getpid()}-{_worker_name()}"
+    return Slot(config.grader_dir / ".slots" / where)
+
+
+def _worker_name() -> str:
+    """The Dask worker running this task, as a file name ("0" outside a cluster's task)."""
+    from distributed import get_worker
+
+    try:
+        name = str(get_worker().name)
+    except ValueError:  # called directly, not as a task
+        return "0"
+    return re.sub(r"[^A-Za-z0-9_.-]", "_", name)
 
 
 def _judge_warm(job: Path, slot: Slot, config: GradeConfig, cancel: StopFlag) -> Finished:

@@ -28,6 +28,7 @@ import shutil
 import signal
 import subprocess
 import sys
+import threading
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -165,8 +166,6 @@ def _import_beside() -> None:
     """The first job's imports: the runner's here (the run needs them first), the plots'
     and recordings' in a thread, while the run waits for its first node to start (the
     first plot's matplotlib import was a second on the first student's way)."""
-    import threading
-
     import harness.links.ros2  # noqa: F401 - what run_job imports first, before the thread
     import harness.runner.suite  # noqa: F401
 
@@ -345,31 +344,40 @@ class WarmJudge:
         shutil.rmtree(self.slot, ignore_errors=True)
 
 
-_JUDGES: list[WarmJudge] = []  # this worker's judge, at most one
+# This process's judges, one a worker (a worker's slot): the embedded cluster's workers
+# are threads of one process, an external cluster's are processes of their own.
+_JUDGES: dict[Path, WarmJudge] = {}
+_JUDGES_TURN = threading.Lock()
 
 
 def warm_judge(argv: list[str], slot: Path) -> WarmJudge:
-    """This worker's judge for `argv` (the same sandbox view), started if need be; one of
-    another view, or one that ended, is closed first."""
-    if _JUDGES and (_JUDGES[0].argv != argv or _JUDGES[0].popen.poll() is not None):
-        _JUDGES.pop().close()
-    if not _JUDGES:
-        _JUDGES.append(WarmJudge(argv, slot))
-    return _JUDGES[0]
+    """The judge of the worker whose slot is `slot`, for `argv` (the same sandbox view),
+    started if need be; one of another view, or one that ended, is closed first."""
+    with _JUDGES_TURN:
+        judge = _JUDGES.get(slot)
+        if judge is not None and (judge.argv != argv or judge.popen.poll() is not None):
+            del _JUDGES[slot]
+            judge.close()
+        if slot not in _JUDGES:
+            _JUDGES[slot] = WarmJudge(argv, slot)
+        return _JUDGES[slot]
 
 
 def drop_judge(judge: WarmJudge) -> None:
     """`judge` is not to be used again (stopped already)."""
-    if judge in _JUDGES:
-        _JUDGES.remove(judge)
+    with _JUDGES_TURN:
+        if _JUDGES.get(judge.slot) is judge:
+            del _JUDGES[judge.slot]
     judge.close()
 
 
 def close_judges(under: str) -> None:
-    """Close this worker's judge if its slot is `under` (a class's grader folder):
-    ``client.run`` at a class's end, since an external cluster's workers outlive the
-    grading (and may serve another grading meanwhile)."""
-    for judge in [j for j in _JUDGES if j.slot.is_relative_to(under)]:
+    """Close the judges whose slots are `under` (a class's grader folder): ``client.run``
+    at a class's end, since an external cluster's workers outlive the grading (and may
+    serve another grading meanwhile)."""
+    with _JUDGES_TURN:
+        judges = [j for j in _JUDGES.values() if j.slot.is_relative_to(under)]
+    for judge in judges:
         drop_judge(judge)
 
 
