@@ -18,12 +18,18 @@ __all__ = ["planned_ticks"]
 
 
 def planned_ticks(scenarios: Sequence[Scenario], settings: RunSettings) -> dict[str, int]:
-    """Each scenario's tick count, simulated without a link (pybullet, no ROS)."""
-    from harness.sim.simulation import Simulation  # imports pybullet
+    """Each scenario's tick count, simulated without a link (pybullet, no ROS), as a run
+    simulates it: where frames are remembered (harness.runner.frame_memo), they are kept
+    for the runs, or the judges, that follow."""
+    from harness.runner.frame_memo import frames_of, keeping
+    from harness.runner.scenario_run import simulated_frames
 
     counts: dict[str, int] = {}
     for scenario in scenarios:
         plan = plan_one(scenario, "", LinkOptions(), settings)  # no link: the ticks are its own
-        with Simulation(scenario) as sim:
-            counts[scenario.name] = sum(1 for _ in sim.ticks(plan.periods()))
+        kept = frames_of(plan)
+        if kept is None:
+            with simulated_frames(plan) as frames:
+                kept = list(keeping(plan, frames))
+        counts[scenario.name] = len(kept)
     return counts

@@ -6,8 +6,9 @@ differs.
 
 from __future__ import annotations
 
+import contextlib
 import time
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Iterator
 from dataclasses import replace
 from typing import TYPE_CHECKING
 
@@ -43,12 +44,9 @@ def run_scenario(
     coming up (started ahead, or by `start`) does so meanwhile. Its wait is the
     result's `startup_s`; a LinkError from the open propagates (`run_through`).
     """
-    from harness.sim.simulation import Simulation  # imports pybullet
-
     started = time.perf_counter()
     scenario, profile, settings = plan.scenario, plan.profile, plan.settings
     result = plan.result()
-    rng = np.random.default_rng(plan.seed)
     try:
         check_link_faults(profile.link, link)
     except ConfigError as err:
@@ -73,17 +71,28 @@ def run_scenario(
         if kept is not None:  # simulated here before: the same frames, no world to build
             judge(kept)
         else:
-            with Simulation(scenario, gui=settings.gui) as sim:
-                simulated = (
-                    Frame(s.tick, s.t, s.x, s.y, s.yaw, _emit(profile, s, sim.spec, rng))
-                    for s in sim.ticks(plan.periods())
-                )
+            with simulated_frames(plan) as simulated:
                 frames = keeping(plan, simulated)
                 judge(frames)
                 complete(frames)  # where frames are kept: those of a run that ended early too
     finally:  # an interrupted run reports its time too; waiting for the link is start-up
         result.wall_s = time.perf_counter() - started - result.startup_s
     return result
+
+
+@contextlib.contextmanager
+def simulated_frames(plan: RunPlan) -> Iterator[Iterator[Frame]]:
+    """The plan's frames, from a world of its own built on entry (before a link is opened:
+    a node started ahead comes up meanwhile) and closed on exit: the scans its faults
+    spoil, drawn from the plan's seed."""
+    from harness.sim.simulation import Simulation  # imports pybullet
+
+    rng = np.random.default_rng(plan.seed)
+    with Simulation(plan.scenario, gui=plan.settings.gui) as sim:
+        yield (
+            Frame(s.tick, s.t, s.x, s.y, s.yaw, _emit(plan.profile, s, sim.spec, rng))
+            for s in sim.ticks(plan.periods())
+        )
 
 
 def _emit(
