@@ -12,6 +12,7 @@ from harness.judge.records import RunResult
 from harness.links import LinkOptions
 from harness.runner import frame_memo, scenario_run
 from harness.runner.plan import plan_run
+from harness.runner.planned_ticks import planned_ticks
 from harness.runner.settings import RunSettings
 from harness.scenario.files import resolve_scenario
 
@@ -66,3 +67,26 @@ def test_without_remembering_nothing_is_kept() -> None:
     assert (
         frame_memo.frames_of(plan_run(SCENARIO, "inprocess", LinkOptions(), RunSettings())) is None
     )
+
+
+def test_frames_a_process_saved_are_what_another_is_sent_for_the_same_scenario(
+    remembered: None, tmp_path: Path
+) -> None:
+    """grade counts the ticks (planned_ticks) and saves the frames; a judge loads them for
+    its own reading of the scenario file, and runs as if it had simulated them itself."""
+    assert planned_ticks([SCENARIO], RunSettings()) == {SCENARIO.name: len(run().records)}
+    saved = tmp_path / "frames.pickle"
+    assert frame_memo.save_frames(saved)
+    frame_memo.remember_frames(False)
+    simulated = ticks(run())  # a world of its own
+    frame_memo.remember_frames()  # the judge's process: nothing kept yet
+    judges_own = resolve_scenario("noisy_approach")  # not the grader's object
+    changed = judges_own.model_copy(update={"obstacles": []})  # edited since: no wall
+    assert frame_memo.load_frames(saved, [changed]) == 0  # another scenario's frames: none
+    assert frame_memo.load_frames(saved, [judges_own]) == 1
+    plan = plan_run(judges_own, "inprocess", LinkOptions(), RunSettings())
+    given = frame_memo.frames_of(plan)
+    assert given is not None and not given[0].scan.ranges.flags.writeable
+    sent = scenario_run.run(judges_own, "inprocess", LinkOptions(), RunSettings())
+    assert ticks(sent) == simulated
+    assert frame_memo.load_frames(tmp_path / "missing.pickle", [judges_own]) == 0

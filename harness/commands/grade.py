@@ -311,10 +311,11 @@ def run(args: argparse.Namespace, console: Console) -> int:
         scenario_legend,
     )
     from harness.grading.discover import discover
-    from harness.grading.grade import WORKER_RETRIES, GradeConfig, grade_class
+    from harness.grading.grade import WORKER_RETRIES, GradeConfig, class_frames, grade_class
     from harness.grading.grading_file import GradebookSettings
     from harness.grading.hidden import HiddenScenario
     from harness.grading.roster import load_roster
+    from harness.runner.frame_memo import remember_frames
     from harness.runner.planned_ticks import planned_ticks
     from harness.runner.settings import check_settings
 
@@ -354,6 +355,7 @@ def run(args: argparse.Namespace, console: Console) -> int:
                 "grading needs rclpy: pip install 'fossbot-hil[ros]' (or source ROS 2 Jazzy)"
             )
         sandbox = sandbox_limits(args, console)  # this machine cannot sandbox: exit 2 now
+        remember_frames()  # the tick counts' frames are the judges' too (class_frames below)
         planned = planned_ticks(scenarios, settings)  # what a partial score counts against
         replaced = previous_grading(out)
         client = soon.client()  # a --scheduler that does not answer: exit 2 now
@@ -382,6 +384,7 @@ def run(args: argparse.Namespace, console: Console) -> int:
             },
             sandbox=sandbox,
             sandbox_checked=args.scheduler is None,  # the embedded cluster's host is this one
+            frames=class_frames(out.resolve() / "grader"),
         )
         if replaced:
             console.print(replaced, markup=False, highlight=False)

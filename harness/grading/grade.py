@@ -44,7 +44,7 @@ from harness.sandbox.probe import sandbox_problem
 from harness.sandbox.refusals import refusal_of
 from harness.sandbox.student import sandboxed_run
 
-__all__ = ["GradeConfig", "grade_class", "grade_student"]
+__all__ = ["GradeConfig", "class_frames", "grade_class", "grade_student"]
 
 MAX_RUN_LOG_BYTES = 20 * 1024 * 1024
 WORKER_RETRIES = 1  # a student is graded again once if their worker died under them
@@ -75,6 +75,9 @@ class GradeConfig:
     # True: the grader has found that its host can sandbox, and every worker runs there
     # (the embedded cluster), so a worker need not try again before its first student.
     sandbox_checked: bool = False
+    # The class's frames as the grader simulated them (harness.runner.frame_memo): every
+    # judge starts from them instead of building the worlds for its first student.
+    frames: Path | None = None
 
     @property
     def unheld(self) -> dict[str, tuple[int, int]]:
@@ -86,6 +89,19 @@ class GradeConfig:
         """<out>/grader: what the grader keeps of each student for itself (job, raw results),
         apart from the folder a student may be handed."""
         return self.students_dir.parent / "grader"
+
+
+def class_frames(grader_dir: Path) -> Path | None:
+    """The frames the grader simulated for the tick counts (harness.runner.frame_memo),
+    saved in `grader_dir` for every judge to start from, and no longer kept here; None
+    if there are none."""
+    from harness.runner.frame_memo import remember_frames, save_frames
+
+    grader_dir.mkdir(parents=True, exist_ok=True)
+    path = grader_dir / "frames.pickle"
+    saved = save_frames(path)
+    remember_frames(False)
+    return path if saved else None
 
 
 def _shorten(text: str, folder: Path, command: str | None = None) -> str:
@@ -286,7 +302,10 @@ def _judge_warm(job: Path, slot: Slot, config: GradeConfig, cancel: StopFlag) ->
         argv = sandboxed_run(
             [*argv, "--sandboxed"],
             node_files=[slot.node],
-            scenario_files=[Path(ref) for ref in config.scenario_refs if Path(ref).is_absolute()],
+            scenario_files=[
+                *(Path(ref) for ref in config.scenario_refs if Path(ref).is_absolute()),
+                *((config.frames,) if config.frames is not None else ()),
+            ],
             outputs=[slot.root / "out"],
             limits=config.sandbox,
         )
@@ -392,6 +411,7 @@ def _grade(student: Student, config: GradeConfig, cancel: StopFlag) -> StudentGr
         results=slot.grader / "results.json",
         junit=slot.student / "junit.xml",
         report=slot.student / "report",
+        frames=config.frames,
         hidden={
             n: {"label": h.label, "show_failure": h.show_failure} for n, h in config.hidden.items()
         },
@@ -494,11 +514,13 @@ def grade_class(
 
 
 def _close_judges(client: Any, config: GradeConfig) -> None:
-    """Every worker's warm judge closed, and its slot gone (an external cluster's workers
-    outlive the grading)."""
+    """Every worker's warm judge closed, its slot and the class's frames gone (an external
+    cluster's workers outlive the grading)."""
     with contextlib.suppress(Exception):
         client.run(close_judges, str(config.grader_dir))
     shutil.rmtree(config.grader_dir / ".slots", ignore_errors=True)
+    if config.frames is not None:
+        config.frames.unlink(missing_ok=True)
 
 
 def _task_key(student: Student) -> str:

@@ -68,11 +68,14 @@ def write_job(
     results: Path,
     junit: Path,
     report: Path | None = None,
+    frames: Path | None = None,
     hidden: dict[str, Any] | None = None,
 ) -> Path:
     """Write a job file for this worker: LinkOptions and RunSettings as their fields;
+    `frames`: the class's simulated frames (harness.runner.frame_memo) to start from;
     `hidden`: scenario name -> {"label", "show_failure"}, shown to the student by label."""
     job = {
+        "frames": None if frames is None else str(frames),
         "hidden": hidden or {},
         "scenarios": scenarios,
         "link": link,
@@ -166,6 +169,8 @@ class _Suite:
         job = self.job
         try:
             chosen = [_scenario(ref) for ref in job["scenarios"]]
+            if job.get("frames"):
+                _frames_given(job["frames"], tuple(job["scenarios"]))
             self.scenarios.update((s.name, s) for s in chosen)
             run_suite(
                 chosen,
@@ -195,6 +200,15 @@ def _scenario(ref: str) -> Any:
     from harness.scenario.files import resolve_scenario
 
     return resolve_scenario(ref)
+
+
+@functools.cache
+def _frames_given(path: str, refs: tuple[str, ...]) -> int:
+    """The grader's frames of these scenarios kept here, once a process (a warm judge's
+    first student): how many plans (none where the memo is off or the file unreadable)."""
+    from harness.runner.frame_memo import load_frames
+
+    return load_frames(Path(path), [_scenario(ref) for ref in refs])
 
 
 def _hidden_scenarios(data: dict[str, Any]) -> dict[str, Any]:

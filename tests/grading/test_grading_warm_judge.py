@@ -103,6 +103,7 @@ def test_the_next_student_sees_nothing_of_the_previous_one(tmp_path: Path) -> No
     job = json.loads((tmp_path / "grades" / "grader" / "b_probe" / "job.json").read_text())
     assert "/.slots/" in job["options"]["node"]  # judged by the worker's warm judge
     assert not (tmp_path / "grades" / "grader" / ".slots").exists()
+    assert not (tmp_path / "grades" / "grader" / "frames.pickle").exists()  # the judges' only
     assert not leftovers(), "a process of the first student outlived the grading"
 
 
