@@ -70,10 +70,8 @@ def keeping(plan: RunPlan, frames: Iterable[Frame]) -> Iterator[Frame]:
         _read_only(frame)
         seen.append(frame)
         yield frame
-    if _kept is not None:
-        held = sum(len(f) for _, f in _kept.values())
-        if held + len(seen) <= MAX_FRAMES:
-            _kept[key] = (plan.scenario, seen)  # the scenario held: its id stays its own
+    if _room_for(len(seen)):
+        _kept[key] = (plan.scenario, seen)  # the scenario held: its id stays its own
 
 
 def complete(kept: Iterator[Frame]) -> None:
@@ -83,6 +81,11 @@ def complete(kept: Iterator[Frame]) -> None:
     if _kept is not None:
         for _ in kept:
             pass
+
+
+def _room_for(count: int) -> bool:
+    """Whether `count` more frames may be kept (MAX_FRAMES); False when none are kept."""
+    return _kept is not None and sum(len(f) for _, f in _kept.values()) + count <= MAX_FRAMES
 
 
 def _read_only(frame: Frame) -> None:
@@ -120,8 +123,7 @@ def load_frames(path: Path, scenarios: Iterable[Scenario]) -> int:
         scenario = ours.get(ref)
         if scenario is None or scenario != simulated:
             continue
-        held = sum(len(f) for _, f in _kept.values())
-        if held + len(frames) > MAX_FRAMES:
+        if not _room_for(len(frames)):
             break
         for frame in frames:
             _read_only(frame)

@@ -28,8 +28,9 @@ def planned_ticks(scenarios: Sequence[Scenario], settings: RunSettings) -> dict[
     for scenario in scenarios:
         plan = plan_one(scenario, "", LinkOptions(), settings)  # no link: the ticks are its own
         kept = frames_of(plan)
-        if kept is None:
-            with simulated_frames(plan) as frames:
-                kept = list(keeping(plan, frames))
-        counts[scenario.name] = len(kept)
+        if kept is not None:
+            counts[scenario.name] = len(kept)
+            continue
+        with simulated_frames(plan) as frames:  # kept by `keeping` where remembered
+            counts[scenario.name] = sum(1 for _ in keeping(plan, frames))
     return counts
