@@ -31,7 +31,7 @@ REQUIRED_KEYS = (
 #: suite, and the same students' runs back to back.
 GRADE_KEYS = (
     "grade_s", "grade_per_student_s", "grade_students", "grade_workers", "grade_runs_s",
-    "grade_ratio",
+    "grade_ratio", "grade_runs_out_s", "grade_ratio_out",
 )  # fmt: skip
 
 #: HIL without gaps (issue 41): a real-time suite over the virtual board, and the gaps

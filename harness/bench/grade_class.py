@@ -10,8 +10,10 @@ the eight are run, in three rounds that alternate the grades and the runs
 (medians). ``grade_per_student_s`` is the eight's grade wall time over its
 students; ``grade_ratio`` is that wall time over what the runs need on the
 cluster's workers (their sum over the workers): 1.0 would be grading at the speed
-of the runs (``grade4_*``: the same for the four). A quick bench grades two
-students on approach_wall once and runs none.
+of the runs (``grade4_*``: the same for the four). The runs are also made
+writing their report (``--out``, what grade writes for each student:
+``grade_runs_out_s``, ``grade_ratio_out``), grade against runs that do the same
+work. A quick bench grades two students on approach_wall once and runs none.
 """
 
 from __future__ import annotations
@@ -19,6 +21,7 @@ from __future__ import annotations
 import csv
 import statistics
 import tempfile
+from collections.abc import Callable
 from pathlib import Path
 
 import harness
@@ -71,12 +74,14 @@ def measure_grade(
     students: int, scenarios: tuple[str, ...] = (), runs: bool = True, rounds: int = ROUNDS
 ) -> StageResult:
     """With `runs`: classes of `students` and of DONE_WHEN_STUDENTS graded, and the larger
-    class's runs back to back, alternating for `rounds` rounds (medians; the smaller
-    class's runs are the first of them); without: one grade of `students`, no runs."""
+    class's runs back to back, without and with their reports, alternating for `rounds`
+    rounds (medians; the smaller class's runs are the first of them); without: one grade
+    of `students`, no runs."""
     workers = default_workers()
     sizes = sorted({students, DONE_WHEN_STUDENTS}) if runs else [students]
     grades: dict[int, list[float]] = {n: [] for n in sizes}
     run_walls: list[list[float]] = []
+    reported_walls: list[list[float]] = []  # the same runs, each writing its report
     with tempfile.TemporaryDirectory(prefix="fossbot-hil-bench-grade-") as tmp:
         classes = {n: Path(tmp) / f"class{n}" for n in sizes}
         scripts = {n: make_class(folder, n) for n, folder in classes.items()}
@@ -86,12 +91,14 @@ def measure_grade(
             for n in sizes:
                 grades[n].append(grade_wall_s(classes[n], Path(tmp) / f"grades{n}", scenarios))
 
-        def run_each() -> None:
-            run_walls.append(
-                [cli_wall_s([*cli_args(node=f"python3 {s}"), *scenarios]) for s in largest]
-            )
+        def runs_into(walls: list[list[float]], reports: Path | None) -> Callable[[], None]:
+            def run_each() -> None:
+                walls.append([cli_wall_s([*_run_args(s, reports), *scenarios]) for s in largest])
 
-        steps = (grade_each, run_each) if runs else (grade_each,)
+            return run_each
+
+        reported = runs_into(reported_walls, Path(tmp) / "reports")
+        steps = (grade_each, runs_into(run_walls, None), reported) if runs else (grade_each,)
         rounds = rounds if runs else 1
         for i in range(rounds):
             for step in steps if i % 2 == 0 else steps[::-1]:
@@ -99,7 +106,9 @@ def measure_grade(
     extra: dict[str, float | int | str | None] = {"grade_workers": workers, "grade_rounds": rounds}
     for n in sizes:
         grade_s = statistics.median(grades[n])
-        runs_s = statistics.median(sum(r[:n]) for r in run_walls) if run_walls else None
+        runs_s = _median_of_sums(run_walls, n)
+        reported_s = _median_of_sums(reported_walls, n)
+        share = min(workers, n)
         prefix = "grade" if n == sizes[-1] else f"grade{n}"
         extra.update(
             {
@@ -107,7 +116,22 @@ def measure_grade(
                 f"{prefix}_s": grade_s,
                 f"{prefix}_per_student_s": grade_s / n,
                 f"{prefix}_runs_s": runs_s,
-                f"{prefix}_ratio": grade_s / (runs_s / min(workers, n)) if runs_s else None,
+                f"{prefix}_ratio": grade_s / (runs_s / share) if runs_s else None,
+                f"{prefix}_runs_out_s": reported_s,
+                f"{prefix}_ratio_out": grade_s / (reported_s / share) if reported_s else None,
             }
         )
     return StageResult("grade", 0, float(extra["grade_s"] or 0.0), 0.0, extra)
+
+
+def _run_args(script: Path, reports: Path | None) -> list[str]:
+    """`fossbot-hil run`'s arguments for a student's script, with its report under
+    `reports` (a folder of the student's name) unless None."""
+    if reports is None:
+        return cli_args(node=f"python3 {script}")
+    return cli_args(node=f"python3 {script}", out=str(reports / script.parent.name))
+
+
+def _median_of_sums(rounds: list[list[float]], n: int) -> float | None:
+    """The median over rounds of the first `n` runs' summed wall time (None: no runs)."""
+    return statistics.median(sum(r[:n]) for r in rounds) if rounds else None

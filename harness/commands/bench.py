@@ -147,6 +147,8 @@ def figures_table(report: dict[str, Any]) -> Table:
         ("grade_per_student_s", "`fossbot-hil grade`, per student (default suite)", "s", 2),
         ("grade_runs_s", "  their `fossbot-hil run`s back to back", "s", 2),
         ("grade_ratio", "  grade / their runs on the same workers", "x", 2),
+        ("grade_runs_out_s", "  their runs back to back, each writing its report", "s", 2),
+        ("grade_ratio_out", "  grade / those runs on the same workers", "x", 2),
         ("hil_suite_s", "real-time HIL suite (virtual board, bundled driver)", "s", 2),
         ("hil_gap_median_s", "  gap between scenarios, median", "s", 2),
         ("hil_gap_max_s", "  gap between scenarios, longest", "s", 2),

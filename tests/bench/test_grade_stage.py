@@ -39,3 +39,4 @@ def test_a_graded_class_gives_the_per_student_figure() -> None:
     assert values["grade_s"] > 0
     assert values["grade_per_student_s"] == pytest.approx(values["grade_s"])
     assert values["grade_runs_s"] is None and values["grade_ratio"] is None
+    assert values["grade_runs_out_s"] is None and values["grade_ratio_out"] is None
