@@ -82,15 +82,12 @@ def name_list(text: str) -> list[str]:
     return names
 
 
-def given(option: str) -> Callable[[str], str]:
-    """A value that must not be empty: '' would silently mean "not given"."""
-
-    def parse(text: str) -> str:
-        if not text.strip():
-            raise argparse.ArgumentTypeError("must not be empty")
-        return text
-
-    return parse
+def not_empty(text: str) -> str:
+    """A value that must not be empty: '' would silently mean "not given" (argparse's
+    message names the option)."""
+    if not text.strip():
+        raise argparse.ArgumentTypeError("must not be empty")
+    return text
 
 
 #: The options that name files or give command lines, each with how its messages name it:

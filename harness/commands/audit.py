@@ -19,8 +19,8 @@ from harness.commands.arguments import (
     add_judging_options,
     add_link_option,
     check_status_regex,
-    given,
     name_list,
+    not_empty,
     whole_number,
 )
 from harness.commands.cluster_options import add_cluster_options, describe_cluster
@@ -64,7 +64,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument(
         "--out",
-        type=given("--out"),
+        type=not_empty,
         default="audit",
         metavar="DIR",
         help="where audit.json and each mistake's run log go (default ./audit)",

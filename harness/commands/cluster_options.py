@@ -13,7 +13,7 @@ from harness.cluster.client import WORKER_WAIT_S
 from harness.commands.arguments import (
     check_link_options,
     check_status_regex,
-    given,
+    not_empty,
     positive,
     whole_number,
 )
@@ -35,7 +35,7 @@ def add_cluster_options(parser: argparse.ArgumentParser, *, unit: str = "runs") 
     group = parser.add_argument_group(f"where the {unit} run (Dask)")
     group.add_argument(
         "--scheduler",
-        type=given("--scheduler"),
+        type=not_empty,
         metavar="ADDRESS",
         help="an existing Dask scheduler, e.g. tcp://host:8786 (default: an embedded cluster)",
     )

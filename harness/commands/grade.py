@@ -26,9 +26,9 @@ from harness.commands.arguments import (
     add_scenario_overrides,
     check_status_regex,
     duration,
-    given,
     judging_settings,
     link_options,
+    not_empty,
     request_of,
 )
 from harness.commands.cluster_options import add_cluster_options, describe_cluster, workers
@@ -70,7 +70,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument(
         "--out",
-        type=given("--out"),
+        type=not_empty,
         default="grades",
         metavar="DIR",
         help="where the class table and each student's logs go (default: grades)",
@@ -87,14 +87,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument(
         "--grading",
-        type=given("--grading"),
+        type=not_empty,
         metavar="FILE",
         help="grading file (YAML): scenarios, weights, hidden scenarios, points and judging "
         "options; options typed on the command line win (see docs/grading.md)",
     )
     parser.add_argument(
         "--roster",
-        type=given("--roster"),
+        type=not_empty,
         metavar="CSV",
         help="class roster with columns folder,id[,name]: ids in the tables and the "
         "gradebook, a row for every student on it",

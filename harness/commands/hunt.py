@@ -19,7 +19,7 @@ from harness.commands.arguments import (
     add_judging_options,
     add_link_option,
     add_node_options,
-    given,
+    not_empty,
     positive,
     seed,
     whole_number,
@@ -109,7 +109,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument(
         "--out",
-        type=given("--out"),
+        type=not_empty,
         default="hunt",
         metavar="DIR",
         help="where the counterexample and hunt.json go (default ./hunt)",

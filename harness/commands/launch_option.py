@@ -10,14 +10,14 @@ import argparse
 
 from rich.console import Console
 
-from harness.commands.arguments import add_row, given, request_of
+from harness.commands.arguments import add_row, not_empty, request_of
 from harness.errors import ConfigError
 
 __all__ = ["add_launch_option", "check_launch"]
 
 
 def add_launch_option(parser: argparse.ArgumentParser) -> None:
-    add_row(parser, "launch", nargs=2, type=given("--launch"), metavar=("PACKAGE", "FILE"))
+    add_row(parser, "launch", nargs=2, type=not_empty, metavar=("PACKAGE", "FILE"))
 
 
 def check_launch(args: argparse.Namespace, console: Console) -> None:

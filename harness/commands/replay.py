@@ -17,7 +17,7 @@ from harness.commands.arguments import (
     check_output_file,
     check_status_regex,
     fault_list,
-    given,
+    not_empty,
     seed,
 )
 from harness.commands.node_names import topic_option
@@ -47,7 +47,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         rule_default="optional",
     )
     parser.add_argument(
-        "--junit-xml", type=given("--junit-xml"), metavar="FILE", help="write a JUnit XML report"
+        "--junit-xml", type=not_empty, metavar="FILE", help="write a JUnit XML report"
     )
     parser.add_argument(
         "--faults",
@@ -60,7 +60,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument(
         "--record",
-        type=given("--record"),
+        type=not_empty,
         metavar="FILE",
         help="write the replayed run as a new MCAP recording",
     )

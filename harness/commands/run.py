@@ -14,7 +14,7 @@ from harness.commands.arguments import (
     add_link_option,
     add_node_options,
     add_scenario_overrides,
-    given,
+    not_empty,
 )
 from harness.commands.launch_option import add_launch_option, check_launch
 from harness.commands.run_grading import RunGrading, add_grading_options, apply_grading
@@ -53,11 +53,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     add_judging_options(parser)
     parser.add_argument("--gui", action="store_true", help="open the PyBullet viewer")
     parser.add_argument(
-        "--junit-xml", type=given("--junit-xml"), metavar="FILE", help="write a JUnit XML report"
+        "--junit-xml", type=not_empty, metavar="FILE", help="write a JUnit XML report"
     )
     parser.add_argument(
         "--out",
-        type=given("--out"),
+        type=not_empty,
         metavar="DIR",
         help="write a report folder: plots, summary.json, junit.xml, index.html "
         "(see docs/reports.md)",
@@ -83,7 +83,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument(
         "--baseline",
-        type=given("--baseline"),
+        type=not_empty,
         metavar="FILE",
         help="summary.json of an earlier run (or its --out folder): say what regressed, "
         "what was fixed and what still fails (see docs/ci.md)",

@@ -21,7 +21,7 @@ from typing import TYPE_CHECKING
 
 from rich.console import Console
 
-from harness.commands.arguments import check_output_file, given
+from harness.commands.arguments import check_output_file, not_empty
 from harness.errors import ConfigError
 from harness.judge.verdicts import RunVerdict
 
@@ -49,7 +49,7 @@ def add_grading_options(parser: argparse.ArgumentParser) -> None:
     group = parser.add_argument_group("grading (see docs/grading.md)")
     group.add_argument(
         "--grading",
-        type=given("--grading"),
+        type=not_empty,
         metavar="FILE",
         help="grading file (YAML): the scenarios, their weights, hidden scenarios, points and "
         "judging options (options typed on the command line win); a hidden scenario is shown "
@@ -57,7 +57,7 @@ def add_grading_options(parser: argparse.ArgumentParser) -> None:
     )
     group.add_argument(
         "--gradescope",
-        type=given("--gradescope"),
+        type=not_empty,
         metavar="FILE",
         help="after the suite, write Gradescope's autograder results (results.json) to FILE: "
         "the score and a test per scenario (see examples/gradescope/)",

@@ -16,8 +16,8 @@ from harness.commands.arguments import (
     add_node_options,
     check_output_file,
     domain_id,
-    given,
     link_options,
+    not_empty,
     positive,
     seed,
 )
@@ -90,7 +90,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument(
         "--record",
-        type=given("--record"),
+        type=not_empty,
         metavar="FILE.mcap|DIR",
         help="write the judged session as an MCAP recording: to FILE.mcap, or to WORLD.mcap "
         "in the folder DIR (any path not ending in .mcap is a folder, made if need be; needs "
@@ -98,13 +98,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument(
         "--animation",
-        type=given("--animation"),
+        type=not_empty,
         metavar="FILE",
         help="write the judged session as an animated top-down view to hand in: FILE.gif "
         "(or FILE.mp4 where ffmpeg is installed; needs a node that answers)",
     )
     parser.add_argument(  # the old name (run's --animate is a flag); kept so scripts still work
-        "--animate", dest="animation", type=given("--animate"), help=argparse.SUPPRESS
+        "--animate", dest="animation", type=not_empty, help=argparse.SUPPRESS
     )
     parser.add_argument(
         "--seed", type=seed, help="seed of the LIDAR's faults (default: the world's)"

@@ -15,8 +15,8 @@ from harness.commands.arguments import (
     add_judging_options,
     add_link_option,
     add_node_options,
-    given,
     name_list,
+    not_empty,
     whole_number,
 )
 from harness.commands.cluster_options import (
@@ -121,7 +121,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     add_judging_options(parser, threshold=False)  # --thresholds is a factor here
     parser.add_argument(
         "--out",
-        type=given("--out"),
+        type=not_empty,
         default="sweep",
         metavar="DIR",
         help="where results.csv and summary.txt go (default ./sweep)",
