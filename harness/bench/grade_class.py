@@ -10,10 +10,10 @@ the eight are run, in three rounds that alternate the grades and the runs
 (medians). ``grade_per_student_s`` is the eight's grade wall time over its
 students; ``grade_ratio`` is that wall time over what the runs need on the
 cluster's workers (their sum over the workers): 1.0 would be grading at the speed
-of the runs (``grade4_*``: the same for the four). The runs are also made
-writing their report (``--out``, what grade writes for each student:
-``grade_runs_out_s``, ``grade_ratio_out``), grade against runs that do the same
-work. A quick bench grades two students on approach_wall once and runs none.
+of the runs (``grade4_*``: the same for the four). The eight are also run each
+writing its report (``--out``, what grade writes for each student):
+``grade_runs_out_s`` and ``grade_ratio_out`` set grade against runs doing the
+same work. A quick bench grades two students on approach_wall once and runs none.
 """
 
 from __future__ import annotations
