@@ -356,6 +356,7 @@ def run(args: argparse.Namespace, console: Console) -> int:
             )
         sandbox = sandbox_limits(args, console)  # this machine cannot sandbox: exit 2 now
         remember_frames()  # the tick counts' frames are the judges' too (class_frames below)
+        stack.callback(remember_frames, False)  # and none kept here if grade ends before
         planned = planned_ticks(scenarios, settings)  # what a partial score counts against
         replaced = previous_grading(out)
         client = soon.client()  # a --scheduler that does not answer: exit 2 now

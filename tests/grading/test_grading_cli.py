@@ -7,6 +7,7 @@ from pathlib import Path
 import pytest
 
 from harness.cli import main
+from harness.runner import frame_memo
 
 
 @pytest.fixture
@@ -89,3 +90,4 @@ def test_usage_errors_exit_2_with_one_line(
     assert needle in err
     assert not out.exists()
     assert (tmp_path / "foreign" / "thesis.tex").read_text() == "precious"
+    assert frame_memo._kept is None  # the tick counts' frames are not kept on in this process
