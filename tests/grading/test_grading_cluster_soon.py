@@ -53,10 +53,13 @@ def test_a_scheduler_that_does_not_answer_is_a_config_error_where_the_client_is_
     assert _cluster_threads() == []
 
 
-def _where_graded(config: GradeConfig) -> tuple[int, str]:
-    import time
+# Both tasks at once, so each is on a worker of its own (one task a worker at a time): the
+# workers are threads of this process, so they meet here; two on one worker never would.
+_BOTH_RUNNING = threading.Barrier(2)
 
-    time.sleep(0.5)  # both workers take one: neither is free when the other is given its task
+
+def _where_graded(config: GradeConfig) -> tuple[int, str]:
+    _BOTH_RUNNING.wait(timeout=30)
     return os.getpid(), _slot(config).root.name
 
 
