@@ -26,8 +26,10 @@ if TYPE_CHECKING:
     from harness.runner.plan import RunPlan
     from harness.scenario.schema import Scenario
 
-__all__ = ["MAX_FRAMES", "complete", "frames_of", "keeping", "load_frames", "remember_frames"]
-__all__ += ["save_frames"]
+__all__ = [
+    "MAX_FRAMES", "complete", "frames_of", "keeping", "load_frames", "remember_frames",
+    "save_frames",
+]  # fmt: skip
 
 MAX_FRAMES = 10_000  # kept at most (a frame is about 3 KB): the default suite has 544
 
