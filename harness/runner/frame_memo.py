@@ -45,12 +45,18 @@ def remember_frames(enabled: bool = True) -> None:
 def _key(plan: RunPlan) -> tuple[object, ...] | None:
     if _kept is None or plan.settings.gui:  # a viewer shows the world: it must be built
         return None
-    key = (id(plan.scenario), plan.seed, plan.profile)
+    key = _key_of(plan.scenario, plan.seed, plan.profile)
     try:
         hash(key)
     except TypeError:  # a fault given values that cannot be compared: simulated each time
         return None
     return key
+
+
+def _key_of(scenario: object, seed: object, profile: object) -> tuple[object, ...]:
+    """Where a plan's frames are kept: its scenario object (held beside them, so its id
+    stays its own), its seed and its faults."""
+    return (id(scenario), seed, profile)
 
 
 def frames_of(plan: RunPlan) -> list[Frame] | None:
@@ -129,6 +135,6 @@ def load_frames(path: Path, scenarios: Iterable[Scenario]) -> int:
             break
         for frame in frames:
             _read_only(frame)
-        _kept[(id(scenario), seed, profile)] = (scenario, frames)
+        _kept[_key_of(scenario, seed, profile)] = (scenario, frames)
         given += 1
     return given
